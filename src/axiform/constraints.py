@@ -1,0 +1,105 @@
+"""Dof numbering: fixed and prescribed dofs, ties (shared dofs), and the sparse pattern.
+
+Full dofs are numbered node by node, dofs_per_node each.  Every full dof maps to an
+equation of the extended system: free equations 0..nf-1 first, then prescribed ones
+nf..nf+np-1.  Tied dofs share one equation.  Prescribed values are multiplied by the
+load factor lambda.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+
+class DofMap:
+    """Map full dofs to equations.  fixed: {full dof: reference value}; ties: groups of full
+    dofs that share one value."""
+
+    def __init__(self, n_full: int, fixed: dict[int, float], ties: list[np.ndarray] = ()):
+        root = np.arange(n_full)
+        if len(ties):
+            pairs = np.vstack([np.column_stack([g[:-1], g[1:]]) for g in map(np.asarray, ties) if len(g) > 1])
+            graph = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n_full, n_full))
+            _, label = connected_components(graph, directed=False)
+            first = np.full(label.max() + 1, n_full)
+            np.minimum.at(first, label, np.arange(n_full))
+            root = first[label]
+        value = {}
+        for dof, v in fixed.items():
+            r = root[dof]
+            if r in value and abs(value[r] - v) > 1e-14 * max(1.0, abs(v)):
+                raise ValueError(f"dof {dof} is tied to a dof prescribed to another value")
+            value[r] = v
+        roots = np.unique(root)
+        is_presc = np.isin(roots, np.fromiter(value.keys(), dtype=np.int64, count=len(value)))
+        free_roots, presc_roots = roots[~is_presc], roots[is_presc]
+        eq_of_root = np.empty(n_full, dtype=np.int64)
+        eq_of_root[free_roots] = np.arange(len(free_roots))
+        eq_of_root[presc_roots] = len(free_roots) + np.arange(len(presc_roots))
+        self.n_full = n_full
+        self.nf = len(free_roots)
+        self.np = len(presc_roots)
+        self.eq = eq_of_root[root]  # full dof -> equation
+        self.prescribed_ref = np.array([value[r] for r in presc_roots], dtype=float)
+        self.free_dof = free_roots  # one representative full dof per free equation
+
+    @property
+    def n_eq(self) -> int:
+        return self.nf + self.np
+
+    def expand(self, u_f: np.ndarray, lam: float) -> np.ndarray:
+        """Full displacement vector from the free unknowns and the load factor."""
+        return np.concatenate([u_f, lam * self.prescribed_ref])[self.eq]
+
+    def gather(self, v_full: np.ndarray) -> np.ndarray:
+        """Sum a full vector (forces) into the equations of the extended system."""
+        return np.bincount(self.eq, weights=v_full, minlength=self.n_eq)
+
+
+class SparsePattern:
+    """The CSR pattern of the extended system, built once from the dof connectivity of
+    every term (element dofs, edge dofs ...); values are refilled each iteration."""
+
+    def __init__(self, dofmap: DofMap, blocks: list[np.ndarray]):
+        self.dofmap = dofmap
+        n = dofmap.n_eq
+        keys = [self._keys(b) for b in blocks]
+        self.keys = np.unique(np.concatenate([k.ravel() for k in keys]))
+        rows, cols = self.keys // n, self.keys % n
+        self.indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=n))])
+        self.indices = cols
+        nf = dofmap.nf
+        ff = (rows < nf) & (cols < nf)
+        fp = (rows < nf) & (cols >= nf)
+        self._ff = np.flatnonzero(ff)
+        self._fp = np.flatnonzero(fp)
+        self._ff_csr = self._sub(rows[ff], cols[ff], nf, nf)
+        self._fp_csr = self._sub(rows[fp], cols[fp] - nf, nf, dofmap.np)
+
+    def _keys(self, dofs: np.ndarray) -> np.ndarray:
+        eq = self.dofmap.eq[dofs]  # (m, k)
+        return (eq[:, :, None] * self.dofmap.n_eq + eq[:, None, :])
+
+    @staticmethod
+    def _sub(rows, cols, nr, nc):
+        indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=nr))])
+        return cols.astype(np.int32), indptr.astype(np.int32), (nr, nc)
+
+    def positions(self, dofs: np.ndarray) -> np.ndarray:
+        """Positions in the data array of each entry (m, k, k) of blocks on these dofs."""
+        return np.searchsorted(self.keys, self._keys(dofs)).ravel()
+
+    def accumulate(self, positions: np.ndarray, values: np.ndarray, data: np.ndarray | None = None):
+        """Add values (matching positions) into a data array of the pattern."""
+        add = np.bincount(positions, weights=values.ravel(), minlength=len(self.keys))
+        return add if data is None else data + add
+
+    def blocks(self, data: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """K_ff and K_fp (free rows; free and prescribed columns) as CSR matrices."""
+        i, p, s = self._ff_csr
+        K_ff = sp.csr_matrix((data[self._ff], i, p), shape=s)
+        i, p, s = self._fp_csr
+        K_fp = sp.csr_matrix((data[self._fp], i, p), shape=s)
+        return K_ff, K_fp

@@ -1,0 +1,171 @@
+"""Meshes of the meridian plane (r, z): structured rectangles, gmsh import, node and edge sets."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .elements import ELEMENTS, ElementKind, gauss_quad, jacobian
+
+
+class MeshError(ValueError):
+    """A mesh that cannot be used (inverted elements, nodes at r < 0, unknown cells...)."""
+
+
+@dataclass
+class Mesh:
+    """Reference nodes (n, 2) as [R, Z], cells (e, k) counter-clockwise, the element kind,
+    named node sets (arrays of node indices) and named edge sets (arrays of boundary-edge
+    indices into `boundary_edges`)."""
+
+    points: np.ndarray
+    cells: np.ndarray
+    element: ElementKind
+    node_sets: dict[str, np.ndarray] = field(default_factory=dict)
+    edge_sets: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def __post_init__(self):
+        self.points = np.asarray(self.points, dtype=float)
+        self.cells = np.asarray(self.cells, dtype=np.int64)
+        edges, owner, side = boundary_edges(self.cells, self.element)
+        self.boundary_edges = edges  # (m, edge_nodes) ordered as the owning cell runs (CCW)
+        self.boundary_owner = owner  # owning cell of each boundary edge
+        self.boundary_side = side  # local edge number 0..3 in the owning cell
+
+    @property
+    def n_nodes(self) -> int:
+        return len(self.points)
+
+    @property
+    def n_cells(self) -> int:
+        return len(self.cells)
+
+    @property
+    def corner_nodes(self) -> np.ndarray:
+        """Nodes that are corners of some cell (all nodes but the Q8 mid-side ones)."""
+        return np.unique(self.cells[:, :4])
+
+    def size(self) -> float:
+        """A characteristic element size: the smallest cell edge length."""
+        c = self.points[self.cells[:, :4]]
+        d = np.linalg.norm(c - np.roll(c, -1, axis=1), axis=-1)
+        return float(d.min())
+
+    def check(self) -> None:
+        """Refuse nodes at r < 0 and cells with detJ <= 0 anywhere (an inverted mesh)."""
+        tol = 1e-9 * max(1.0, float(np.abs(self.points).max()))
+        bad = np.flatnonzero(self.points[:, 0] < -tol)
+        if bad.size:
+            raise MeshError(f"node(s) {bad[:10].tolist()} lie at r < 0; the meridian plane is r >= 0")
+        xi_g, _ = gauss_quad(self.element.gauss)
+        corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=float)
+        xi = np.vstack([xi_g, corners])
+        _, _, detJ, _ = jacobian(self.element, self.points[self.cells], xi)
+        bad = np.flatnonzero((detJ <= 0).any(axis=1))
+        if bad.size:
+            raise MeshError(
+                f"inverted or degenerate element(s) {bad[:10].tolist()} (detJ <= 0; nodes must run "
+                f"counter-clockwise in the (r, z) plane): first one has nodes {self.cells[bad[0]].tolist()}")
+
+
+def boundary_edges(cells: np.ndarray, kind: ElementKind):
+    """Edges used by exactly one cell, with the owning cell's orientation (outward normal on
+    the right-hand side of the edge's direction, i.e. (dz, -dr))."""
+    local = kind.edge_local_nodes()  # (4, edge_nodes)
+    all_edges = cells[:, local]  # (e, 4, en)
+    ends = np.sort(all_edges[:, :, :2].reshape(-1, 2), axis=1)
+    _, inv, count = np.unique(ends, axis=0, return_inverse=True, return_counts=True)
+    once = count[inv.ravel()] == 1
+    idx = np.flatnonzero(once)
+    return all_edges.reshape(-1, local.shape[1])[idx], idx // 4, idx % 4
+
+
+def rectangle(r: tuple[float, float], z: tuple[float, float], divisions: tuple[int, int],
+              element: str = "q4") -> Mesh:
+    """Structured mesh of [r0, r1] x [z0, z1] with divisions (nr, nz); Q8 gets mid-side nodes.
+
+    Named node and edge sets: "left" (r = r0), "right" (r = r1), "bottom" (z = z0), "top" (z = z1).
+    """
+    kind = ELEMENTS[element]
+    nr, nz = divisions
+    if kind.nodes == 4:
+        R, Z = np.meshgrid(np.linspace(*r, nr + 1), np.linspace(*z, nz + 1), indexing="xy")
+        points = np.column_stack([R.ravel(), Z.ravel()])
+        i, j = np.meshgrid(np.arange(nr), np.arange(nz), indexing="xy")
+        n0 = (j * (nr + 1) + i).ravel()
+        cells = np.column_stack([n0, n0 + 1, n0 + nr + 2, n0 + nr + 1])
+    else:
+        # a (2nr+1) x (2nz+1) grid of which the cell centres are dropped
+        R, Z = np.meshgrid(np.linspace(*r, 2 * nr + 1), np.linspace(*z, 2 * nz + 1), indexing="xy")
+        keep = ~((np.arange(2 * nz + 1)[:, None] % 2 == 1) & (np.arange(2 * nr + 1)[None, :] % 2 == 1))
+        number = -np.ones(R.shape, dtype=np.int64)
+        number[keep] = np.arange(keep.sum())
+        points = np.column_stack([R[keep], Z[keep]])
+        i, j = np.meshgrid(2 * np.arange(nr), 2 * np.arange(nz), indexing="xy")
+        i, j = i.ravel(), j.ravel()
+        cells = np.column_stack([number[j, i], number[j, i + 2], number[j + 2, i + 2], number[j + 2, i],
+                                 number[j, i + 1], number[j + 1, i + 2], number[j + 2, i + 1], number[j + 1, i]])
+    mesh = Mesh(points, cells, kind)
+    tol = 1e-9 * max(abs(r[1] - r[0]), abs(z[1] - z[0]))
+    for name, axis, value in (("left", 0, r[0]), ("right", 0, r[1]), ("bottom", 1, z[0]), ("top", 1, z[1])):
+        mesh.node_sets[name] = np.flatnonzero(np.abs(mesh.points[:, axis] - value) <= tol)
+        mesh.edge_sets[name] = edges_on_nodes(mesh, mesh.node_sets[name])
+    return mesh
+
+
+def edges_on_nodes(mesh: Mesh, nodes: np.ndarray) -> np.ndarray:
+    """Boundary edges (indices) all of whose nodes are in `nodes`."""
+    inside = np.zeros(mesh.n_nodes, dtype=bool)
+    inside[nodes] = True
+    return np.flatnonzero(inside[mesh.boundary_edges].all(axis=1))
+
+
+_MESHIO_QUADS = {"quad": "q4", "quad8": "q8"}
+
+
+def read_gmsh(path: str | Path, element: str | None = None) -> Mesh:
+    """Read a gmsh .msh file (through meshio) made of quadrilaterals in the (x, y) = (r, z) plane.
+
+    Quad4 cells give Q4 (or SFR if element="sfr"), quad8 give Q8.  Physical groups become
+    named node sets (all their nodes) and, for line groups, named edge sets.
+    """
+    import meshio
+
+    m = meshio.read(path)
+    quads = [(b.type, b.data) for b in m.cells if b.type in _MESHIO_QUADS]
+    if not quads:
+        raise MeshError(f"{path}: no quadrilateral cells (quad or quad8) found")
+    types = {t for t, _ in quads}
+    if len(types) > 1:
+        raise MeshError(f"{path}: mixes {sorted(types)}; one element kind per mesh")
+    ctype = types.pop()
+    native = _MESHIO_QUADS[ctype]
+    element = element or native
+    if native == "q8" and element != "q8" or native == "q4" and element == "q8":
+        raise MeshError(f"{path}: holds {ctype} cells, which cannot be used as element '{element}'")
+    cells = np.vstack([d for _, d in quads]).astype(np.int64)
+    points = np.asarray(m.points[:, :2], dtype=float)
+    used = np.unique(cells)
+    # drop nodes that no quad uses (gmsh keeps geometry points)
+    renumber = -np.ones(len(points), dtype=np.int64)
+    renumber[used] = np.arange(len(used))
+    mesh = Mesh(points[used], renumber[cells], ELEMENTS[element])
+    names = {int(v[0]): k for k, v in (m.field_data or {}).items()}
+    phys = m.cell_data.get("gmsh:physical")
+    if phys is not None:
+        groups: dict[str, list[np.ndarray]] = {}
+        line_groups: dict[str, list[np.ndarray]] = {}
+        for block, tags in zip(m.cells, phys):
+            for tag in np.unique(tags):
+                name = names.get(int(tag), str(int(tag)))
+                nodes = renumber[np.unique(block.data[tags == tag])]
+                groups.setdefault(name, []).append(nodes[nodes >= 0])
+                if block.type.startswith("line"):
+                    line_groups.setdefault(name, []).append(nodes[nodes >= 0])
+        for name, parts in groups.items():
+            mesh.node_sets[name] = np.unique(np.concatenate(parts))
+        for name, parts in line_groups.items():
+            mesh.edge_sets[name] = edges_on_nodes(mesh, np.unique(np.concatenate(parts)))
+    return mesh
