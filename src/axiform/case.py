@@ -1,0 +1,343 @@
+"""The TOML case file: schema (every key validated), and the model built from it.
+
+An invalid case raises CaseError naming the key path and the reason, before any work.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from .materials import MooneyRivlin
+from .mesh import Mesh, MeshError, read_gmsh, rectangle
+from .model import Model
+from .selectors import SelectorError, select_edges, select_nodes
+from .solver import DisplacementControl, LoadControl, NewtonOptions
+
+DofName = Literal["ur", "uz", "rot"]
+PositiveFloat = Annotated[float, Field(gt=0)]
+
+
+class CaseError(ValueError):
+    """An invalid case: the message names the key path and the reason."""
+
+
+class Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=False)
+
+
+class Selector(Strict):
+    """Nodes matching all given criteria: r / z (within tol), box [[r0, z0], [r1, z1]], set."""
+
+    r: float | None = None
+    z: float | None = None
+    box: tuple[tuple[float, float], tuple[float, float]] | None = None
+    set: str | None = None
+    tol: PositiveFloat | None = None
+
+    @model_validator(mode="after")
+    def _some(self):
+        if self.r is None and self.z is None and self.box is None and self.set is None:
+            raise ValueError("a selector needs at least one of r, z, box, set")
+        return self
+
+
+class MeshSpec(Strict):
+    kind: Literal["rectangle", "gmsh"] = "rectangle"
+    element: Literal["q4", "q8", "sfr"]
+    r: tuple[float, float] | None = None
+    z: tuple[float, float] | None = None
+    divisions: tuple[Annotated[int, Field(ge=1)], Annotated[int, Field(ge=1)]] | None = None
+    file: str | None = None
+    sfr_edges: Literal["tie", "fix", "free"] = "tie"
+
+    @model_validator(mode="after")
+    def _kind(self):
+        if self.kind == "rectangle":
+            for key in ("r", "z", "divisions"):
+                if getattr(self, key) is None:
+                    raise ValueError(f"a rectangle mesh needs '{key}'")
+            if self.file is not None:
+                raise ValueError("'file' belongs to kind = \"gmsh\"")
+            if not self.r[0] < self.r[1] or not self.z[0] < self.z[1]:
+                raise ValueError("r and z must be given as [min, max] with min < max")
+            if self.r[0] < 0:
+                raise ValueError("r must be >= 0 (the meridian plane)")
+        else:
+            if self.file is None:
+                raise ValueError("a gmsh mesh needs 'file'")
+            for key in ("r", "z", "divisions"):
+                if getattr(self, key) is not None:
+                    raise ValueError(f"'{key}' belongs to kind = \"rectangle\"")
+        return self
+
+
+class MaterialSpec(Strict):
+    """Mooney-Rivlin (C1, C2) or neo-Hooke (C1, or E and nu); kappa given, or from E and nu."""
+
+    model: Literal["mooney-rivlin", "neo-hooke"]
+    C1: PositiveFloat | None = None
+    C2: Annotated[float, Field(ge=0)] | None = None
+    kappa: PositiveFloat | None = None
+    E: PositiveFloat | None = None
+    nu: Annotated[float, Field(gt=-1.0, lt=0.5)] | None = None
+
+    @model_validator(mode="after")
+    def _constants(self):
+        if (self.E is None) != (self.nu is None):
+            raise ValueError("E and nu go together")
+        if self.kappa is not None and self.E is not None:
+            raise ValueError("give kappa or E and nu, not both")
+        if self.kappa is None and self.E is None:
+            raise ValueError("missing material constant: kappa (or E and nu)")
+        if self.model == "mooney-rivlin":
+            missing = [k for k in ("C1", "C2") if getattr(self, k) is None]
+            if missing:
+                raise ValueError(f"missing material constant: {', '.join(missing)}")
+        else:
+            if self.C2 not in (None, 0.0):
+                raise ValueError("neo-hooke has no C2 (use mooney-rivlin)")
+            if self.C1 is None and self.E is None:
+                raise ValueError("missing material constant: C1 (or E and nu)")
+        return self
+
+    def build(self) -> MooneyRivlin:
+        C2 = self.C2 or 0.0
+        C1 = self.C1 if self.C1 is not None else self.E / (4.0 * (1.0 + self.nu))  # mu / 2
+        kappa = self.kappa if self.kappa is not None else self.E / (3.0 * (1.0 - 2.0 * self.nu))
+        return MooneyRivlin(C1, C2, kappa)
+
+
+class FixSpec(Strict):
+    at: Selector
+    dofs: Annotated[list[DofName], Field(min_length=1)]
+    value: float = 0.0
+
+
+class PressureSpec(Strict):
+    on: Selector
+    value: float
+
+
+class PointLoadSpec(Strict):
+    at: Selector
+    dof: Literal["ur", "uz"]
+    value: float
+
+
+class MonitorSpec(Strict):
+    """One node's displacement (at + dof) or the reaction summed over nodes (reaction + dof)."""
+
+    name: str
+    at: Selector | None = None
+    reaction: Selector | None = None
+    dof: DofName
+
+    @model_validator(mode="after")
+    def _one(self):
+        if (self.at is None) == (self.reaction is None):
+            raise ValueError("a monitor needs exactly one of 'at' or 'reaction'")
+        return self
+
+
+class DofRef(Strict):
+    at: Selector
+    dof: DofName
+
+
+class SolverSpec(Strict):
+    control: Literal["load", "displacement", "arc-length"] = "load"
+    dof: DofRef | None = None
+    target: float | None = None
+    steps: Annotated[int, Field(ge=1)] = 10
+    max_iterations: Annotated[int, Field(ge=1)] = 20
+    tolerance: Annotated[float, Field(gt=0, lt=1)] = 1e-8
+    min_step: Annotated[float, Field(gt=0, le=1)] = 1e-4
+    growth: Annotated[float, Field(ge=1)] = 1.5
+
+    @model_validator(mode="after")
+    def _control(self):
+        if self.control == "displacement":
+            if self.dof is None or self.target is None:
+                raise ValueError("displacement control needs 'dof' and 'target'")
+        elif self.dof is not None:
+            raise ValueError("'dof' belongs to control = \"displacement\"")
+        if self.control == "arc-length":
+            raise ValueError("arc-length control is not available in this version; use \"load\" or \"displacement\"")
+        if self.target is not None and self.target == 0:
+            raise ValueError("target must not be 0")
+        return self
+
+
+class OutputSpec(Strict):
+    every: Annotated[int, Field(ge=1)] = 1  # field output every k-th converged step (and the last)
+    vtu: bool = True
+
+
+class Case(Strict):
+    title: str = ""
+    mesh: MeshSpec
+    material: MaterialSpec
+    fix: list[FixSpec] = []
+    pressure: list[PressureSpec] = []
+    point_load: list[PointLoadSpec] = []
+    monitor: list[MonitorSpec] = []
+    solver: SolverSpec = SolverSpec()
+    output: OutputSpec = OutputSpec()
+
+
+def _loc(loc: tuple) -> str:
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        elif part in ("function-after",) or str(part).startswith(("function-", "tuple[", "list[")):
+            continue
+        else:
+            out += ("." if out else "") + str(part)
+    return out or "(case)"
+
+
+def parse(data: dict[str, Any]) -> Case:
+    """Validate a case given as a dict; CaseError lists every problem with its key path."""
+    try:
+        return Case.model_validate(data)
+    except ValidationError as exc:
+        lines = []
+        for err in exc.errors():
+            msg = err["msg"].removeprefix("Value error, ")
+            if err["type"] == "extra_forbidden":
+                msg = "unknown key"
+            lines.append(f"{_loc(err['loc'])}: {msg}")
+        raise CaseError("\n".join(dict.fromkeys(lines))) from None
+
+
+def override(data: dict[str, Any], assignment: str) -> None:
+    """Apply KEY=VALUE (dotted key, VALUE in TOML syntax; a bare word is taken as a string)."""
+    key, sep, text = assignment.partition("=")
+    if not sep or not key.strip():
+        raise CaseError(f"--set {assignment!r}: expected KEY=VALUE")
+    try:
+        value = tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = text
+    *parents, last = key.strip().split(".")
+    node = data
+    for p in parents:
+        node = node.setdefault(p, {})
+        if not isinstance(node, dict):
+            raise CaseError(f"--set {key}: '{p}' is not a table")
+    node[last] = value
+
+
+def load(path: str | Path, overrides: list[str] = ()) -> Case:
+    """Read and validate a TOML case file, with optional KEY=VALUE overrides."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise CaseError(f"{path}: no such file") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise CaseError(f"{path}: not valid TOML ({exc})") from None
+    for assignment in overrides:
+        override(data, assignment)
+    return parse(data)
+
+
+@dataclass
+class Monitor:
+    """A named scalar read off each converged step: one dof, or a sum of reactions."""
+
+    name: str
+    dofs: np.ndarray
+    reaction: bool
+
+    def value(self, step) -> float:
+        if self.reaction:
+            return float(step.evaluation.r_full[self.dofs].sum())
+        return float(step.u[self.dofs].sum())
+
+
+@dataclass
+class Built:
+    """What a case turns into: the model, the path-following control, Newton options, monitors."""
+
+    case: Case
+    model: Model
+    control: LoadControl | DisplacementControl
+    options: NewtonOptions
+    monitors: list[Monitor]
+
+
+def _mesh(spec: MeshSpec, base: Path) -> Mesh:
+    if spec.kind == "rectangle":
+        return rectangle(spec.r, spec.z, spec.divisions, spec.element)
+    path = Path(spec.file)
+    path = path if path.is_absolute() else base / path
+    if not path.exists():
+        raise CaseError(f"mesh.file: no such file {path}")
+    try:
+        return read_gmsh(path, spec.element)
+    except MeshError:
+        raise
+    except Exception as exc:  # meshio's own errors for unreadable files
+        raise CaseError(f"mesh.file: cannot read {path} ({exc})") from None
+
+
+def _one_node(mesh: Mesh, sel: Selector, where: str) -> int:
+    nodes = select_nodes(mesh, sel.model_dump(), where)
+    if len(nodes) != 1:
+        raise CaseError(f"{where}: selector must match exactly one node, it matches {len(nodes)}")
+    return int(nodes[0])
+
+
+def build(case: Case, base: str | Path = ".") -> Built:
+    """Turn a validated case into a finalized model; errors name the key at fault."""
+    base = Path(base)
+    try:
+        mesh = _mesh(case.mesh, base)
+        model = Model(mesh, case.material.build(), sfr_edges=case.mesh.sfr_edges)
+    except MeshError as exc:
+        raise CaseError(f"mesh: {exc}") from None
+    try:
+        for i, f in enumerate(case.fix):
+            model.prescribe(select_nodes(mesh, f.at.model_dump(), f"fix[{i}].at"), f.dofs, f.value)
+        for i, p in enumerate(case.pressure):
+            model.pressure(select_edges(mesh, p.on.model_dump(), f"pressure[{i}].on"), p.value)
+        for i, pl in enumerate(case.point_load):
+            model.point_load(select_nodes(mesh, pl.at.model_dump(), f"point_load[{i}].at"), pl.dof, pl.value)
+        monitors = []
+        for i, m in enumerate(case.monitor):
+            if m.dof == "rot" and model.dpn == 2:
+                raise CaseError(f"monitor[{i}].dof: element '{case.mesh.element}' has no rotation dof")
+            if m.at is not None:
+                nodes = np.array([_one_node(mesh, m.at, f"monitor[{i}].at")])
+            else:
+                nodes = select_nodes(mesh, m.reaction.model_dump(), f"monitor[{i}].reaction")
+            monitors.append(Monitor(m.name, model.dof(nodes, m.dof), m.reaction is not None))
+        if len({m.name for m in monitors}) != len(monitors):
+            raise CaseError("monitor: names must be unique")
+        s = case.solver
+        if s.control == "displacement":
+            if s.dof.dof == "rot":
+                raise CaseError("solver.dof.dof: drive a displacement (ur or uz), not a fibre rotation")
+            node = _one_node(mesh, s.dof.at, "solver.dof.at")
+            dof = int(model.dof(node, s.dof.dof))
+            if dof in model.fixed:
+                raise CaseError("solver.dof: the driven dof is also fixed by a [[fix]] table")
+            control = DisplacementControl(dof, s.target, s.steps)
+        else:
+            control = LoadControl(1.0 if s.target is None else s.target, s.steps)
+        if not case.pressure and not case.point_load and not any(f.value for f in case.fix):
+            raise CaseError("nothing loads the model: give [[pressure]], [[point_load]] or a [[fix]] with a value")
+    except SelectorError as exc:
+        raise CaseError(str(exc)) from None
+    model.finalize()
+    options = NewtonOptions(tolerance=s.tolerance, max_iterations=s.max_iterations,
+                            min_step=s.min_step, growth=s.growth)
+    return Built(case, model, control, options, monitors)

@@ -1,0 +1,111 @@
+"""`axiform run CASE.toml --out DIR` and `axiform check CASE.toml`.
+
+Exit codes: 0 finished, 1 stopped short (converged steps kept), 2 invalid case.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from . import __version__
+from .case import CaseError, build, load
+from .results import ResultsWriter
+from .solver import solve
+
+
+class Progress:
+    """One line per converged step on a terminal (rewritten in place), a summary at the end."""
+
+    def __init__(self, stream, target: float, driven: str, quiet: bool):
+        self.stream = stream
+        self.target = target
+        self.driven = driven
+        self.tty = stream.isatty() and not quiet
+        self.t0 = time.perf_counter()
+
+    def __call__(self, step, done: float, values: dict[str, float]):
+        if not self.tty:
+            return
+        frac = min(max(done / self.target, 0.0), 1.0) if self.target else 1.0
+        bar = "#" * int(30 * frac) + "-" * (30 - int(30 * frac))
+        mon = "  ".join(f"{k} {v:.4g}" for k, v in list(values.items())[:3])
+        self.stream.write(f"\r[{bar}] {100 * frac:5.1f}%  step {step.number}  lambda {step.lam:.5g}  "
+                          f"its {step.iterations}  {mon}  {time.perf_counter() - self.t0:.1f} s\x1b[K")
+        self.stream.flush()
+
+    def close(self):
+        if self.tty:
+            self.stream.write("\n")
+
+
+def run(case_path: str, out: str | None, quiet: bool = False, overrides: list[str] = ()) -> int:
+    case_file = Path(case_path)
+    try:
+        case = load(case_file, overrides)
+        built = build(case, case_file.parent)
+    except CaseError as exc:
+        print(f"axiform: invalid case {case_file}:\n{exc}", file=sys.stderr)
+        return 2
+    out_dir = Path(out) if out else Path("results") / case_file.stem
+    writer = ResultsWriter(out_dir, built.model, built.monitors, case.title,
+                           every=case.output.every, vtu=case.output.vtu)
+    model, control = built.model, built.control
+    progress = Progress(sys.stderr, control.target, "", quiet)
+    driven = getattr(control, "dof", None)
+
+    def on_step(step):
+        values = writer.step(step)
+        done = step.u[driven] if driven is not None else step.lam
+        progress(step, done, values)
+
+    if not quiet:
+        print(f"axiform {__version__}: {case.title or case_file.name}: {model.mesh.n_cells} {model.mesh.element.name} "
+              f"elements, {model.n_free} free dofs -> {out_dir}", file=sys.stderr)
+    result = solve(model, control, built.options, on_step=on_step)
+    progress.close()
+    writer.finish(result.status, result.message)
+    if not quiet or result.status != "finished":
+        print(f"axiform: {result.status} after {len(result.steps)} steps, {result.newton_iterations} Newton "
+              f"iterations, {result.wall_time_s:.2f} s" + (f": {result.message}" if result.message else ""),
+              file=sys.stderr)
+    return 0 if result.status == "finished" else 1
+
+
+def check(case_path: str, overrides: list[str] = ()) -> int:
+    case_file = Path(case_path)
+    try:
+        built = build(load(case_file, overrides), case_file.parent)
+    except CaseError as exc:
+        print(f"axiform: invalid case {case_file}:\n{exc}", file=sys.stderr)
+        return 2
+    m = built.model
+    print(f"{case_file}: valid; {m.mesh.n_cells} {m.mesh.element.name} elements, {m.mesh.n_nodes} nodes, "
+          f"{m.n_free} free dofs")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="axiform", description=__doc__.splitlines()[0])
+    parser.add_argument("--version", action="version", version=f"axiform {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+    p_run = sub.add_parser("run", help="run a case file and write its results folder")
+    p_run.add_argument("case", help="the case file (TOML)")
+    p_run.add_argument("--out", help="results folder (default: results/<case name>)")
+    p_run.add_argument("-q", "--quiet", action="store_true", help="no progress display")
+    p_check = sub.add_parser("check", help="validate a case file and build its model, without solving")
+    p_check.add_argument("case")
+    for p in (p_run, p_check):
+        p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                       help="override a key, VALUE in TOML syntax: --set mesh.element='\"q8\"' "
+                            "--set mesh.divisions=[40,4]")
+    args = parser.parse_args(argv)
+    if args.command == "run":
+        return run(args.case, args.out, args.quiet, args.set)
+    return check(args.case, args.set)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,39 @@
+"""Nodal fields for output: displacement, fibre rotation, J, Cauchy and von Mises stress.
+
+Quadrature-point values are averaged to the nodes (each element's mean, then the mean over
+the elements around a node): enough for pictures, not for error estimates.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .materials import cauchy_stress
+
+
+def point_fields(model, u_full: np.ndarray) -> dict[str, np.ndarray]:
+    mesh = model.mesh
+    dpn = model.dpn
+    u = u_full.reshape(-1, dpn)
+    solid = model.solid
+    x = solid.gradient(u_full)
+    P = model.material.stress(x)
+    J = x[..., 4] * (x[..., 0] * x[..., 3] - x[..., 1] * x[..., 2])
+    sig = cauchy_stress(x, P)  # (e, q, 4): rr, zz, tt, rz
+    s_rr, s_zz, s_tt, s_rz = (sig[..., i] for i in range(4))
+    mises = np.sqrt(0.5 * ((s_rr - s_zz) ** 2 + (s_zz - s_tt) ** 2 + (s_tt - s_rr) ** 2) + 3 * s_rz**2)
+    cell_values = np.column_stack([J.mean(1), sig.mean(1), mises.mean(1)])  # (e, 6)
+    count = np.bincount(mesh.cells.ravel(), minlength=mesh.n_nodes)
+    nodal = np.zeros((mesh.n_nodes, cell_values.shape[1]))
+    for k in range(mesh.cells.shape[1]):
+        np.add.at(nodal, mesh.cells[:, k], cell_values)
+    nodal /= np.maximum(count, 1)[:, None]
+    out = {
+        "displacement": np.column_stack([u[:, 0], u[:, 1], np.zeros(len(u))]),
+        "J": nodal[:, 0],
+        "cauchy_stress": nodal[:, 1:5],  # rr, zz, tt, rz
+        "von_mises": nodal[:, 5],
+    }
+    if dpn == 3:
+        out["fibre_rotation"] = u[:, 2].copy()
+    return out

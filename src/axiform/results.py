@@ -1,0 +1,106 @@
+"""The results folder, written as steps converge: history.csv, summary.json, a VTU series.
+
+history.csv: one row per converged step (step, load_factor, iterations, then one column per
+monitor).  summary.json: status, steps, newton_iterations, wall_time_s, dofs, elements,
+element (and more).  fields/: a ParaView series (step_NNNN.vtu listed in fields.pvd).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import time
+from pathlib import Path
+from xml.etree import ElementTree as ET
+
+import numpy as np
+
+from .fields import point_fields
+
+
+class ResultsWriter:
+    """Writes the results folder step by step, so that a run stopped midway keeps every
+    converged step."""
+
+    def __init__(self, out: str | Path, model, monitors=(), title: str = "", every: int = 1,
+                 vtu: bool = True):
+        self.out = Path(out)
+        self.out.mkdir(parents=True, exist_ok=True)
+        self.model = model
+        self.monitors = list(monitors)
+        self.every = every
+        self.vtu = vtu
+        self.t0 = time.perf_counter()
+        self.steps = 0
+        self.newton_iterations = 0
+        self._pvd: list[tuple[float, str]] = []
+        self._last_written = 0
+        self.summary = {
+            "title": title,
+            "status": "running",
+            "steps": 0,
+            "newton_iterations": 0,
+            "wall_time_s": 0.0,
+            "dofs": int(model.dofmap.n_eq),
+            "free_dofs": int(model.n_free),
+            "elements": int(model.mesh.n_cells),
+            "nodes": int(model.mesh.n_nodes),
+            "element": model.mesh.element.name,
+            "load_factor": 0.0,
+            "monitors": {},
+        }
+        with open(self.out / "history.csv", "w", newline="") as fh:
+            csv.writer(fh).writerow(["step", "load_factor", "iterations"] + [m.name for m in self.monitors])
+        if vtu:
+            (self.out / "fields").mkdir(exist_ok=True)
+            for old in (self.out / "fields").glob("step_*.vtu"):
+                old.unlink()
+        self._write_summary()
+
+    def _write_summary(self):
+        self.summary["wall_time_s"] = round(time.perf_counter() - self.t0, 4)
+        tmp = self.out / "summary.json.tmp"
+        tmp.write_text(json.dumps(self.summary, indent=2) + "\n")
+        tmp.replace(self.out / "summary.json")
+
+    def step(self, step) -> dict[str, float]:
+        """Record a converged step; returns the monitor values."""
+        values = {m.name: m.value(step) for m in self.monitors}
+        with open(self.out / "history.csv", "a", newline="") as fh:
+            csv.writer(fh).writerow([step.number, repr(float(step.lam)), step.iterations]
+                                    + [repr(v) for v in values.values()])
+        self.steps = step.number
+        self.newton_iterations += step.iterations
+        self.summary.update(steps=self.steps, newton_iterations=self.newton_iterations,
+                            load_factor=float(step.lam), monitors=values)
+        if self.vtu and step.number % self.every == 0:
+            self._write_fields(step)
+        self._last_step = step
+        self._write_summary()
+        return values
+
+    def _write_fields(self, step):
+        import meshio
+
+        mesh = self.model.mesh
+        data = point_fields(self.model, step.u)
+        cell_type = "quad8" if mesh.element.nodes == 8 else "quad"
+        pts = np.column_stack([mesh.points, np.zeros(mesh.n_nodes)])
+        name = f"step_{step.number:04d}.vtu"
+        meshio.write(self.out / "fields" / name, meshio.Mesh(pts, [(cell_type, mesh.cells)], point_data=data))
+        self._pvd.append((float(step.number), f"fields/{name}"))
+        self._last_written = step.number
+        root = ET.Element("VTKFile", type="Collection", version="0.1")
+        coll = ET.SubElement(root, "Collection")
+        for t, f in self._pvd:
+            ET.SubElement(coll, "DataSet", timestep=repr(t), part="0", file=f)
+        ET.ElementTree(root).write(self.out / "fields.pvd")
+
+    def finish(self, status: str, message: str = "") -> None:
+        """Final summary; the last converged step always gets its field output."""
+        if self.vtu and self.steps and self._last_written != self.steps:
+            self._write_fields(self._last_step)
+        self.summary["status"] = status
+        if message:
+            self.summary["message"] = message
+        self._write_summary()
