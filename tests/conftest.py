@@ -1,0 +1,27 @@
+import numpy as np
+import pytest
+
+from axiform import rectangle
+
+
+def distorted_rectangle(r, z, divisions, element, amount=0.25, seed=0):
+    """A rectangle mesh whose interior corner nodes are moved at random by up to `amount`
+    of the cell size (Q8 mid-side nodes are put back at the middle of their straight edges)."""
+    mesh = rectangle(r, z, divisions, element)
+    rng = np.random.default_rng(seed)
+    h = np.array([(r[1] - r[0]) / divisions[0], (z[1] - z[0]) / divisions[1]])
+    boundary = np.unique(mesh.boundary_edges)
+    corners = np.setdiff1d(mesh.corner_nodes, boundary)
+    mesh.points[corners] += amount * h * rng.uniform(-1, 1, size=(len(corners), 2))
+    if element == "q8":
+        ends = np.array([[0, 1], [1, 2], [2, 3], [3, 0]])
+        for k, (a, b) in zip(range(4, 8), ends):
+            mids = mesh.cells[:, k]
+            mesh.points[mids] = 0.5 * (mesh.points[mesh.cells[:, a]] + mesh.points[mesh.cells[:, b]])
+    mesh.check()
+    return mesh
+
+
+@pytest.fixture(params=["q4", "q8", "sfr"])
+def element(request):
+    return request.param

@@ -1,0 +1,198 @@
+"""The case-file contract (DESIGN section 7): invalid input refused before any work with the key
+path and exit 2; history.csv and summary.json written as steps converge; exit 1 for a run
+that stopped short, with its converged steps kept; exit 0 when finished."""
+
+import csv
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from axiform.cli import main
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+PLATE = """
+title = "plate"
+[mesh]
+kind = "rectangle"
+r = [0.0, 7.5]
+z = [0.0, 0.5]
+divisions = [10, 2]
+element = "{element}"
+[material]
+model = "mooney-rivlin"
+C1 = 80.0
+C2 = 20.0
+kappa = 1.0e4
+[[fix]]
+at = {{ r = 7.5 }}
+dofs = ["ur", "uz", "rot"]
+[[fix]]
+at = {{ r = 0.0 }}
+dofs = ["ur"]
+[[pressure]]
+on = {{ z = 0.0 }}
+value = 1.0
+[[monitor]]
+name = "w_center"
+at = {{ r = 0.0, z = 0.5 }}
+dof = "uz"
+[[monitor]]
+name = "rim_fz"
+reaction = {{ r = 7.5 }}
+dof = "uz"
+[solver]
+control = "displacement"
+dof = {{ at = {{ r = 0.0, z = 0.5 }}, dof = "uz" }}
+target = 3.0
+steps = 6
+"""
+
+
+def write(tmp_path, text, name="case.toml"):
+    p = tmp_path / name
+    p.write_text(text)
+    return p
+
+
+def run(tmp_path, text, *extra):
+    case = write(tmp_path, text)
+    return main(["run", str(case), "--out", str(tmp_path / "out"), "-q", *extra])
+
+
+@pytest.mark.parametrize("element", ["q4", "q8", "sfr"])
+def test_plate_runs_and_writes_results(tmp_path, element):
+    assert run(tmp_path, PLATE.format(element=element)) == 0
+    out = tmp_path / "out"
+    rows = list(csv.DictReader(open(out / "history.csv")))
+    assert list(rows[0]) == ["step", "load_factor", "iterations", "w_center", "rim_fz"]
+    assert float(rows[-1]["w_center"]) == pytest.approx(3.0)
+    lam = np.array([float(r["load_factor"]) for r in rows])
+    assert (np.diff(lam) > 0).all()
+    # the rim reaction balances the pressure: p * pi * r_rim^2 (the rim does not move)
+    assert float(rows[-1]["rim_fz"]) == pytest.approx(-lam[-1] * np.pi * 7.5**2, rel=1e-6)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "finished"
+    assert summary["steps"] == len(rows)
+    assert summary["newton_iterations"] == sum(int(r["iterations"]) for r in rows)
+    assert summary["element"] == element and summary["elements"] == 20
+    assert summary["dofs"] > 0 and summary["wall_time_s"] > 0
+    assert (out / "fields.pvd").exists() and len(list((out / "fields").glob("*.vtu"))) == len(rows)
+
+
+def test_examples_are_valid():
+    for case in sorted(EXAMPLES.glob("*.toml")):
+        assert main(["check", str(case)]) == 0, case
+
+
+BAD = [
+    ("unknown key", lambda t: t.replace('kappa = 1.0e4', 'kappa = 1.0e4\nkapa = 3.0'), r"material\.kapa: unknown key"),
+    ("wrong type", lambda t: t.replace("divisions = [10, 2]", 'divisions = [10, "two"]'), r"mesh\.divisions\[1\]: Input should be a valid integer"),
+    ("missing constant", lambda t: t.replace("C2 = 20.0\n", ""), r"material: missing material constant: C2"),
+    ("missing kappa", lambda t: t.replace("kappa = 1.0e4\n", ""), r"material: missing material constant: kappa"),
+    ("selector matches nothing", lambda t: t.replace("at = { r = 7.5 }", "at = { r = 7.7 }"),
+     r"fix\[0\]\.at: selector \{r = 7.7\} matches no node"),
+    ("monitor not one node", lambda t: t.replace('at = { r = 0.0, z = 0.5 }\ndof = "uz"', 'at = { r = 0.0 }\ndof = "uz"'),
+     r"monitor\[0\]\.at: selector must match exactly one node, it matches 3"),
+    ("bad element", lambda t: t.replace('element = "q4"', 'element = "q9"'), r"mesh\.element: Input should be 'q4', 'q8' or 'sfr'"),
+    ("bad dof", lambda t: t.replace('dofs = ["ur"]', 'dofs = ["ux"]'), r"fix\[1\]\.dofs\[0\]: Input should be"),
+    ("reversed range", lambda t: t.replace("r = [0.0, 7.5]", "r = [7.5, 0.0]"), r"mesh: r and z must be given as \[min, max\]"),
+    ("displacement without dof", lambda t: t.replace('dof = { at = { r = 0.0, z = 0.5 }, dof = "uz" }\n', ""),
+     r"solver: displacement control needs 'dof' and 'target'"),
+    ("negative steps", lambda t: t.replace("steps = 6", "steps = -1"), r"solver\.steps: Input should be greater than or equal to 1"),
+    ("not toml", lambda t: t + "\n[[[", r"not valid TOML"),
+]
+
+
+@pytest.mark.parametrize("name, edit, message", BAD, ids=[b[0] for b in BAD])
+def test_invalid_case_is_refused_with_key_path(tmp_path, capsys, name, edit, message):
+    text = edit(PLATE.format(element="q4"))
+    assert run(tmp_path, text) == 2
+    err = capsys.readouterr().err
+    assert "invalid case" in err
+    assert re.search(message, err), err
+    assert not (tmp_path / "out").exists()  # refused before any work
+
+
+GMSH_INVERTED = """$MeshFormat
+2.2 0 8
+$EndMeshFormat
+$Nodes
+6
+1 0 0 0
+2 1 0 0
+3 2 0 0
+4 0 1 0
+5 1 1 0
+6 2 1 0
+$EndNodes
+$Elements
+2
+1 3 2 1 1 1 2 5 4
+2 3 2 1 1 2 5 6 3
+$EndElements
+"""
+
+
+def test_inverted_mesh_is_refused(tmp_path, capsys):
+    write(tmp_path, GMSH_INVERTED, "bad.msh")
+    text = PLATE.format(element="q4").replace(
+        'kind = "rectangle"\nr = [0.0, 7.5]\nz = [0.0, 0.5]\ndivisions = [10, 2]', 'kind = "gmsh"\nfile = "bad.msh"')
+    assert run(tmp_path, text) == 2
+    err = capsys.readouterr().err
+    assert re.search(r"mesh: inverted or degenerate element\(s\) \[1\]", err), err
+
+
+def test_overrides_from_the_command_line(tmp_path):
+    case = write(tmp_path, PLATE.format(element="q4"))
+    assert main(["run", str(case), "--out", str(tmp_path / "o"), "-q", "--set", "mesh.element=q8",
+                 "--set", "solver.target=1.0", "--set", "solver.steps=2"]) == 0
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["element"] == "q8" and summary["steps"] == 2
+
+
+CYLINDER_BEYOND_LIMIT = """
+[mesh]
+r = [1.0, 2.0]
+z = [0.0, 0.1]
+divisions = [4, 1]
+element = "q8"
+[material]
+model = "neo-hooke"
+C1 = 0.5
+kappa = 50.0
+[[fix]]
+at = { z = 0.0 }
+dofs = ["uz"]
+[[fix]]
+at = { z = 0.1 }
+dofs = ["uz"]
+[[pressure]]
+on = { r = 1.0 }
+value = 1.5
+[[monitor]]
+name = "u_inner"
+at = { r = 1.0, z = 0.0 }
+dof = "ur"
+[solver]
+control = "load"
+steps = 5
+min_step = 0.01
+"""
+
+
+def test_run_that_stops_short_keeps_its_steps(tmp_path, capsys):
+    """A thick neo-Hookean tube has a limit pressure near mu ln(B/A) ~ 0.69 mu: asked for
+    1.5 mu under load control, it must stop (exit 1) and keep every converged step."""
+    assert run(tmp_path, CYLINDER_BEYOND_LIMIT) == 1
+    out = tmp_path / "out"
+    summary = json.loads((out / "summary.json").read_text())
+    rows = list(csv.DictReader(open(out / "history.csv")))
+    assert summary["status"] == "stopped" and "minimum" in summary["message"]
+    assert summary["steps"] == len(rows) >= 2
+    assert 0.3 < float(rows[-1]["load_factor"]) < 1.0
+    assert len(list((out / "fields").glob("*.vtu"))) == len(rows)
+    assert "stopped" in capsys.readouterr().err
