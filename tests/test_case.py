@@ -196,3 +196,36 @@ def test_run_that_stops_short_keeps_its_steps(tmp_path, capsys):
     assert 0.3 < float(rows[-1]["load_factor"]) < 1.0
     assert len(list((out / "fields").glob("*.vtu"))) == len(rows)
     assert "stopped" in capsys.readouterr().err
+
+
+def test_point_load_is_balanced_by_the_reactions(tmp_path):
+    """A ring load of total force F on the free top corner of a block standing on z = 0:
+    the axial reactions of the base sum to -F."""
+    text = """
+[mesh]
+r = [1.0, 2.0]
+z = [0.0, 1.0]
+divisions = [4, 4]
+element = "sfr"
+[material]
+model = "neo-hooke"
+E = 3.0
+nu = 0.45
+[[fix]]
+at = { z = 0.0 }
+dofs = ["ur", "uz"]
+[[point_load]]
+at = { r = 2.0, z = 1.0 }
+dof = "uz"
+value = -0.4
+[[monitor]]
+name = "base_fz"
+reaction = { z = 0.0 }
+dof = "uz"
+[solver]
+steps = 2
+"""
+    assert run(tmp_path, text) == 0
+    rows = list(csv.DictReader(open(tmp_path / "out" / "history.csv")))
+    assert [float(r["load_factor"]) for r in rows] == [0.5, 1.0]
+    assert float(rows[-1]["base_fz"]) == pytest.approx(0.4, rel=1e-9)
