@@ -27,6 +27,8 @@ class Mesh:
     edge_sets: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __post_init__(self):
+        self.fibres: np.ndarray | None = None  # (stations, corner nodes through the thickness)
+        self.fibre_s: np.ndarray | None = None  # reference arc length of each station
         self.points = np.asarray(self.points, dtype=float)
         self.cells = np.asarray(self.cells, dtype=np.int64)
         edges, owner, side = boundary_edges(self.cells, self.element)
@@ -82,36 +84,96 @@ def boundary_edges(cells: np.ndarray, kind: ElementKind):
     return all_edges.reshape(-1, local.shape[1])[idx], idx // 4, idx % 4
 
 
+def _structured(grid: np.ndarray, kind: ElementKind):
+    """Nodes and cells of a structured mesh on a grid of points (ni + 1, nj + 1, 2), i the
+    first direction and j the second (cells i, i+1 x j, j+1, counter-clockwise when the
+    second direction is to the left of the first).  For Q8 the grid has the mid-side points
+    too ((2 ni + 1, 2 nj + 1)); cell centres are dropped.  Returns points, cells, number (the
+    node number of each grid point, -1 for dropped ones)."""
+    ni, nj = grid.shape[0] - 1, grid.shape[1] - 1
+    number = -np.ones((ni + 1, nj + 1), dtype=np.int64)
+    if kind.nodes == 4:
+        number[:] = np.arange(number.size).reshape(number.shape)
+        i, j = (a.ravel() for a in np.meshgrid(np.arange(ni), np.arange(nj), indexing="ij"))
+        cells = np.column_stack([number[i, j], number[i + 1, j], number[i + 1, j + 1], number[i, j + 1]])
+    else:
+        keep = ~((np.arange(ni + 1)[:, None] % 2 == 1) & (np.arange(nj + 1)[None, :] % 2 == 1))
+        number[keep] = np.arange(keep.sum())
+        i, j = (2 * a.ravel() for a in np.meshgrid(np.arange(ni // 2), np.arange(nj // 2), indexing="ij"))
+        cells = np.column_stack([number[i, j], number[i + 2, j], number[i + 2, j + 2], number[i, j + 2],
+                                 number[i + 1, j], number[i + 2, j + 1], number[i + 1, j + 2], number[i, j + 1]])
+    points = grid.reshape(-1, 2)[number.ravel() >= 0]
+    return points, cells, number
+
+
+def _add_grid_sets(mesh: Mesh, number: np.ndarray, names: dict[str, tuple]) -> None:
+    """Named node and edge sets for grid lines: name -> index (slice) into the grid."""
+    for name, index in names.items():
+        nodes = number[index].ravel()
+        mesh.node_sets[name] = np.unique(nodes[nodes >= 0])
+        mesh.edge_sets[name] = edges_on_nodes(mesh, mesh.node_sets[name])
+
+
+def _set_fibres(mesh: Mesh, number: np.ndarray, s: np.ndarray) -> None:
+    """The through-thickness lines of corner nodes at each station (thickness output)."""
+    step = 2 if mesh.element.nodes == 8 else 1
+    mesh.fibres = number[::step, ::step]
+    mesh.fibre_s = s[::step]
+
+
 def rectangle(r: tuple[float, float], z: tuple[float, float], divisions: tuple[int, int],
               element: str = "q4") -> Mesh:
     """Structured mesh of [r0, r1] x [z0, z1] with divisions (nr, nz); Q8 gets mid-side nodes.
 
     Named node and edge sets: "left" (r = r0), "right" (r = r1), "bottom" (z = z0), "top" (z = z1).
+    The fibres (for thickness output) are the vertical lines of nodes.
     """
     kind = ELEMENTS[element]
-    nr, nz = divisions
-    if kind.nodes == 4:
-        R, Z = np.meshgrid(np.linspace(*r, nr + 1), np.linspace(*z, nz + 1), indexing="xy")
-        points = np.column_stack([R.ravel(), Z.ravel()])
-        i, j = np.meshgrid(np.arange(nr), np.arange(nz), indexing="xy")
-        n0 = (j * (nr + 1) + i).ravel()
-        cells = np.column_stack([n0, n0 + 1, n0 + nr + 2, n0 + nr + 1])
-    else:
-        # a (2nr+1) x (2nz+1) grid of which the cell centres are dropped
-        R, Z = np.meshgrid(np.linspace(*r, 2 * nr + 1), np.linspace(*z, 2 * nz + 1), indexing="xy")
-        keep = ~((np.arange(2 * nz + 1)[:, None] % 2 == 1) & (np.arange(2 * nr + 1)[None, :] % 2 == 1))
-        number = -np.ones(R.shape, dtype=np.int64)
-        number[keep] = np.arange(keep.sum())
-        points = np.column_stack([R[keep], Z[keep]])
-        i, j = np.meshgrid(2 * np.arange(nr), 2 * np.arange(nz), indexing="xy")
-        i, j = i.ravel(), j.ravel()
-        cells = np.column_stack([number[j, i], number[j, i + 2], number[j + 2, i + 2], number[j + 2, i],
-                                 number[j, i + 1], number[j + 1, i + 2], number[j + 2, i + 1], number[j + 1, i]])
+    f = 2 if kind.nodes == 8 else 1
+    nr, nz = divisions[0] * f, divisions[1] * f
+    R, Z = np.meshgrid(np.linspace(*r, nr + 1), np.linspace(*z, nz + 1), indexing="ij")
+    points, cells, number = _structured(np.stack([R, Z], axis=-1), kind)
     mesh = Mesh(points, cells, kind)
-    tol = 1e-9 * max(abs(r[1] - r[0]), abs(z[1] - z[0]))
-    for name, axis, value in (("left", 0, r[0]), ("right", 0, r[1]), ("bottom", 1, z[0]), ("top", 1, z[1])):
-        mesh.node_sets[name] = np.flatnonzero(np.abs(mesh.points[:, axis] - value) <= tol)
-        mesh.edge_sets[name] = edges_on_nodes(mesh, mesh.node_sets[name])
+    _add_grid_sets(mesh, number, {"left": (0, slice(None)), "right": (-1, slice(None)),
+                                  "bottom": (slice(None), 0), "top": (slice(None), -1)})
+    _set_fibres(mesh, number, R[:, 0] - r[0])
+    return mesh
+
+
+def layered(profile, thickness, layers: int, element: str = "q4") -> Mesh:
+    """A layered body of the given thickness about a mid-surface profile (profile.Profile).
+
+    thickness: a number, a function of the reference arc length s along the profile, or a
+    table [[s, t], ...] interpolated linearly.  layers: elements through the thickness.
+    Named sets: "start", "end" (the profile's ends), "bottom", "top" (the faces to the right
+    and to the left of the direction of travel), and "inner", "outer" (the same faces named by
+    their mean distance to the axis) unless both faces are as far from the axis.
+    """
+    kind = ELEMENTS[element]
+    f = 2 if kind.nodes == 8 else 1
+    mid, tangent, s, miter = profile.sample(f)
+    if callable(thickness):
+        t = np.asarray([thickness(v) for v in s], float)
+    elif np.ndim(thickness) == 0:
+        t = np.full(len(s), float(thickness))
+    else:
+        table = np.asarray(thickness, float)
+        t = np.interp(s, table[:, 0], table[:, 1])
+    if (t <= 0).any():
+        raise MeshError("the wall thickness must be > 0 everywhere along the profile")
+    normal = np.column_stack([-tangent[:, 1], tangent[:, 0]])  # to the left of the travel
+    offsets = np.linspace(-0.5, 0.5, layers * f + 1)
+    grid = mid[:, None, :] + (t * miter)[:, None, None] * offsets[None, :, None] * normal[:, None, :]
+    points, cells, number = _structured(grid, kind)
+    mesh = Mesh(points, cells, kind)
+    _add_grid_sets(mesh, number, {"start": (0, slice(None)), "end": (-1, slice(None)),
+                                  "bottom": (slice(None), 0), "top": (slice(None), -1)})
+    rb, rt = grid[:, 0, 0].mean(), grid[:, -1, 0].mean()
+    if abs(rb - rt) > 1e-9 * max(abs(rb), abs(rt), 1.0):
+        inner, outer = ("bottom", "top") if rb < rt else ("top", "bottom")
+        mesh.node_sets["inner"], mesh.edge_sets["inner"] = mesh.node_sets[inner], mesh.edge_sets[inner]
+        mesh.node_sets["outer"], mesh.edge_sets["outer"] = mesh.node_sets[outer], mesh.edge_sets[outer]
+    _set_fibres(mesh, number, s)
     return mesh
 
 

@@ -24,7 +24,11 @@ SFR_EDGE_RULES = ("tie", "fix", "free")
 @dataclass
 class Evaluation:
     """Residual and tangent at one state: r (free eqs), dR/dlambda (free eqs), K_ff, the full
-    residual (reactions at supported dofs) and the full external load per unit lambda."""
+    residual (reactions at supported dofs), the full external load per unit lambda, and the
+    norm of the assembled magnitudes of the element forces (the scale against which the
+    residual is small: it does not cancel where large stresses balance), and the round-off
+    level of the residual, eps ||K||_inf ||u||: the residual of u rounded to double precision,
+    below which no Newton iteration can go (thin walls with a large kappa reach it)."""
 
     r: np.ndarray
     dr_dlam: np.ndarray
@@ -32,6 +36,8 @@ class Evaluation:
     r_full: np.ndarray
     f_ext_full: np.ndarray
     f_int_full: np.ndarray
+    force_scale: float
+    noise: float = 0.0
 
 
 @dataclass
@@ -154,6 +160,7 @@ class Model:
         u = dm.expand(u_f, lam)
         fe, Ke = self.solid.evaluate(u, tangent)
         f_int = np.bincount(self.solid.dofs.ravel(), weights=fe.ravel(), minlength=self.n_full)
+        f_abs = np.bincount(self.solid.dofs.ravel(), weights=np.abs(fe).ravel(), minlength=self.n_full)
         f_ext, dfext = self.external_load(u, tangent)
         r_full = f_int - lam * f_ext
         r_eq = dm.gather(r_full)
@@ -166,4 +173,9 @@ class Model:
             K, K_fp = self.pattern.blocks(data)
             if dm.np:
                 dr_dlam = dr_dlam + K_fp @ dm.prescribed_ref
-        return Evaluation(r_eq[: dm.nf], dr_dlam, K, r_full, f_ext, f_int)
+        scale = float(np.linalg.norm(f_abs) + abs(lam) * np.linalg.norm(f_ext))
+        noise = 0.0
+        if K is not None and K.nnz:
+            row_sums = np.add.reduceat(np.abs(K.data), K.indptr[:-1][np.diff(K.indptr) > 0])
+            noise = float(np.finfo(float).eps * row_sums.max() * np.linalg.norm(u))
+        return Evaluation(r_eq[: dm.nf], dr_dlam, K, r_full, f_ext, f_int, scale, noise)

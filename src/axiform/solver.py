@@ -37,8 +37,25 @@ class DisplacementControl:
 
 
 @dataclass
+class ArcLengthControl:
+    """Crisfield's cylindrical arc length: each step keeps ||du|| (displacements, and fibre
+    rotations times the size of the body) equal to the arc length, lambda free, so limit points are passed.  Runs until
+    lambda reaches target, or the dof `stop_dof` reaches `stop_value` if given (the last step
+    lands exactly there); the first arc length is that of a load step target / steps unless
+    `arc_length` is given; at most max_steps steps."""
+
+    target: float = 1.0
+    steps: int = 10
+    arc_length: float | None = None
+    stop_dof: int | None = None
+    stop_value: float | None = None
+    max_steps: int = 1000
+
+
+@dataclass
 class NewtonOptions:
-    """tolerance: ||R|| <= tolerance * ||reference force||; a step is cut back (halved) when
+    """tolerance: ||R|| <= tolerance * ||reference force||, the reference being the norm of the
+    assembled magnitudes of the element forces plus that of the external load; a step is cut back (halved) when
     Newton needs more than max_iterations, diverges, or an element inverts; it grows by
     `growth` after a step converged in at most `easy_iterations`; the run stops when a step
     would be smaller than min_step times the nominal step."""
@@ -81,7 +98,7 @@ class StepFailed(Exception):
 
 
 def _reference_force(ev: Evaluation, lam: float, floor: float) -> float:
-    return max(np.linalg.norm(ev.f_int_full), abs(lam) * np.linalg.norm(ev.f_ext_full), floor)
+    return max(ev.force_scale, floor)
 
 
 def _force_floor(model: Model) -> float:
@@ -92,59 +109,202 @@ def _force_floor(model: Model) -> float:
     return 1e-12 * mu * span**2 * 2 * np.pi
 
 
-def solve(model: Model, control: LoadControl | DisplacementControl,
+def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthControl,
           options: NewtonOptions | None = None,
-          on_step: Callable[[Step], None] | None = None,
-          u_f0: np.ndarray | None = None) -> SolveResult:
+          on_step: Callable[[Step], None] | None = None) -> SolveResult:
     """Run the load stepping to the end or until the step would fall below the minimum.
     Every converged step is handed to on_step as it comes."""
     opts = options or NewtonOptions()
     if model.dofmap is None:
         model.finalize()
     t0 = time.perf_counter()
-    floor = _force_floor(model)
-    nominal = control.target / control.steps
-    u_f = np.zeros(model.n_free) if u_f0 is None else u_f0.copy()
-    lam = 0.0
+    if isinstance(control, ArcLengthControl):
+        path = _ArcLength(model, control, opts)
+    elif isinstance(control, DisplacementControl):
+        path = _Displacement(model, control, opts)
+    else:
+        path = _Load(model, control, opts)
     result = SolveResult("finished")
-    c = None
-    if isinstance(control, DisplacementControl):
-        c = int(model.dofmap.eq[control.dof])
-        if c >= model.n_free:
-            raise ValueError("the controlled dof is prescribed: it cannot be driven by displacement control")
-    done = 0.0  # progress along the control variable
-    step = nominal
-    while abs(control.target - done) > 1e-12 * abs(control.target):
-        remaining = control.target - done
-        if abs(step) > abs(remaining):
-            step = remaining
+    nominal = path.nominal
+    size = nominal
+    while not path.done():
+        size = path.clip(size)
         try:
-            if c is None:
-                u_new, lam_new, its, res, ev = _newton_load(model, u_f, lam + step, opts, floor)
-            else:
-                u_new, lam_new, its, res, ev = _newton_displacement(
-                    model, u_f, lam, c, done + step, opts, floor)
+            u_new, lam_new, its, res, ev = path.attempt(size)
         except StepFailed as exc:
-            step /= 2.0
-            if abs(step) < opts.min_step * abs(nominal):
+            size /= 2.0
+            if abs(size) < opts.min_step * abs(nominal):
                 result.status = "stopped"
                 result.message = f"no convergence with the step cut below the minimum ({exc})"
                 break
-            result.message = str(exc)
             continue
-        u_f, lam = u_new, lam_new
-        done += step
+        path.accept(u_new, lam_new, size)
         result.newton_iterations += its
-        s = Step(len(result.steps) + 1, lam, its, res, u_f, model.expand(u_f, lam), ev)
-        result.steps.append(s)
+        step = Step(len(result.steps) + 1, lam_new, its, res, u_new, model.expand(u_new, lam_new), ev)
+        result.steps.append(step)
         if on_step:
-            on_step(s)
+            on_step(step)
         if its <= opts.easy_iterations:
-            step = min(step * opts.growth, nominal, key=abs)
-    if result.status == "finished":
-        result.message = ""
+            size = min(size * opts.growth, nominal, key=abs)
+        if len(result.steps) >= path.max_steps and not path.done():
+            result.status = "stopped"
+            result.message = f"the end was not reached in {path.max_steps} steps"
+            break
     result.wall_time_s = time.perf_counter() - t0
     return result
+
+
+class _Path:
+    """Shared state of a path-following scheme: the last converged (u_f, lambda)."""
+
+    max_steps = 10**9
+
+    def __init__(self, model: Model, opts: NewtonOptions):
+        self.model = model
+        self.opts = opts
+        self.floor = _force_floor(model)
+        self.u_f = np.zeros(model.n_free)
+        self.lam = 0.0
+
+    def clip(self, size: float) -> float:
+        return size
+
+    def accept(self, u_f, lam, size):
+        self.u_f, self.lam = u_f, lam
+
+
+class _Load(_Path):
+    def __init__(self, model, control: LoadControl, opts):
+        super().__init__(model, opts)
+        self.target = control.target
+        self.nominal = control.target / control.steps
+
+    def done(self):
+        return abs(self.target - self.lam) <= 1e-12 * abs(self.target)
+
+    def clip(self, size):
+        remaining = self.target - self.lam
+        return remaining if abs(size) > abs(remaining) else size
+
+    def attempt(self, size):
+        lam = self.target if abs(self.target - self.lam - size) <= 1e-12 * abs(self.target) else self.lam + size
+        return _newton_load(self.model, self.u_f, lam, self.opts, self.floor)
+
+
+class _Displacement(_Path):
+    def __init__(self, model, control: DisplacementControl, opts):
+        super().__init__(model, opts)
+        self.c = int(model.dofmap.eq[control.dof])
+        if self.c >= model.n_free:
+            raise ValueError("the controlled dof is prescribed: it cannot be driven by displacement control")
+        self.target = control.target
+        self.nominal = control.target / control.steps
+        self.reached = 0.0
+
+    def done(self):
+        return abs(self.target - self.reached) <= 1e-12 * abs(self.target)
+
+    def clip(self, size):
+        remaining = self.target - self.reached
+        return remaining if abs(size) > abs(remaining) else size
+
+    def attempt(self, size):
+        goal = self.target if abs(self.target - self.reached - size) <= 1e-12 * abs(self.target) else self.reached + size
+        return _newton_displacement(self.model, self.u_f, self.lam, self.c, goal, self.opts, self.floor)
+
+    def accept(self, u_f, lam, size):
+        super().accept(u_f, lam, size)
+        self.reached += size
+
+
+class _ArcLength(_Path):
+    def __init__(self, model, control: ArcLengthControl, opts):
+        super().__init__(model, opts)
+        self.control = control
+        self.max_steps = control.max_steps
+        # theta times a length is a displacement: weigh the fibre rotations by the square of
+        # the body's size, so that a step cannot swing them freely where they are weakly held
+        # (thin walls); smaller weights let SFR balloons wander at the limit point
+        rep = model.dofmap.free_dof % model.dpn
+        span = float(np.linalg.norm(np.ptp(model.mesh.points, axis=0)))
+        self.weight = np.where(rep < 2, 1.0, span**2)
+        self.previous = None  # last converged increment, for the direction of the next one
+        self.stop = None
+        if control.stop_dof is not None:
+            self.stop = int(model.dofmap.eq[control.stop_dof])
+            if self.stop >= model.n_free:
+                raise ValueError("the stop dof is prescribed")
+        if control.arc_length is not None:
+            self.nominal = control.arc_length
+        else:
+            ev = _evaluate(model, self.u_f, 0.0)
+            t = -_factorize(ev.K)(ev.dr_dlam)
+            self.nominal = abs(control.target / control.steps) * self._norm(t)
+        self.finished = False
+
+    def _norm(self, v):
+        return float(np.sqrt(np.dot(self.weight * v, v)))
+
+    def done(self):
+        return self.finished
+
+    def _crossed(self, old, new, goal):
+        return goal is not None and (old - goal) * (new - goal) <= 0 and new != old
+
+    def attempt(self, size):
+        u_new, lam_new, its, res, ev = self._arc_step(size)
+        c = self.control
+        if self._crossed(self.lam, lam_new, c.target):
+            out = _newton_load(self.model, self.u_f, c.target, self.opts, self.floor)
+            self._landed = True
+            return out
+        if self.stop is not None and self._crossed(self.u_f[self.stop], u_new[self.stop], c.stop_value):
+            out = _newton_displacement(self.model, self.u_f, self.lam, self.stop, c.stop_value, self.opts, self.floor)
+            self._landed = True
+            return out
+        self._landed = False
+        return u_new, lam_new, its, res, ev
+
+    def accept(self, u_f, lam, size):
+        self.previous = u_f - self.u_f
+        super().accept(u_f, lam, size)
+        self.finished = self._landed
+
+    def _arc_step(self, dl):
+        model, opts, W = self.model, self.opts, self.weight
+        ev = _evaluate(model, self.u_f, self.lam)
+        t = -_factorize(ev.K)(ev.dr_dlam)  # du/dlambda along the tangent
+        sign = np.sign(np.dot(W * t, self.previous)) if self.previous is not None else np.sign(self.control.target)
+        dlam = (sign or 1.0) * dl / max(self._norm(t), 1e-300)
+        du = dlam * t
+        residuals = [float(np.linalg.norm(ev.r))]
+        for it in range(1, opts.max_iterations + 1):
+            lam = self.lam + dlam
+            ev = _evaluate(model, self.u_f + du, lam)
+            if _check(ev, lam, opts, self.floor, residuals):
+                return self.u_f + du, lam, it, residuals, ev
+            solve = _factorize(ev.K)
+            ab = solve(np.column_stack([-ev.r, -ev.dr_dlam]))
+            a, b = ab[:, 0], ab[:, 1]
+            # ||du + a + dl b||_W = dl: a quadratic in the load correction (Crisfield)
+            da = du + a
+            A = np.dot(W * b, b)
+            B = 2.0 * np.dot(W * b, da)
+            C = np.dot(W * da, da) - dl * dl
+            disc = B * B - 4.0 * A * C
+            if A == 0:
+                raise StepFailed("arc length: the load does not move the structure")
+            if disc < 0:
+                # no point of the new line lies on the arc: take its point closest to it
+                dmu = -B / (2.0 * A)
+            else:
+                roots = (-B + np.array([1.0, -1.0]) * np.sqrt(disc)) / (2.0 * A)
+                # the root that keeps the increment closest to its previous direction
+                cosines = [np.dot(W * (da + r * b), du) for r in roots]
+                dmu = roots[int(np.argmax(cosines))]
+            du = da + dmu * b
+            dlam += dmu
+        raise StepFailed(f"no convergence in {opts.max_iterations} iterations")
 
 
 def _check(ev: Evaluation, lam: float, opts: NewtonOptions, floor: float, residuals: list[float]) -> bool:
@@ -155,7 +315,7 @@ def _check(ev: Evaluation, lam: float, opts: NewtonOptions, floor: float, residu
     ref = _reference_force(ev, lam, floor)
     if norm > 1e10 * ref:
         raise StepFailed("Newton diverges")
-    return norm <= opts.tolerance * ref
+    return norm <= max(opts.tolerance * ref, ev.noise)
 
 
 def _evaluate(model: Model, u_f, lam) -> Evaluation:

@@ -1,0 +1,72 @@
+"""Arc length through a limit point: a thin Mooney-Rivlin balloon (h0/R0 = 0.01, C2/C1 = 0.1)
+inflated through its pressure maximum and minimum, against the thin-membrane formula
+p = 4 (h0/R0) (1/l - 1/l^7) (C1 + C2 l^2)."""
+
+import numpy as np
+import pytest
+
+from axiform import Model, MooneyRivlin
+from axiform.mesh import layered
+from axiform.profile import Arc, Profile
+from axiform.solver import ArcLengthControl, LoadControl, solve
+
+R0, H0, C1, C2 = 1.0, 0.01, 1.0, 0.1
+
+
+def membrane_pressure(l):
+    return 4 * H0 / R0 * (1 / l - 1 / l**7) * (C1 + C2 * l**2)
+
+
+def balloon(element, layers, divisions):
+    """A quarter of the sphere: symmetry plane z = 0 at the start, axis at the end."""
+    mesh = layered(Profile((R0, 0.0), (Arc((0.0, 0.0), (0.0, R0), divisions, ccw=True),)), H0, layers, element)
+    model = Model(mesh, MooneyRivlin(C1, C2, 1e4 * C1))
+    model.fix(mesh.node_sets["start"], ["uz"])
+    model.fix(mesh.node_sets["end"], ["ur"])
+    model.pressure(mesh.edge_sets["inner"], 1.0)
+    return mesh, model.finalize()
+
+
+@pytest.mark.parametrize("element, layers, divisions", [("q8", 1, 8), ("q4", 4, 16)])
+def test_balloon_through_its_pressure_maximum_and_minimum(element, layers, divisions):
+    mesh, model = balloon(element, layers, divisions)
+    equator = mesh.fibres[0]  # the fibre at z = 0, from the outer to the inner face
+    outer = int(model.dof(equator[0], "ur"))
+    inner = int(model.dof(equator[-1], "ur"))
+    res = solve(model, ArcLengthControl(target=1.0, steps=20, stop_dof=outer, stop_value=4.0, max_steps=600))
+    assert res.status == "finished", res.message
+    last = res.last
+    assert last.u[outer] == pytest.approx(4.0, rel=1e-12)  # landed on the stop value
+    stretch = np.array([1 + 0.5 * (s.u[outer] + s.u[inner]) / R0 for s in res.steps])
+    p = np.array([s.lam for s in res.steps])
+    exact = membrane_pressure(stretch)
+    err = np.abs(p - exact) / exact
+    assert err.max() < 0.02, (stretch[err.argmax()], err.max())
+    # the path went up to the maximum, down through it to the minimum and up again
+    imax = p.argmax()
+    imin = imax + p[imax:].argmin()
+    assert 0 < imax < imin < len(p) - 1
+    l = np.linspace(1.0, 5.0, 40001)
+    pm = membrane_pressure(l)
+    assert p[imax] == pytest.approx(pm.max(), rel=0.01)
+    assert stretch[imax - 1] < l[pm.argmax()] < stretch[imax + 1]
+    kmin = l > l[pm.argmax()]
+    assert p[imin] == pytest.approx(pm[kmin].min(), rel=0.02)
+    # stretch grows monotonically along the path: no turning back
+    assert (np.diff(stretch) > 0).all()
+
+
+def test_load_control_cannot_pass_the_maximum():
+    """The same balloon under load control stops short below the maximum pressure."""
+    _, model = balloon("q8", 1, 8)
+    res = solve(model, LoadControl(target=0.035, steps=7))
+    assert res.status == "stopped"
+    assert res.last.lam < membrane_pressure(np.linspace(1, 3, 2001)).max() * 1.01
+
+
+def test_arc_length_lands_on_the_target_load():
+    _, model = balloon("q8", 1, 8)
+    res = solve(model, ArcLengthControl(target=0.02, steps=5))
+    assert res.status == "finished"
+    assert res.last.lam == pytest.approx(0.02, rel=1e-12)
+    assert all(np.diff([s.lam for s in res.steps]) > 0)
