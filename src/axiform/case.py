@@ -14,10 +14,11 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from .materials import MooneyRivlin
-from .mesh import Mesh, MeshError, read_gmsh, rectangle
+from .mesh import Mesh, MeshError, layered, read_gmsh, rectangle
+from .profile import Arc, Line, Profile, ProfileError
 from .model import Model
 from .selectors import SelectorError, select_edges, select_nodes
-from .solver import DisplacementControl, LoadControl, NewtonOptions
+from .solver import ArcLengthControl, DisplacementControl, LoadControl, NewtonOptions
 
 DofName = Literal["ur", "uz", "rot"]
 PositiveFloat = Annotated[float, Field(gt=0)]
@@ -47,34 +48,72 @@ class Selector(Strict):
         return self
 
 
+class LinePiece(Strict):
+    to: tuple[float, float]
+    divisions: Annotated[int, Field(ge=1)]
+
+
+class ArcPiece(Strict):
+    center: tuple[float, float]
+    to: tuple[float, float]
+    divisions: Annotated[int, Field(ge=1)]
+    ccw: bool = True
+
+
+class PieceSpec(Strict):
+    """One piece of a profile: { line = {...} } or { arc = {...} }."""
+
+    line: LinePiece | None = None
+    arc: ArcPiece | None = None
+
+    @model_validator(mode="after")
+    def _one(self):
+        if (self.line is None) == (self.arc is None):
+            raise ValueError("a profile piece is either { line = ... } or { arc = ... }")
+        return self
+
+
+_GRID_KEYS = {"rectangle": ("r", "z", "divisions"), "gmsh": ("file",),
+              "layered": ("start", "profile", "thickness", "layers")}
+
+
 class MeshSpec(Strict):
-    kind: Literal["rectangle", "gmsh"] = "rectangle"
+    kind: Literal["rectangle", "gmsh", "layered"] = "rectangle"
     element: Literal["q4", "q8", "sfr"]
     r: tuple[float, float] | None = None
     z: tuple[float, float] | None = None
     divisions: tuple[Annotated[int, Field(ge=1)], Annotated[int, Field(ge=1)]] | None = None
     file: str | None = None
+    start: tuple[float, float] | None = None
+    profile: Annotated[list[PieceSpec], Field(min_length=1)] | None = None
+    thickness: PositiveFloat | Annotated[list[tuple[float, PositiveFloat]], Field(min_length=2)] | None = None
+    layers: Annotated[int, Field(ge=1)] | None = None
     sfr_edges: Literal["tie", "fix", "free"] = "tie"
 
     @model_validator(mode="after")
     def _kind(self):
+        for kind, keys in _GRID_KEYS.items():
+            for key in keys:
+                given = getattr(self, key) is not None
+                if kind == self.kind and not given:
+                    raise ValueError(f"a {kind} mesh needs '{key}'")
+                if kind != self.kind and given and key not in _GRID_KEYS[self.kind]:
+                    raise ValueError(f"'{key}' belongs to kind = \"{kind}\"")
         if self.kind == "rectangle":
-            for key in ("r", "z", "divisions"):
-                if getattr(self, key) is None:
-                    raise ValueError(f"a rectangle mesh needs '{key}'")
-            if self.file is not None:
-                raise ValueError("'file' belongs to kind = \"gmsh\"")
             if not self.r[0] < self.r[1] or not self.z[0] < self.z[1]:
                 raise ValueError("r and z must be given as [min, max] with min < max")
             if self.r[0] < 0:
                 raise ValueError("r must be >= 0 (the meridian plane)")
-        else:
-            if self.file is None:
-                raise ValueError("a gmsh mesh needs 'file'")
-            for key in ("r", "z", "divisions"):
-                if getattr(self, key) is not None:
-                    raise ValueError(f"'{key}' belongs to kind = \"rectangle\"")
+        if self.kind == "layered" and isinstance(self.thickness, list):
+            s = [row[0] for row in self.thickness]
+            if any(b <= a for a, b in zip(s, s[1:])):
+                raise ValueError("thickness table: arc lengths must increase")
         return self
+
+    def build_profile(self):
+        pieces = tuple(Line(p.line.to, p.line.divisions) if p.line else
+                       Arc(p.arc.center, p.arc.to, p.arc.divisions, p.arc.ccw) for p in self.profile)
+        return Profile(self.start, pieces)
 
 
 class MaterialSpec(Strict):
@@ -150,11 +189,20 @@ class DofRef(Strict):
     dof: DofName
 
 
+class StopSpec(Strict):
+    at: Selector
+    dof: Literal["ur", "uz"]
+    value: float
+
+
 class SolverSpec(Strict):
     control: Literal["load", "displacement", "arc-length"] = "load"
     dof: DofRef | None = None
     target: float | None = None
     steps: Annotated[int, Field(ge=1)] = 10
+    arc_length: PositiveFloat | None = None
+    stop: StopSpec | None = None
+    max_steps: Annotated[int, Field(ge=1)] = 1000
     max_iterations: Annotated[int, Field(ge=1)] = 20
     tolerance: Annotated[float, Field(gt=0, lt=1)] = 1e-8
     min_step: Annotated[float, Field(gt=0, le=1)] = 1e-4
@@ -167,8 +215,10 @@ class SolverSpec(Strict):
                 raise ValueError("displacement control needs 'dof' and 'target'")
         elif self.dof is not None:
             raise ValueError("'dof' belongs to control = \"displacement\"")
-        if self.control == "arc-length":
-            raise ValueError("arc-length control is not available in this version; use \"load\" or \"displacement\"")
+        if self.control != "arc-length":
+            for key in ("arc_length", "stop"):
+                if getattr(self, key) is not None:
+                    raise ValueError(f"'{key}' belongs to control = \"arc-length\"")
         if self.target is not None and self.target == 0:
             raise ValueError("target must not be 0")
         return self
@@ -177,6 +227,9 @@ class SolverSpec(Strict):
 class OutputSpec(Strict):
     every: Annotated[int, Field(ge=1)] = 1  # field output every k-th converged step (and the last)
     vtu: bool = True
+    gid: bool = False
+    plots: bool = True
+    revolved: Annotated[int, Field(ge=0)] = 0  # sectors of a 3D revolved copy of the last step
 
 
 class Case(Strict):
@@ -269,7 +322,7 @@ class Built:
 
     case: Case
     model: Model
-    control: LoadControl | DisplacementControl
+    control: LoadControl | DisplacementControl | ArcLengthControl
     options: NewtonOptions
     monitors: list[Monitor]
 
@@ -277,6 +330,11 @@ class Built:
 def _mesh(spec: MeshSpec, base: Path) -> Mesh:
     if spec.kind == "rectangle":
         return rectangle(spec.r, spec.z, spec.divisions, spec.element)
+    if spec.kind == "layered":
+        try:
+            return layered(spec.build_profile(), spec.thickness, spec.layers, spec.element)
+        except ProfileError as exc:
+            raise CaseError(f"mesh.profile: {exc}") from None
     path = Path(spec.file)
     path = path if path.is_absolute() else base / path
     if not path.exists():
@@ -331,6 +389,15 @@ def build(case: Case, base: str | Path = ".") -> Built:
             if dof in model.fixed:
                 raise CaseError("solver.dof: the driven dof is also fixed by a [[fix]] table")
             control = DisplacementControl(dof, s.target, s.steps)
+        elif s.control == "arc-length":
+            stop_dof = stop_value = None
+            if s.stop is not None:
+                stop_dof = int(model.dof(_one_node(mesh, s.stop.at, "solver.stop.at"), s.stop.dof))
+                if stop_dof in model.fixed:
+                    raise CaseError("solver.stop: that dof is fixed by a [[fix]] table")
+                stop_value = s.stop.value
+            control = ArcLengthControl(1.0 if s.target is None else s.target, s.steps, s.arc_length,
+                                       stop_dof, stop_value, s.max_steps)
         else:
             control = LoadControl(1.0 if s.target is None else s.target, s.steps)
         if not case.pressure and not case.point_load and not any(f.value for f in case.fix):

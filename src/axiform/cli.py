@@ -1,4 +1,4 @@
-"""`axiform run CASE.toml --out DIR` and `axiform check CASE.toml`.
+"""`axiform run CASE.toml --out DIR`, `axiform check CASE.toml`, `axiform plot DIR`.
 
 Exit codes: 0 finished, 1 stopped short (converged steps kept), 2 invalid case.
 """
@@ -19,17 +19,15 @@ from .solver import solve
 class Progress:
     """One line per converged step on a terminal (rewritten in place), a summary at the end."""
 
-    def __init__(self, stream, target: float, driven: str, quiet: bool):
+    def __init__(self, stream, quiet: bool):
         self.stream = stream
-        self.target = target
-        self.driven = driven
         self.tty = stream.isatty() and not quiet
         self.t0 = time.perf_counter()
 
-    def __call__(self, step, done: float, values: dict[str, float]):
+    def __call__(self, step, frac: float, values: dict[str, float]):
         if not self.tty:
             return
-        frac = min(max(done / self.target, 0.0), 1.0) if self.target else 1.0
+        frac = min(max(frac, 0.0), 1.0)
         bar = "#" * int(30 * frac) + "-" * (30 - int(30 * frac))
         mon = "  ".join(f"{k} {v:.4g}" for k, v in list(values.items())[:3])
         self.stream.write(f"\r[{bar}] {100 * frac:5.1f}%  step {step.number}  lambda {step.lam:.5g}  "
@@ -50,16 +48,21 @@ def run(case_path: str, out: str | None, quiet: bool = False, overrides: list[st
         print(f"axiform: invalid case {case_file}:\n{exc}", file=sys.stderr)
         return 2
     out_dir = Path(out) if out else Path("results") / case_file.stem
-    writer = ResultsWriter(out_dir, built.model, built.monitors, case.title,
-                           every=case.output.every, vtu=case.output.vtu)
+    o = case.output
+    writer = ResultsWriter(out_dir, built.model, built.monitors, case.title, every=o.every, vtu=o.vtu,
+                           gid_files=o.gid, revolved=o.revolved, plots=o.plots)
     model, control = built.model, built.control
-    progress = Progress(sys.stderr, control.target, "", quiet)
+    progress = Progress(sys.stderr, quiet)
+    # progress: the driven dof, the stop dof of an arc length, or the load factor
     driven = getattr(control, "dof", None)
+    goal = control.target
+    if getattr(control, "stop_dof", None) is not None:
+        driven, goal = control.stop_dof, control.stop_value
 
     def on_step(step):
         values = writer.step(step)
         done = step.u[driven] if driven is not None else step.lam
-        progress(step, done, values)
+        progress(step, done / goal, values)
 
     if not quiet:
         print(f"axiform {__version__}: {case.title or case_file.name}: {model.mesh.n_cells} {model.mesh.element.name} "
@@ -87,6 +90,18 @@ def check(case_path: str, overrides: list[str] = ()) -> int:
     return 0
 
 
+def plot(folder: str, field: str) -> int:
+    from .plots import plot_folder
+
+    path = Path(folder)
+    if not (path / "history.csv").exists():
+        print(f"axiform: {folder} is not a results folder (no history.csv)", file=sys.stderr)
+        return 2
+    for png in plot_folder(path, field):
+        print(png)
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="axiform", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"axiform {__version__}")
@@ -101,7 +116,13 @@ def main(argv: list[str] | None = None) -> int:
         p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                        help="override a key, VALUE in TOML syntax: --set mesh.element='\"q8\"' "
                             "--set mesh.divisions=[40,4]")
+    p_plot = sub.add_parser("plot", help="write the PNG plots of a results folder")
+    p_plot.add_argument("folder")
+    p_plot.add_argument("--field", default="von_mises",
+                        help="nodal field colouring the deformed shape (von_mises, J, fibre_rotation, ...)")
     args = parser.parse_args(argv)
+    if args.command == "plot":
+        return plot(args.folder, args.field)
     if args.command == "run":
         return run(args.case, args.out, args.quiet, args.set)
     return check(args.case, args.set)

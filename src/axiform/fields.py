@@ -1,4 +1,5 @@
-"""Nodal fields for output: displacement, fibre rotation, J, Cauchy and von Mises stress.
+"""Nodal fields for output: displacement, fibre rotation, J, Cauchy and von Mises stress,
+principal stretches.
 
 Quadrature-point values are averaged to the nodes (each element's mean, then the mean over
 the elements around a node): enough for pictures, not for error estimates.
@@ -22,7 +23,13 @@ def point_fields(model, u_full: np.ndarray) -> dict[str, np.ndarray]:
     sig = cauchy_stress(x, P)  # (e, q, 4): rr, zz, tt, rz
     s_rr, s_zz, s_tt, s_rz = (sig[..., i] for i in range(4))
     mises = np.sqrt(0.5 * ((s_rr - s_zz) ** 2 + (s_zz - s_tt) ** 2 + (s_tt - s_rr) ** 2) + 3 * s_rz**2)
-    cell_values = np.column_stack([J.mean(1), sig.mean(1), mises.mean(1)])  # (e, 6)
+    # principal stretches: eigenvalues of the meridian block of C = F^T F, and the hoop stretch
+    a, b, c, d = x[..., 0], x[..., 1], x[..., 2], x[..., 3]
+    C11, C22, C12 = a * a + c * c, b * b + d * d, a * b + c * d
+    mean, dev = 0.5 * (C11 + C22), np.sqrt(0.25 * (C11 - C22) ** 2 + C12**2)
+    l1, l2 = np.sqrt(mean + dev), np.sqrt(np.maximum(mean - dev, 0.0))
+    stretches = np.stack([l1, l2, x[..., 4]], axis=-1)
+    cell_values = np.column_stack([J.mean(1), sig.mean(1), mises.mean(1), stretches.mean(1)])  # (e, 9)
     count = np.bincount(mesh.cells.ravel(), minlength=mesh.n_nodes)
     nodal = np.zeros((mesh.n_nodes, cell_values.shape[1]))
     for k in range(mesh.cells.shape[1]):
@@ -33,6 +40,7 @@ def point_fields(model, u_full: np.ndarray) -> dict[str, np.ndarray]:
         "J": nodal[:, 0],
         "cauchy_stress": nodal[:, 1:5],  # rr, zz, tt, rz
         "von_mises": nodal[:, 5],
+        "principal_stretches": nodal[:, 6:9],  # in-plane major, minor, hoop
     }
     if dpn == 3:
         out["fibre_rotation"] = u[:, 2].copy()

@@ -1,8 +1,10 @@
-"""The results folder, written as steps converge: history.csv, summary.json, a VTU series.
+"""The results folder, written as steps converge: history.csv, summary.json, a VTU series,
+thickness.csv, optional GiD files and a 3D revolved copy, and PNG plots at the end.
 
 history.csv: one row per converged step (step, load_factor, iterations, then one column per
 monitor).  summary.json: status, steps, newton_iterations, wall_time_s, dofs, elements,
 element (and more).  fields/: a ParaView series (step_NNNN.vtu listed in fields.pvd).
+thickness.csv: the wall thickness along the body at the last written step.
 """
 
 from __future__ import annotations
@@ -15,7 +17,9 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
+from . import gid
 from .fields import point_fields
+from .thickness import thickness_table, write_thickness_csv
 
 
 class ResultsWriter:
@@ -23,13 +27,16 @@ class ResultsWriter:
     converged step."""
 
     def __init__(self, out: str | Path, model, monitors=(), title: str = "", every: int = 1,
-                 vtu: bool = True):
+                 vtu: bool = True, gid_files: bool = False, revolved: int = 0, plots: bool = True):
         self.out = Path(out)
         self.out.mkdir(parents=True, exist_ok=True)
         self.model = model
         self.monitors = list(monitors)
         self.every = every
         self.vtu = vtu
+        self.gid = gid_files
+        self.revolved = revolved
+        self.plots = plots
         self.t0 = time.perf_counter()
         self.steps = 0
         self.newton_iterations = 0
@@ -55,6 +62,12 @@ class ResultsWriter:
             (self.out / "fields").mkdir(exist_ok=True)
             for old in (self.out / "fields").glob("step_*.vtu"):
                 old.unlink()
+        for stale in ("thickness.csv", "fields.pvd", "revolved.vtu", "load_curve.png", "thickness.png",
+                      "deformed.png"):
+            (self.out / stale).unlink(missing_ok=True)
+        if self.gid:
+            gid.write_mesh(self.out / "axiform.post.msh", model.mesh.points, model.mesh.cells)
+            gid.start_results(self.out / "axiform.post.res")
         self._write_summary()
 
     def _write_summary(self):
@@ -73,34 +86,61 @@ class ResultsWriter:
         self.newton_iterations += step.iterations
         self.summary.update(steps=self.steps, newton_iterations=self.newton_iterations,
                             load_factor=float(step.lam), monitors=values)
-        if self.vtu and step.number % self.every == 0:
+        if step.number % self.every == 0:
             self._write_fields(step)
         self._last_step = step
         self._write_summary()
         return values
 
     def _write_fields(self, step):
+        """Field output of one step: VTU (+ .pvd), GiD results, thickness.csv."""
         import meshio
 
         mesh = self.model.mesh
+        self._last_written = step.number
+        u = step.u.reshape(-1, self.model.dpn)[:, :2]
+        table = thickness_table(mesh, u)
+        if table is not None:
+            write_thickness_csv(self.out / "thickness.csv", table, step.number, float(step.lam))
+        if not (self.vtu or self.gid):
+            return
         data = point_fields(self.model, step.u)
+        if self.gid:
+            gid.append_results(self.out / "axiform.post.res", step.number, data)
+        if not self.vtu:
+            return
         cell_type = "quad8" if mesh.element.nodes == 8 else "quad"
         pts = np.column_stack([mesh.points, np.zeros(mesh.n_nodes)])
         name = f"step_{step.number:04d}.vtu"
         meshio.write(self.out / "fields" / name, meshio.Mesh(pts, [(cell_type, mesh.cells)], point_data=data))
         self._pvd.append((float(step.number), f"fields/{name}"))
-        self._last_written = step.number
         root = ET.Element("VTKFile", type="Collection", version="0.1")
         coll = ET.SubElement(root, "Collection")
         for t, f in self._pvd:
             ET.SubElement(coll, "DataSet", timestep=repr(t), part="0", file=f)
         ET.ElementTree(root).write(self.out / "fields.pvd")
 
+    def _write_revolved(self, step):
+        from .revolve import revolve
+
+        mesh = self.model.mesh
+        u = step.u.reshape(-1, self.model.dpn)[:, :2]
+        data = point_fields(self.model, step.u)
+        keep = {k: data[k] for k in ("displacement", "von_mises", "J")}
+        revolve(mesh.points + u, mesh.cells, self.revolved, keep).write(self.out / "revolved.vtu")
+
     def finish(self, status: str, message: str = "") -> None:
-        """Final summary; the last converged step always gets its field output."""
-        if self.vtu and self.steps and self._last_written != self.steps:
+        """Final summary; the last converged step always gets its field output, the 3D copy and
+        the plots."""
+        if self.steps and self._last_written != self.steps:
             self._write_fields(self._last_step)
+        if self.steps and self.revolved:
+            self._write_revolved(self._last_step)
         self.summary["status"] = status
         if message:
             self.summary["message"] = message
         self._write_summary()
+        if self.plots and self.steps:
+            from .plots import plot_folder
+
+            plot_folder(self.out)
