@@ -121,17 +121,31 @@ def _set_fibres(mesh: Mesh, number: np.ndarray, s: np.ndarray) -> None:
     mesh.fibre_s = s[::step]
 
 
+def graded(a: float, b: float, n: int, ratio: float = 1.0, per_division: int = 1) -> np.ndarray:
+    """n divisions of [a, b] in geometric progression, the last one `ratio` times the first
+    (per_division - 1 points inside each division, at its middle for Q8)."""
+    if ratio == 1.0:
+        w = np.ones(n)
+    else:
+        w = ratio ** (np.arange(n) / max(n - 1, 1))
+    ends = np.concatenate([[0.0], np.cumsum(w)]) / w.sum()
+    if per_division == 2:
+        ends = np.sort(np.concatenate([ends, 0.5 * (ends[1:] + ends[:-1])]))
+    return a + (b - a) * ends
+
+
 def rectangle(r: tuple[float, float], z: tuple[float, float], divisions: tuple[int, int],
-              element: str = "q4") -> Mesh:
+              element: str = "q4", grading: tuple[float, float] = (1.0, 1.0)) -> Mesh:
     """Structured mesh of [r0, r1] x [z0, z1] with divisions (nr, nz); Q8 gets mid-side nodes.
+    grading: size of the last element over the first, radially and axially (geometric).
 
     Named node and edge sets: "left" (r = r0), "right" (r = r1), "bottom" (z = z0), "top" (z = z1).
     The fibres (for thickness output) are the vertical lines of nodes.
     """
     kind = ELEMENTS[element]
     f = 2 if kind.nodes == 8 else 1
-    nr, nz = divisions[0] * f, divisions[1] * f
-    R, Z = np.meshgrid(np.linspace(*r, nr + 1), np.linspace(*z, nz + 1), indexing="ij")
+    R, Z = np.meshgrid(graded(*r, divisions[0], grading[0], f), graded(*z, divisions[1], grading[1], f),
+                       indexing="ij")
     points, cells, number = _structured(np.stack([R, Z], axis=-1), kind)
     mesh = Mesh(points, cells, kind)
     _add_grid_sets(mesh, number, {"left": (0, slice(None)), "right": (-1, slice(None)),

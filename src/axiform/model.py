@@ -55,6 +55,7 @@ class Model:
     fixed: dict[int, float] = field(default_factory=dict)
     pressures: list[FollowerPressure] = field(default_factory=list)
     point_loads: list[tuple[int, float]] = field(default_factory=list)
+    contacts: list = field(default_factory=list)
 
     def __post_init__(self):
         if self.sfr_edges not in SFR_EDGE_RULES:
@@ -90,6 +91,11 @@ class Model:
         """A force value * lambda on each node: the total force on the revolved ring."""
         for d in self.dof(np.asarray(nodes), dof):
             self.point_loads.append((int(d), float(value)))
+        self.dofmap = None
+
+    def contact(self, pair) -> None:
+        """Add a contact pair (axiform.contact.ContactPair)."""
+        self.contacts.append(pair)
         self.dofmap = None
 
     # ---- finalize ------------------------------------------------------------------------
@@ -130,6 +136,8 @@ class Model:
         self.pattern = SparsePattern(self.dofmap, [self.solid.dofs] + [p.dofs for p in self.pressures])
         self._solid_pos = self.pattern.positions(self.solid.dofs)
         self._pressure_pos = [self.pattern.positions(p.dofs) for p in self.pressures]
+        self._contact_dofs = [c.dofs(self.dpn) for c in self.contacts]
+        self._contact_pos = [self.pattern.positions(d) for d in self._contact_dofs]
         self.f_point = np.zeros(self.n_full)
         for d, v in self.point_loads:
             self.f_point[d] += v
@@ -138,6 +146,12 @@ class Model:
     @property
     def n_free(self) -> int:
         return self.dofmap.nf
+
+    def commit(self) -> None:
+        """A step converged at the last evaluated state: update the history variables
+        (contact stick points, sticky nodes, positions for the crossing test)."""
+        for pair in self.contacts:
+            pair.commit()
 
     # ---- evaluation ------------------------------------------------------------------------
     def expand(self, u_f: np.ndarray, lam: float) -> np.ndarray:
@@ -163,13 +177,26 @@ class Model:
         f_abs = np.bincount(self.solid.dofs.ravel(), weights=np.abs(fe).ravel(), minlength=self.n_full)
         f_ext, dfext = self.external_load(u, tangent)
         r_full = f_int - lam * f_ext
+        # contact: R -= f_c, K -= df_c/dx; a moving surface adds dR/dlambda = (df_c/dx) motion
+        dr_contact = np.zeros(self.n_full)
+        contact_data = []
+        u2 = u.reshape(-1, self.dpn)[:, :2]
+        for pair, dofs in zip(self.contacts, self._contact_dofs):
+            fc, Kc, _ = pair.evaluate(u2, lam)
+            np.add.at(r_full, dofs.ravel(), -fc.ravel())
+            motion = np.asarray(pair.surface.motion, float)
+            if motion.any():
+                np.add.at(dr_contact, dofs.ravel(), (Kc @ motion).ravel())
+            contact_data.append(-Kc)
         r_eq = dm.gather(r_full)
-        dr_dlam = -dm.gather(f_ext)[: dm.nf]
+        dr_dlam = (dm.gather(dr_contact) - dm.gather(f_ext))[: dm.nf]
         K = None
         if tangent:
             data = self.pattern.accumulate(self._solid_pos, Ke)
             if dfext is not None:
                 data -= lam * dfext
+            for pos, Kc in zip(self._contact_pos, contact_data):
+                data = self.pattern.accumulate(pos, Kc, data)
             K, K_fp = self.pattern.blocks(data)
             if dm.np:
                 dr_dlam = dr_dlam + K_fp @ dm.prescribed_ref

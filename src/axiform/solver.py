@@ -139,6 +139,7 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
                 break
             continue
         path.accept(u_new, lam_new, size)
+        model.commit()
         result.newton_iterations += its
         step = Step(len(result.steps) + 1, lam_new, its, res, u_new, model.expand(u_new, lam_new), ev)
         result.steps.append(step)

@@ -1,0 +1,1 @@
+"""Contact of the body with rigid moulds (paper section 3)."""
