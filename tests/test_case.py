@@ -229,3 +229,38 @@ steps = 2
     rows = list(csv.DictReader(open(tmp_path / "out" / "history.csv")))
     assert [float(r["load_factor"]) for r in rows] == [0.5, 1.0]
     assert float(rows[-1]["base_fz"]) == pytest.approx(0.4, rel=1e-9)
+
+
+def test_toric_plate_case_with_sticky_contact(tmp_path):
+    out = tmp_path / "toric"
+    assert main(["run", str(EXAMPLES / "toric_plate.toml"), "--out", str(out), "-q",
+                 "--set", "mesh.divisions=[20,2]", "--set", "solver.target=3.0", "--set", "solver.steps=15",
+                 "--set", "output.plots=false"]) == 0
+    rows = list(csv.DictReader(open(out / "history.csv")))
+    area = np.array([float(r["contact_area"]) for r in rows])
+    assert area[0] == 0 and area[-1] > 0 and (np.diff(area) >= 0).all()  # sticky: never lets go
+    text = (out / "contact.csv").read_text().splitlines()
+    assert text[1] == "pair,node,r,z,gap,pressure,status" and any(line.endswith(",sticky") for line in text)
+    summary = json.loads((out / "summary.json").read_text())
+    pen = summary["contact"][0]["penetration"]
+    assert 0 <= pen < 0.01 * 0.5  # the default penalty leaves < 1 % of the thickness
+    assert float(rows[-1]["penetration"]) == pytest.approx(pen)
+
+
+CONTACT_BAD = [
+    ("slaves match nothing", 'slaves = { z = 0.5 }', 'slaves = { z = 0.6 }', r"contact\[0\]\.slaves: selector \{z = 0.6\} matches no node"),
+    ("two surfaces", 'surface = { circle = { center = [4.5, 3.0], radius = 1.5 } }',
+     'surface = { circle = { center = [4.5, 3.0], radius = 1.5 }, polyline = [[0, 1], [1, 1]] }',
+     r"contact\[0\]\.surface: a surface is exactly one of"),
+    ("monitor index", "contact = 0\nquantity = \"area\"", "contact = 3\nquantity = \"area\"",
+     r"monitor\[2\]\.contact: there are 1 \[\[contact\]\] tables"),
+    ("sticky and friction", "sticky = true", "sticky = true\nfriction = 0.2", r"contact\[0\]: give friction or sticky"),
+]
+
+
+@pytest.mark.parametrize("name, old, new, message", CONTACT_BAD, ids=[b[0] for b in CONTACT_BAD])
+def test_invalid_contact_tables(tmp_path, capsys, name, old, new, message):
+    text = (EXAMPLES / "toric_plate.toml").read_text()
+    assert old in text
+    assert run(tmp_path, text.replace(old, new, 1)) == 2
+    assert re.search(message, capsys.readouterr().err)

@@ -13,6 +13,8 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from .contact.pair import ContactPair
+from .contact.surfaces import Circle, Polyline
 from .materials import MooneyRivlin
 from .mesh import Mesh, MeshError, layered, read_gmsh, rectangle
 from .profile import Arc, Line, Profile, ProfileError
@@ -170,17 +172,104 @@ class PointLoadSpec(Strict):
 
 
 class MonitorSpec(Strict):
-    """One node's displacement (at + dof) or the reaction summed over nodes (reaction + dof)."""
+    """One node's displacement (at + dof), the reaction summed over nodes (reaction + dof), or
+    a quantity of a contact pair (contact = index of the [[contact]] table + quantity)."""
 
     name: str
     at: Selector | None = None
     reaction: Selector | None = None
-    dof: DofName
+    dof: DofName | None = None
+    contact: Annotated[int, Field(ge=0)] | None = None
+    quantity: Literal["force-r", "force-z", "area", "penetration"] | None = None
 
     @model_validator(mode="after")
     def _one(self):
-        if (self.at is None) == (self.reaction is None):
-            raise ValueError("a monitor needs exactly one of 'at' or 'reaction'")
+        given = [k for k in ("at", "reaction", "contact") if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise ValueError("a monitor needs exactly one of 'at', 'reaction' or 'contact'")
+        if self.contact is None:
+            if self.dof is None:
+                raise ValueError(f"a monitor with '{given[0]}' needs 'dof'")
+            if self.quantity is not None:
+                raise ValueError("'quantity' belongs to a contact monitor")
+        else:
+            if self.quantity is None:
+                raise ValueError("a contact monitor needs 'quantity'")
+            if self.dof is not None:
+                raise ValueError("'dof' does not belong to a contact monitor")
+        return self
+
+
+class CircleSpec(Strict):
+    center: tuple[float, float]
+    radius: PositiveFloat
+    inside: bool = False
+
+
+class SurfaceLine(Strict):
+    to: tuple[float, float]
+
+
+class SurfaceArc(Strict):
+    center: tuple[float, float]
+    to: tuple[float, float]
+    ccw: bool = True
+
+
+class SurfacePiece(Strict):
+    """{ line = { to } } or { arc = { center, to, ccw } }: exact, no divisions needed."""
+
+    line: SurfaceLine | None = None
+    arc: SurfaceArc | None = None
+
+    @model_validator(mode="after")
+    def _one(self):
+        if (self.line is None) == (self.arc is None):
+            raise ValueError("a surface piece is either { line = ... } or { arc = ... }")
+        return self
+
+
+class ProfileSurfaceSpec(Strict):
+    start: tuple[float, float]
+    pieces: Annotated[list[SurfacePiece], Field(min_length=1)]
+
+
+class SurfaceSpec(Strict):
+    """A rigid surface: a circle, a polyline (points in order: the body on their left), the
+    points of a CSV file (r, z per line), or a profile of lines and arcs."""
+
+    circle: CircleSpec | None = None
+    polyline: Annotated[list[tuple[float, float]], Field(min_length=2)] | None = None
+    file: str | None = None
+    profile: ProfileSurfaceSpec | None = None
+
+    @model_validator(mode="after")
+    def _one(self):
+        if sum(getattr(self, k) is not None for k in ("circle", "polyline", "file", "profile")) != 1:
+            raise ValueError("a surface is exactly one of circle, polyline, file, profile")
+        return self
+
+
+class MotionSpec(Strict):
+    ur: float = 0.0
+    uz: float = 0.0
+
+
+class ContactSpec(Strict):
+    surface: SurfaceSpec
+    slaves: Selector
+    penalty: PositiveFloat | None = None
+    tangential_penalty: PositiveFloat | None = None
+    friction: Annotated[float, Field(ge=0)] = 0.0
+    sticky: bool = False
+    motion: MotionSpec = MotionSpec()
+    depth: PositiveFloat | None = None
+    search: Literal["buckets", "binary", "brute"] = "buckets"
+
+    @model_validator(mode="after")
+    def _law(self):
+        if self.sticky and self.friction:
+            raise ValueError("give friction or sticky = true, not both")
         return self
 
 
@@ -240,6 +329,7 @@ class Case(Strict):
     pressure: list[PressureSpec] = []
     point_load: list[PointLoadSpec] = []
     monitor: list[MonitorSpec] = []
+    contact: list[ContactSpec] = []
     solver: SolverSpec = SolverSpec()
     output: OutputSpec = OutputSpec()
 
@@ -302,15 +392,24 @@ def load(path: str | Path, overrides: list[str] = ()) -> Case:
     return parse(data)
 
 
+_CONTACT_QUANTITY = {"force-r": "force_r", "force-z": "force_z", "area": "contact_area",
+                     "penetration": "penetration"}
+
+
 @dataclass
 class Monitor:
-    """A named scalar read off each converged step: one dof, or a sum of reactions."""
+    """A named scalar read off each converged step: one dof, a sum of reactions, or a
+    contact pair's total force, contact area or penetration."""
 
     name: str
-    dofs: np.ndarray
-    reaction: bool
+    dofs: np.ndarray | None = None
+    reaction: bool = False
+    pair: object = None
+    quantity: str = ""
 
     def value(self, step) -> float:
+        if self.pair is not None:
+            return float(self.pair.report()[_CONTACT_QUANTITY[self.quantity]])
         if self.reaction:
             return float(step.evaluation.r_full[self.dofs].sum())
         return float(step.u[self.dofs].sum())
@@ -347,6 +446,54 @@ def _mesh(spec: MeshSpec, base: Path) -> Mesh:
         raise CaseError(f"mesh.file: cannot read {path} ({exc})") from None
 
 
+def default_penalty(material: MooneyRivlin, mesh: Mesh) -> float:
+    """10 E / h: E the small-strain Young's modulus of the material, h the smallest element
+    edge; the penetration left is then about p h / (10 E) for a contact pressure p."""
+    mu, k = material.shear_modulus, material.kappa
+    return 10.0 * 9.0 * k * mu / (3.0 * k + mu) / mesh.size()
+
+
+def _surface(spec: SurfaceSpec, motion: tuple[float, float], base: Path, where: str):
+    if spec.circle is not None:
+        c = spec.circle
+        return Circle(motion=motion, center=c.center, radius=c.radius, inside=c.inside)
+    if spec.polyline is not None:
+        points = np.asarray(spec.polyline, float)
+    elif spec.profile is not None:
+        pieces = tuple(Line(p.line.to, 1) if p.line else Arc(p.arc.center, p.arc.to, 1, p.arc.ccw)
+                       for p in spec.profile.pieces)
+        try:
+            profile = Profile(spec.profile.start, pieces)
+            profile.sample(1)  # checks the arcs
+            return Polyline.from_profile(profile, motion)
+        except (ProfileError, ValueError) as exc:
+            raise CaseError(f"{where}.surface.profile: {exc}") from None
+    else:
+        path = Path(spec.file)
+        path = path if path.is_absolute() else base / path
+        try:
+            points = np.loadtxt(path, delimiter=",", ndmin=2, comments="#")
+        except (OSError, ValueError) as exc:
+            raise CaseError(f"{where}.surface.file: cannot read {path} as r, z rows ({exc})") from None
+        if points.shape[1] != 2:
+            raise CaseError(f"{where}.surface.file: {path} must have two columns, r and z")
+    try:
+        return Polyline(motion=motion, points=points)
+    except ValueError as exc:
+        raise CaseError(f"{where}.surface: {exc}") from None
+
+
+def _contact(mesh: Mesh, model: Model, spec: ContactSpec, base: Path, where: str) -> ContactPair:
+    surface = _surface(spec.surface, (spec.motion.ur, spec.motion.uz), base, where)
+    slaves = select_nodes(mesh, spec.slaves.model_dump(), f"{where}.slaves")
+    penalty = spec.penalty if spec.penalty is not None else default_penalty(model.material, mesh)
+    try:
+        return ContactPair(mesh, surface, slaves, penalty, friction=spec.friction, sticky=spec.sticky,
+                           tangential_penalty=spec.tangential_penalty, depth=spec.depth, search=spec.search)
+    except ValueError as exc:
+        raise CaseError(f"{where}.slaves: {exc}") from None
+
+
 def _one_node(mesh: Mesh, sel: Selector, where: str) -> int:
     nodes = select_nodes(mesh, sel.model_dump(), where)
     if len(nodes) != 1:
@@ -369,8 +516,16 @@ def build(case: Case, base: str | Path = ".") -> Built:
             model.pressure(select_edges(mesh, p.on.model_dump(), f"pressure[{i}].on"), p.value)
         for i, pl in enumerate(case.point_load):
             model.point_load(select_nodes(mesh, pl.at.model_dump(), f"point_load[{i}].at"), pl.dof, pl.value)
+        pairs = [_contact(mesh, model, c, base, f"contact[{i}]") for i, c in enumerate(case.contact)]
+        for pair in pairs:
+            model.contact(pair)
         monitors = []
         for i, m in enumerate(case.monitor):
+            if m.contact is not None:
+                if m.contact >= len(pairs):
+                    raise CaseError(f"monitor[{i}].contact: there are {len(pairs)} [[contact]] tables (from 0)")
+                monitors.append(Monitor(m.name, pair=pairs[m.contact], quantity=m.quantity))
+                continue
             if m.dof == "rot" and model.dpn == 2:
                 raise CaseError(f"monitor[{i}].dof: element '{case.mesh.element}' has no rotation dof")
             if m.at is not None:
@@ -400,8 +555,10 @@ def build(case: Case, base: str | Path = ".") -> Built:
                                        stop_dof, stop_value, s.max_steps)
         else:
             control = LoadControl(1.0 if s.target is None else s.target, s.steps)
-        if not case.pressure and not case.point_load and not any(f.value for f in case.fix):
-            raise CaseError("nothing loads the model: give [[pressure]], [[point_load]] or a [[fix]] with a value")
+        moving = any(c.motion.ur or c.motion.uz for c in case.contact)
+        if not case.pressure and not case.point_load and not any(f.value for f in case.fix) and not moving:
+            raise CaseError("nothing loads the model: give [[pressure]], [[point_load]], a [[fix]] with a "
+                            "value or a moving [[contact]] surface")
     except SelectorError as exc:
         raise CaseError(str(exc)) from None
     model.finalize()

@@ -78,8 +78,9 @@ def last_vtu(folder: Path) -> Path | None:
     return folder / files[-1] if files else None
 
 
-def plot_deformed(vtu: Path, out: Path, field: str = "von_mises") -> Path | None:
-    """The deformed meridian section over the undeformed outline, coloured by a nodal field."""
+def plot_deformed(vtu: Path, out: Path, field: str = "von_mises", surfaces: Path | None = None) -> Path | None:
+    """The deformed meridian section over the undeformed outline, coloured by a nodal field,
+    with the rigid surfaces (surfaces.csv) where there are some."""
     import meshio
     from matplotlib.collections import PolyCollection
 
@@ -99,6 +100,16 @@ def plot_deformed(vtu: Path, out: Path, field: str = "von_mises") -> Path | None
     ax.add_collection(pc)
     fig.colorbar(pc, ax=ax, label=field)
     allp = np.vstack([X, x])
+    if surfaces is not None and surfaces.exists():
+        sd = np.loadtxt(surfaces, delimiter=",", skiprows=1, ndmin=2)
+        for k in np.unique(sd[:, 0]):
+            pts = sd[sd[:, 0] == k, 1:]
+            ax.plot(pts[:, 0], pts[:, 1], "r-", lw=1.5)
+        # show the moulds around the body, not their whole extent
+        lo, hi = allp.min(axis=0), allp.max(axis=0)
+        pad = 0.15 * (hi - lo).max()
+        near = ((sd[:, 1:] > lo - pad) & (sd[:, 1:] < hi + pad)).all(axis=1)
+        allp = np.vstack([allp, sd[near, 1:]])
     ax.set_xlim(allp[:, 0].min(), allp[:, 0].max())
     ax.set_ylim(allp[:, 1].min(), allp[:, 1].max())
     ax.set_aspect("equal")
@@ -127,5 +138,5 @@ def plot_folder(folder: str | Path, field: str = "von_mises") -> list[Path]:
         made.append(plot_thickness(folder / "thickness.csv", folder / "thickness.png"))
     vtu = last_vtu(folder)
     if vtu is not None and vtu.exists():
-        made.append(plot_deformed(vtu, folder / "deformed.png", field))
+        made.append(plot_deformed(vtu, folder / "deformed.png", field, folder / "surfaces.csv"))
     return [p for p in made if p is not None]

@@ -62,7 +62,7 @@ class ResultsWriter:
             (self.out / "fields").mkdir(exist_ok=True)
             for old in (self.out / "fields").glob("step_*.vtu"):
                 old.unlink()
-        for stale in ("thickness.csv", "fields.pvd", "revolved.vtu", "load_curve.png", "thickness.png",
+        for stale in ("thickness.csv", "contact.csv", "surfaces.csv", "fields.pvd", "revolved.vtu", "load_curve.png", "thickness.png",
                       "deformed.png"):
             (self.out / stale).unlink(missing_ok=True)
         if self.gid:
@@ -82,6 +82,8 @@ class ResultsWriter:
         with open(self.out / "history.csv", "a", newline="") as fh:
             csv.writer(fh).writerow([step.number, repr(float(step.lam)), step.iterations]
                                     + [repr(v) for v in values.values()])
+        if self.model.contacts:
+            self._write_contact(step)
         self.steps = step.number
         self.newton_iterations += step.iterations
         self.summary.update(steps=self.steps, newton_iterations=self.newton_iterations,
@@ -91,6 +93,28 @@ class ResultsWriter:
         self._last_step = step
         self._write_summary()
         return values
+
+    def _write_contact(self, step):
+        """contact.csv: every slave node of every pair at this step; totals in the summary."""
+        from .contact.pair import STATUS
+
+        lines = [f"# step {step.number}, load_factor {float(step.lam)!r}",
+                 "pair,node,r,z,gap,pressure,status"]
+        totals = []
+        u = step.u.reshape(-1, self.model.dpn)[:, :2]
+        for k, pair in enumerate(self.model.contacts):
+            rep = pair.report()
+            x = self.model.mesh.points[rep["node"]] + u[rep["node"]]
+            for node, (r, z), g, p, st in zip(rep["node"], x, rep["gap"], rep["pressure"], rep["status"]):
+                lines.append(f"{k},{node},{r:.10g},{z:.10g},{g:.6g},{p:.6g},{STATUS[int(st)]}")
+            totals.append({q: rep[q] for q in ("force_r", "force_z", "contact_area", "penetration")})
+        (self.out / "contact.csv").write_text("\n".join(lines) + "\n")
+        outline = ["pair,r,z"]
+        for k, pair in enumerate(self.model.contacts):
+            pts = pair.surface.polyline() + pair.surface.offset(float(step.lam))
+            outline += [f"{k},{r:.10g},{z:.10g}" for r, z in pts]
+        (self.out / "surfaces.csv").write_text("\n".join(outline) + "\n")
+        self.summary["contact"] = totals
 
     def _write_fields(self, step):
         """Field output of one step: VTU (+ .pvd), GiD results, thickness.csv."""

@@ -64,7 +64,7 @@ class NewtonOptions:
     max_iterations: int = 20
     min_step: float = 1e-4
     growth: float = 1.5
-    easy_iterations: int = 5
+    easy_iterations: int = 8
 
 
 @dataclass
@@ -334,16 +334,27 @@ def _factorize(K):
 
 
 def _newton_load(model, u_f, lam, opts, floor):
-    """Newton at fixed lambda from the last converged state."""
+    """Newton at fixed lambda from the last converged state.  With contact, a correction that
+    raises the residual is shortened (halved up to three times): the active set and the
+    stick/slip states change between iterations, and a full step can overshoot."""
     u_f = u_f.copy()
     residuals: list[float] = []
+    ev = _evaluate(model, u_f, lam)
     for it in range(opts.max_iterations + 1):
-        ev = _evaluate(model, u_f, lam)
         if _check(ev, lam, opts, floor, residuals):
             return u_f, lam, it, residuals, ev
         if it == opts.max_iterations:
             break
-        u_f -= _factorize(ev.K)(ev.r)
+        du = -_factorize(ev.K)(ev.r)
+        trial = _evaluate(model, u_f + du, lam)
+        if model.contacts:
+            norm = np.linalg.norm(ev.r)
+            for _ in range(3):
+                if np.linalg.norm(trial.r) <= norm:
+                    break
+                du *= 0.5
+                trial = _evaluate(model, u_f + du, lam)
+        u_f, ev = u_f + du, trial
     raise StepFailed(f"no convergence in {opts.max_iterations} iterations")
 
 

@@ -12,7 +12,7 @@ import numpy as np
 from ..mesh import Mesh
 from .surfaces import Projection, RigidSurface
 
-STATUS = {0: "open", 1: "stick", 2: "slip", 3: "sticky"}
+STATUS = {0: "open", 1: "stick", 2: "slip", 3: "sticky"}  # slip: |ft| > tanh(1) mu fn
 
 
 def ring_areas(mesh: Mesh, nodes: np.ndarray) -> np.ndarray:
@@ -39,11 +39,15 @@ class ContactPair:
     defaults to the same.  friction: Coulomb coefficient mu (0: frictionless).  sticky: a node
     that touches is tied to the point where it touched.  depth: how deep behind the surface a
     node is still taken as touching it (nodes deeper were not in contact at the last
-    converged step and did not cross the surface since)."""
+    converged step and did not cross the surface since).  smoothing: the penalty law is
+    rounded over gaps in [-smoothing, smoothing] (fn = kn (d - g)^2 / 4d there, kn (-g)
+    below), so that the force has a continuous derivative and nodes grazing the surface
+    do not chatter in and out of contact from one Newton iteration to the next; default 1e-3
+    of the smallest element edge."""
 
     def __init__(self, mesh: Mesh, surface: RigidSurface, slaves: np.ndarray, penalty: float,
                  friction: float = 0.0, sticky: bool = False, tangential_penalty: float | None = None,
-                 depth: float | None = None, search: str = "buckets"):
+                 depth: float | None = None, search: str = "buckets", smoothing: float | None = None):
         corner = np.zeros(mesh.n_nodes, bool)
         corner[mesh.corner_nodes] = True
         on_boundary = np.zeros(mesh.n_nodes, bool)
@@ -61,6 +65,7 @@ class ContactPair:
         self.mu = friction
         self.sticky = sticky
         self.depth = depth if depth is not None else 0.5 * mesh.size()
+        self.smoothing = smoothing if smoothing is not None else 1e-3 * mesh.size()
         self.search = search
         n = len(self.nodes)
         # history, updated only at converged steps
@@ -83,32 +88,43 @@ class ContactPair:
         f = np.zeros((n, 2))
         K = np.zeros((n, 2, 2))  # d f / d x
         status = np.zeros(n, np.int8)
-        contact = proj.active & (proj.g < 0) & ~self.stuck
-        fn = np.where(contact, -self.kn * proj.g, 0.0)
+        d = self.smoothing
+        g = proj.g
+        contact = proj.active & (g < d) & ~self.stuck
+        # normal law (eqs. 40-41): f = fn n, fn = -kn g, rounded over |g| < d
+        band = contact & (g > -d)
+        fn = np.where(contact, np.where(band, self.kn * (d - g) ** 2 / (4 * d), -self.kn * g), 0.0)
+        dfn = np.where(contact, np.where(band, -self.kn * (d - g) / (2 * d), -self.kn), 0.0)  # dfn/dg
         nv, tv = proj.n, proj.t
         outer = lambda a, b: a[:, :, None] * b[:, None, :]  # noqa: E731
-        # normal law (eqs. 40-41): f = fn n, fn = -kn g
         f += fn[:, None] * nv
-        K -= self.kn[:, None, None] * outer(nv, nv) * contact[:, None, None]
+        K += dfn[:, None, None] * outer(nv, nv)
         K += (fn * proj.kappa)[:, None, None] * outer(tv, tv)  # fn dn/dx
         status[contact] = 1
         if self.mu > 0 and not self.sticky:
-            # a node touching for the first time sticks where it was at the last converged step
+            # Coulomb friction (eqs. 42-45) with the stick/slip corner rounded:
+            # ft = -mu fn tanh(z), z = kt (s - s0) / (mu fn).  For small slips it is the
+            # tangential penalty kt (s - s0) (stick, eq. 44), for large ones mu fn (slip, eq. 45).
+            # The sharp law makes Newton cycle between stick and slip from one iteration to
+            # the next; this one is smooth.  A node touching for the first time sticks where it
+            # was at the last converged step.
             fresh = contact & np.isnan(self.s_stick)
             s0 = np.where(fresh, proj.s_prev, self.s_stick)
             slip = np.where(contact, proj.s - s0, 0.0)
-            ft_trial = -self.kt * slip  # eq. 43
             limit = self.mu * fn  # eq. 42
-            sliding = contact & (np.abs(ft_trial) > limit)  # eq. 45
-            sticking = contact & ~sliding  # eq. 44
-            sgn = np.sign(slip)
-            ft = np.where(sliding, -limit * sgn, np.where(sticking, ft_trial, 0.0))
+            rub = contact & (limit > 0)
+            safe = np.where(rub, limit, 1.0)
+            z = np.where(rub, self.kt * slip / safe, 0.0)
+            th = np.tanh(z)
+            sech2 = 1.0 - th * th
+            ft = np.where(rub, -limit * th, 0.0)
             f += ft[:, None] * tv
-            K -= (sticking * self.kt * proj.m)[:, None, None] * outer(tv, tv)
-            K += (sliding * self.mu * self.kn * sgn)[:, None, None] * outer(tv, nv)
+            K -= (rub * self.kt * sech2 * proj.m)[:, None, None] * outer(tv, tv)  # dft/ds
+            K -= (rub * self.mu * (th - z * sech2) * dfn)[:, None, None] * outer(tv, nv)  # dft/dfn
             K -= (ft * proj.kappa)[:, None, None] * outer(nv, tv)  # ft dt/dx
+            sliding = rub & (np.abs(z) > 1.0)
             status[sliding] = 2
-            self._slip_state = (contact, s0, sliding, limit, sgn)
+            self._slip_state = (contact, s0, z, limit)
         if self.sticky:
             tied = self.stuck
             f[tied] -= self.kn[tied, None] * (x[tied] - self.stuck_point[tied])
@@ -123,8 +139,11 @@ class ContactPair:
         x, proj, f, status = self.last
         self.x_prev = x.copy()
         if self.mu > 0 and not self.sticky:
-            contact, s0, sliding, limit, sgn = self._slip_state
-            s_new = np.where(sliding, proj.s - sgn * limit / np.maximum(self.kt, 1e-300), s0)
+            # slip beyond z = 3 (tanh = 0.995) is plastic: the stick point follows the node, so
+            # that a reversal of the slip finds the force at once
+            contact, s0, z, limit = self._slip_state
+            zc = np.clip(z, -3.0, 3.0)
+            s_new = np.where(z != zc, proj.s - zc * limit / np.maximum(self.kt, 1e-300), s0)
             self.s_stick = np.where(contact, s_new, np.nan)
         if self.sticky:
             new = (status == 1)
@@ -148,6 +167,6 @@ class ContactPair:
             "force_r": float(f[:, 0].sum()),
             "force_z": float(f[:, 1].sum()),
             "contact_area": float(self.area[in_contact].sum()),
-            "penetration": float(max(0.0, -np.nanmin(np.where(in_contact & (status < 3), gap, np.nan)))
-                                 if (in_contact & (status < 3)).any() else 0.0),
+            "penetration": float(max(0.0, -np.nanmin(np.where(in_contact, gap, np.nan)))
+                                 if (in_contact & proj.active).any() else 0.0),
         }

@@ -95,57 +95,141 @@ class Circle(RigidSurface):
 
 @dataclass
 class Polyline(RigidSurface):
-    """Straight segments through `points` (k, 2); the body lies on the side of the normal
-    n = (-s, c) of each segment (eqs. 36-37): to the left when walking along the points."""
+    """A chain of straight and circular pieces through `points` (k, 2); the body lies on the
+    side of the normal n = (-s, c) of the direction of travel (eqs. 36-37): to the left when
+    walking along the points.  `centers` (k - 1 entries, None for a straight piece) makes a
+    piece a circular arc about that center, counter-clockwise where `ccw` says so.  Arcs are
+    exact, not faceted: a node sliding round a die radius sees a smooth surface."""
 
     points: np.ndarray = field(default_factory=lambda: np.zeros((2, 2)))
+    centers: list | None = None
+    ccw: list | None = None
 
     def __post_init__(self):
-        self.points = np.asarray(self.points, float)
-        if self.points.ndim != 2 or self.points.shape[1] != 2 or len(self.points) < 2:
+        P = np.asarray(self.points, float)
+        if P.ndim != 2 or P.shape[1] != 2 or len(P) < 2:
             raise ValueError("a polyline needs at least two points [r, z]")
-        a, b = self.points[:-1], self.points[1:]
-        L = np.linalg.norm(b - a, axis=1)
-        if (L <= 0).any():
-            raise ValueError(f"polyline segment {int(np.argmin(L))} has zero length")
-        self.a, self.b, self.L = a, b, L
-        self.tan = (b - a) / L[:, None]  # (c, s), eq. 36
-        self.nor = np.column_stack([-self.tan[:, 1], self.tan[:, 0]])  # (-s, c), eq. 37
-        self.s0 = np.concatenate([[0.0], np.cumsum(L)[:-1]])  # arc length at each segment start
+        self.points = P
+        m = len(P) - 1
+        centers = self.centers or [None] * m
+        ccw = self.ccw or [True] * m
+        if len(centers) != m or len(ccw) != m:
+            raise ValueError("one center (or None) and one ccw flag per piece")
+        self.a, self.b = P[:-1], P[1:]
+        self.is_arc = np.array([c is not None for c in centers])
+        self.c = np.array([c if c is not None else (np.nan, np.nan) for c in centers], float)
+        chord = np.linalg.norm(self.b - self.a, axis=1)
+        if (chord <= 0).any():
+            raise ValueError(f"polyline piece {int(np.argmin(chord))} has zero length")
+        self.R = np.where(self.is_arc, np.linalg.norm(self.a - np.nan_to_num(self.c), axis=1), np.nan)
+        self.phi0 = np.arctan2(self.a[:, 1] - self.c[:, 1], self.a[:, 0] - self.c[:, 0])
+        phi1 = np.arctan2(self.b[:, 1] - self.c[:, 1], self.b[:, 0] - self.c[:, 0])
+        self.dir = np.where(np.asarray(ccw, bool), 1.0, -1.0)  # +1 ccw, -1 cw
+        for k in np.flatnonzero(self.is_arc):
+            if abs(np.linalg.norm(self.b[k] - self.c[k]) - self.R[k]) > 1e-9 * max(self.R[k], 1.0):
+                raise ValueError(f"polyline piece {k}: the arc's ends are not on one circle")
+        self.sweep = np.where(self.is_arc, ((phi1 - self.phi0) * self.dir) % (2 * np.pi), 0.0)
+        self.L = np.where(self.is_arc, self.R * self.sweep, chord)
+        tan = (self.b - self.a) / chord[:, None]
+        self.tan_a, self.tan_b = tan.copy(), tan.copy()
+        for k in np.flatnonzero(self.is_arc):
+            for end, phi in (("tan_a", self.phi0[k]), ("tan_b", phi1[k])):
+                getattr(self, end)[k] = self.dir[k] * np.array([-np.sin(phi), np.cos(phi)])
+        self.s0 = np.concatenate([[0.0], np.cumsum(self.L)[:-1]])
+        # bounding boxes of the pieces for the global search
+        self.lo, self.hi = np.minimum(self.a, self.b), np.maximum(self.a, self.b)
+        for k in np.flatnonzero(self.is_arc):
+            pts = self._arc_points(k, 33)
+            self.lo[k], self.hi[k] = pts.min(axis=0), pts.max(axis=0)
+
+    @classmethod
+    def from_profile(cls, profile, motion=(0.0, 0.0)) -> "Polyline":
+        """The exact pieces of an axiform.profile.Profile (lines and arcs)."""
+        from ..profile import Arc
+
+        points = [profile.start] + [p.to for p in profile.pieces]
+        centers = [p.center if isinstance(p, Arc) else None for p in profile.pieces]
+        ccw = [p.ccw if isinstance(p, Arc) else True for p in profile.pieces]
+        return cls(motion=motion, points=np.array(points, float), centers=centers, ccw=ccw)
+
+    def _arc_points(self, k: int, n: int) -> np.ndarray:
+        phi = self.phi0[k] + self.dir[k] * np.linspace(0, self.sweep[k], n)
+        return self.c[k] + self.R[k] * np.column_stack([np.cos(phi), np.sin(phi)])
 
     def polyline(self) -> np.ndarray:
-        return self.points
+        """Points along the surface, arcs sampled finely (for pictures)."""
+        out = [self.a[:1]]
+        for k in range(len(self.a)):
+            out.append(self._arc_points(k, 25)[1:] if self.is_arc[k] else self.b[k:k + 1])
+        return np.vstack(out)
+
+    def _piece_local(self, k: np.ndarray, x: np.ndarray):
+        """For pairs (piece k, point x): xi (fraction along the piece, < 0 before its start,
+        > 1 beyond its end), gap g, normal n, tangent t, curvature kappa, m, point."""
+        arc = self.is_arc[k]
+        a, tan = self.a[k], self.tan_a[k]
+        nor = np.column_stack([-tan[:, 1], tan[:, 0]])
+        xi = np.einsum("ij,ij->i", x - a, tan) / self.L[k]
+        g = np.einsum("ij,ij->i", x - a, nor)
+        t, n = tan.copy(), nor
+        kappa = np.zeros(len(k))
+        m = np.ones(len(k))
+        if arc.any():
+            ka, xa = k[arc], x[arc]
+            d = xa - self.c[ka]
+            rho = np.maximum(np.linalg.norm(d, axis=1), 1e-300)
+            phi = np.arctan2(d[:, 1], d[:, 0])
+            sweep, sgn = self.sweep[ka], self.dir[ka]
+            alpha = ((phi - self.phi0[ka]) * sgn) % (2 * np.pi)
+            after = alpha - sweep
+            before = 2 * np.pi - alpha
+            xa_frac = np.where(alpha <= sweep, alpha / np.where(sweep > 0, sweep, 1.0),
+                               np.where(after < before, 1.0 + after / sweep, -before / sweep))
+            ta = sgn[:, None] * np.column_stack([-np.sin(phi), np.cos(phi)])
+            na = np.column_stack([-ta[:, 1], ta[:, 0]])
+            xi[arc] = xa_frac
+            g[arc] = np.einsum("ij,ij->i", d - self.R[ka, None] * d / rho[:, None], na)
+            t[arc], n[arc] = ta, na
+            kappa[arc] = -sgn / rho  # ccw: the body inside the arc
+            m[arc] = self.R[ka] / rho
+        xic = np.clip(xi, 0.0, 1.0)
+        point = np.where(arc[:, None], np.nan, a + (xic * self.L[k])[:, None] * tan)
+        if arc.any():
+            ka = k[arc]
+            phi = self.phi0[ka] + self.dir[ka] * xic[arc] * self.sweep[ka]
+            point[arc] = self.c[ka] + self.R[ka, None] * np.column_stack([np.cos(phi), np.sin(phi)])
+        return xi, g, n, t, kappa, m, point
 
     def local(self, x: np.ndarray, x_prev: np.ndarray, depth: float, method: str = "buckets") -> Projection:
-        """Candidates from the global search (segments widened by the depth and by how far
+        """Candidates from the global search (piece boxes widened by the depth and by how far
         the nodes moved since the last converged step), then for each node:
-        1. a segment its path crossed since the last converged step (front to back: paper
+        1. a piece its path crossed since the last converged step (front to back: paper
            Figure 6), the first one crossed along the path;
-        2. else the segments it projects onto (0 <= xi <= 1, eq. 38) with a gap above -depth:
+        2. else the pieces it projects onto (0 <= xi <= 1, eq. 38) with a gap above -depth:
            the one with the largest gap.  A node that entered a corner where the mould turns
-           away from the body faces two segments (Figure 8): it leaves by the nearer face;
+           away from the body faces two pieces (Figure 8): it leaves by the nearer face;
         3. else a corner where the mould turns towards the body (a cavity corner), the node
-           behind both segments and outside both projection ranges, facing none (Figure 8):
+           behind both pieces and outside both projection ranges, facing none (Figure 8):
            the vertex is its contact point, with the mean of the two normals."""
         nn = len(x)
         moved = float(np.linalg.norm(x - x_prev, axis=1).max()) if nn else 0.0
         widen = depth + moved
         finder = {"buckets": search.buckets, "binary": search.binary_sort, "brute": search.brute_force}[method]
-        pairs = finder(x, self.a, self.b, widen)
+        pairs = finder(x, self.lo, self.hi, widen)
         out = Projection.empty(nn)
         if len(pairs) == 0:
             return out
         i, k = pairs[:, 0], pairs[:, 1]
-        a, t, nrm, L = self.a[k], self.tan[k], self.nor[k], self.L[k]
-        xi = np.einsum("ij,ij->i", x[i] - a, t) / L  # eq. 38
-        g = np.einsum("ij,ij->i", x[i] - a, nrm)  # eq. 39
-        xi0 = np.einsum("ij,ij->i", x_prev[i] - a, t) / L
-        g0 = np.einsum("ij,ij->i", x_prev[i] - a, nrm)
+        xi, g, n, t, kappa, m, point = self._piece_local(k, x[i])
+        xi0, g0, *_ = self._piece_local(k, x_prev[i])
         tol = 1e-9
         with np.errstate(divide="ignore", invalid="ignore"):
             tau = np.where(g0 - g > 0, g0 / (g0 - g), np.inf)  # where along the path it crosses
-            xic = np.where(np.isfinite(tau), xi0 + tau * (xi - xi0), np.nan)
-        crossed = (g0 >= 0) & (g < 0) & (xic >= -tol) & (xic <= 1 + tol)
+        crossed = (g0 >= 0) & (g < 0) & np.isfinite(tau)
+        if crossed.any():
+            xc = x_prev[i[crossed]] + np.minimum(tau[crossed], 1.0)[:, None] * (x[i[crossed]] - x_prev[i[crossed]])
+            xic = self._piece_local(k[crossed], xc)[0]
+            crossed[crossed] = (xic >= -tol) & (xic <= 1 + tol)
         inrange = (xi >= -tol) & (xi <= 1 + tol) & (g > -depth)
         # rank the pairs of each node: crossings first (earliest), then in-range (largest gap)
         score = np.where(crossed, 2.0 + (1.0 - np.minimum(tau, 1.0)), np.where(inrange, 1.0, -np.inf))
@@ -156,15 +240,12 @@ class Polyline(RigidSurface):
         best = best[np.isfinite(score[best])]
         bi, bk = i[best], k[best]
         out.active[bi] = True
-        out.g[bi] = g[best]
-        out.n[bi] = self.nor[bk]
-        out.t[bi] = self.tan[bk]
-        xib = np.clip(xi[best], 0.0, 1.0)
-        out.s[bi] = self.s0[bk] + xib * self.L[bk]
-        out.point[bi] = self.a[bk] + (xib * self.L[bk])[:, None] * self.tan[bk]
+        out.g[bi], out.n[bi], out.t[bi] = g[best], n[best], t[best]
+        out.kappa[bi], out.m[bi], out.point[bi] = kappa[best], m[best], point[best]
+        out.s[bi] = self.s0[bk] + np.clip(xi[best], 0.0, 1.0) * self.L[bk]
         out.s_prev[bi] = self.s0[bk] + np.clip(xi0[best], 0.0, 1.0) * self.L[bk]
         out.kind[bi] = np.where(crossed[best], 3, 1)
-        # cavity corners: a node behind segment k beyond its end and behind k+1 before its start
+        # cavity corners: a node behind piece k beyond its end and behind k+1 before its start
         free = ~out.active
         if free.any() and len(self.a) > 1:
             beyond = (xi > 1 + tol) & (g < 0) & (g > -depth) & free[i]
@@ -173,11 +254,11 @@ class Polyline(RigidSurface):
             for node, seg in zip(i[before].tolist(), k[before].tolist()):
                 if seg >= 1 and (node, seg - 1) in key_end and not out.active[node]:
                     prev = seg - 1
-                    turn = self.tan[prev, 0] * self.tan[seg, 1] - self.tan[prev, 1] * self.tan[seg, 0]
-                    if turn <= 0:  # the mould turns away from the body: no such dead zone
+                    t1, t2 = self.tan_b[prev], self.tan_a[seg]
+                    if t1[0] * t2[1] - t1[1] * t2[0] <= 0:  # the mould turns away from the body
                         continue
                     v = self.b[prev]
-                    nv = self.nor[prev] + self.nor[seg]
+                    nv = np.array([-t1[1], t1[0]]) + np.array([-t2[1], t2[0]])
                     nv /= np.linalg.norm(nv)
                     out.active[node] = True
                     out.n[node] = nv
