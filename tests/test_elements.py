@@ -140,3 +140,19 @@ def test_inverted_state_is_refused():
     u = full_vector(model, np.column_stack([np.zeros(mesh.n_nodes), -2.0 * mesh.points[:, 1]]))
     with pytest.raises(InvertedElementError):
         model.solid.evaluate(u)
+
+
+def test_sfr_zero_mode_removed_on_every_body():
+    """Two separate SFR bodies: each has its own uniform-theta mode; the model fixes one theta
+    on each, and the supported tangent is regular."""
+    from axiform.mesh import Mesh
+    a = rectangle((0.0, 1.0), (0.0, 1.0), (2, 2), "sfr")
+    b = rectangle((2.0, 3.0), (0.0, 1.0), (2, 2), "sfr")
+    mesh = Mesh(np.vstack([a.points, b.points]), np.vstack([a.cells, b.cells + a.n_nodes]), a.element)
+    model = Model(mesh, LAW)
+    model.fix(select_nodes(mesh, {"z": 0.0}), ["ur", "uz"])
+    model.finalize()
+    assert len(model.dofmap.prescribed_ref) == 2 * 6 + 2  # ur, uz on 6 base nodes, one theta per body
+    K = model.evaluate(np.zeros(model.n_free), 0.0).K.toarray()
+    s = np.linalg.svd(K, compute_uv=False)
+    assert s[-1] > 1e-10 * s[0]

@@ -11,6 +11,7 @@ from typing import Iterable, Sequence
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
 from .assembly import SolidAssembly
 from .constraints import DofMap, SparsePattern
@@ -123,8 +124,17 @@ class Model:
                     fixed.setdefault(int(b), 0.0)
                 else:
                     ties.append(np.array([a, b]))
-        if not any(d % 3 == 2 for d in fixed):
-            fixed[int(self.dof(self.mesh.corner_nodes[0], "rot"))] = 0.0
+        # one theta per connected body, unless some theta of that body is already held
+        cells = self.mesh.cells
+        rows = np.repeat(cells[:, 0], cells.shape[1])
+        graph = sp.coo_matrix((np.ones(rows.size), (rows, cells.ravel())),
+                              shape=(self.mesh.n_nodes, self.mesh.n_nodes))
+        _, body = connected_components(graph, directed=False)
+        held = {body[d // self.dpn] for d in fixed if d % self.dpn == 2}
+        for b in np.unique(body[cells[:, 0]]):
+            if b not in held:
+                node = int(cells[body[cells[:, 0]] == b][0, 0])
+                fixed[int(self.dof(node, "rot"))] = 0.0
         return ties
 
     def finalize(self) -> "Model":
