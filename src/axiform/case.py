@@ -361,7 +361,8 @@ def parse(data: dict[str, Any]) -> Case:
 
 
 def override(data: dict[str, Any], assignment: str) -> None:
-    """Apply KEY=VALUE (dotted key, VALUE in TOML syntax; a bare word is taken as a string)."""
+    """Apply KEY=VALUE: KEY dotted, with [i] for an entry of an array of tables
+    (contact[1].friction), VALUE in TOML syntax (a bare word is taken as a string)."""
     key, sep, text = assignment.partition("=")
     if not sep or not key.strip():
         raise CaseError(f"--set {assignment!r}: expected KEY=VALUE")
@@ -369,12 +370,27 @@ def override(data: dict[str, Any], assignment: str) -> None:
         value = tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:
         value = text
-    *parents, last = key.strip().split(".")
-    node = data
-    for p in parents:
-        node = node.setdefault(p, {})
-        if not isinstance(node, dict):
-            raise CaseError(f"--set {key}: '{p}' is not a table")
+    parts = []
+    for part in key.strip().split("."):
+        name, _, index = part.partition("[")
+        parts.append(name)
+        if index:
+            if not index.endswith("]") or not index[:-1].isdigit():
+                raise CaseError(f"--set {key}: bad index in '{part}'")
+            parts.append(int(index[:-1]))
+    node: Any = data
+    for p, nxt in zip(parts[:-1], parts[1:]):
+        if isinstance(p, int):
+            if not isinstance(node, list) or p >= len(node):
+                raise CaseError(f"--set {key}: there is no entry {p}")
+            node = node[p]
+        else:
+            if not isinstance(node, dict):
+                raise CaseError(f"--set {key}: '{p}' is not inside a table")
+            node = node.setdefault(p, [] if isinstance(nxt, int) else {})
+    last = parts[-1]
+    if isinstance(last, int) or not isinstance(node, dict):
+        raise CaseError(f"--set {key}: name a key, not an array entry")
     node[last] = value
 
 
