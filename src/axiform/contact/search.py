@@ -28,11 +28,18 @@ def _sorted_pairs(nodes: np.ndarray, segs: np.ndarray) -> np.ndarray:
 
 
 def brute_force(x: np.ndarray, a: np.ndarray, b: np.ndarray, widen: float) -> np.ndarray:
-    """Every (node, segment) pair tested: O(N M)."""
+    """Every (node, segment) pair tested: O(N M), in chunks of nodes to bound the memory."""
     lo, hi = _boxes(a, b, widen)
-    ok = ((x[:, None, :] >= lo[None]) & (x[:, None, :] <= hi[None])).all(axis=2)
-    n, s = np.nonzero(ok)
-    return _sorted_pairs(n, s)
+    found = []
+    step = max(1, 2**22 // max(len(a), 1))
+    for k in range(0, len(x), step):
+        p = x[k:k + step]
+        ok = ((p[:, None, 0] >= lo[None, :, 0]) & (p[:, None, 0] <= hi[None, :, 0])
+              & (p[:, None, 1] >= lo[None, :, 1]) & (p[:, None, 1] <= hi[None, :, 1]))
+        n, s = np.nonzero(ok)
+        found.append(np.column_stack([n + k, s]))
+    pairs = np.vstack(found) if found else np.zeros((0, 2), np.int64)
+    return _sorted_pairs(pairs[:, 0], pairs[:, 1])
 
 
 class Buckets:
@@ -88,6 +95,8 @@ class Buckets:
 
 def buckets(x: np.ndarray, a: np.ndarray, b: np.ndarray, widen: float, bs: float | None = None) -> np.ndarray:
     """Bucket search; the bucket width defaults to the mean segment box size plus 2 widen."""
+    if len(x) == 0 or len(a) == 0:
+        return np.zeros((0, 2), np.int64)
     if bs is None:
         bs = float(np.mean(np.abs(b - a).max(axis=1))) + 2 * widen
         bs = max(bs, 1e-12 * max(1.0, float(np.ptp(x, axis=0).max())))
