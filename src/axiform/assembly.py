@@ -19,7 +19,10 @@ def element_dofs(cells: np.ndarray, dofs_per_node: int) -> np.ndarray:
 
 
 class SolidAssembly:
-    """The solid's contribution: internal forces and material tangent of every element."""
+    """The solid's contribution: internal forces and material tangent of every element,
+    evaluated in chunks of elements so that the temporaries stay in cache."""
+
+    chunk = 2048
 
     def __init__(self, mesh: Mesh, material):
         self.mesh = mesh
@@ -27,30 +30,40 @@ class SolidAssembly:
         self.G, self.dV = gradient_operator(mesh.element, mesh.points[mesh.cells])
         self.dofs = element_dofs(mesh.cells, mesh.element.dofs_per_node)
         e, q, _, nd = self.G.shape
-        self._GdV_T = np.ascontiguousarray(
-            (self.G * self.dV[..., None, None]).transpose(0, 3, 1, 2).reshape(e, nd, q * 5))
+        self._G2 = self.G.reshape(e, q * 5, nd)  # g = G2 u_e, all points at once
+        # G dV stored (e, 5q, nd) and used transposed: matmul runs G^T (A G) faster on it
+        self._GdV = np.ascontiguousarray((self.G * self.dV[..., None, None]).reshape(e, q * 5, nd))
 
     def gradient(self, u_full: np.ndarray) -> np.ndarray:
         """Deformation gradient components x = F (e, q, 5) (eq. 6)."""
+        e, q, _, nd = self.G.shape
         ue = u_full[self.dofs]
-        return deformation_gradient(np.einsum("eqik,ek->eqi", self.G, ue))
+        return deformation_gradient(np.matmul(self._G2, ue[:, :, None]).reshape(e, q, 5))
 
-    def check_inverted(self, x: np.ndarray) -> None:
+    @staticmethod
+    def check_inverted(x: np.ndarray, offset: int = 0) -> None:
         J = x[..., 4] * (x[..., 0] * x[..., 3] - x[..., 1] * x[..., 2])
         bad = ~(J > 0).all(axis=1)
         if bad.any():
-            raise InvertedElementError(np.flatnonzero(bad))
+            raise InvertedElementError(np.flatnonzero(bad) + offset)
 
     def evaluate(self, u_full: np.ndarray, tangent: bool = True):
         """Element internal forces fe (e, nd) and, if asked, element tangents Ke (e, nd, nd)."""
-        x = self.gradient(u_full)
-        self.check_inverted(x)
         e, q, _, nd = self.G.shape
-        if not tangent:
-            P = self.material.stress(x)
-            return np.einsum("ekp,ep->ek", self._GdV_T, P.reshape(e, q * 5)), None
-        P, A = self.material.stress_tangent(x)
-        fe = np.einsum("ekp,ep->ek", self._GdV_T, P.reshape(e, q * 5))
-        AG = np.matmul(A, self.G).reshape(e, q * 5, nd)
-        Ke = np.matmul(self._GdV_T, AG)
+        fe = np.empty((e, nd))
+        Ke = np.empty((e, nd, nd)) if tangent else None
+        for start in range(0, e, self.chunk):
+            sl = slice(start, min(start + self.chunk, e))
+            m = sl.stop - sl.start
+            ue = u_full[self.dofs[sl]]
+            x = deformation_gradient(np.matmul(self._G2[sl], ue[:, :, None]).reshape(m, q, 5))
+            self.check_inverted(x, start)
+            GdV_T = self._GdV[sl].transpose(0, 2, 1)
+            if tangent:
+                P, A = self.material.stress_tangent(x)
+                AG = np.matmul(A, self.G[sl]).reshape(m, q * 5, nd)
+                np.matmul(GdV_T, AG, out=Ke[sl])
+            else:
+                P = self.material.stress(x)
+            np.matmul(GdV_T, P.reshape(m, q * 5, 1), out=fe[sl, :, None])
         return fe, Ke

@@ -65,8 +65,11 @@ class SparsePattern:
     def __init__(self, dofmap: DofMap, blocks: list[np.ndarray]):
         self.dofmap = dofmap
         n = dofmap.n_eq
-        keys = [self._keys(b) for b in blocks]
-        self.keys = np.unique(np.concatenate([k.ravel() for k in keys]))
+        keys = np.sort(np.concatenate([self._keys(b).ravel() for b in blocks]))
+        distinct = np.empty(keys.size, dtype=bool)  # np.unique, by one sort: several times faster
+        distinct[:1] = True
+        np.not_equal(keys[1:], keys[:-1], out=distinct[1:])
+        self.keys = keys[distinct]
         rows, cols = self.keys // n, self.keys % n
         self.indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=n))])
         self.indices = cols

@@ -14,10 +14,6 @@ from dataclasses import dataclass
 import numpy as np
 
 # x = (a, b, c, d, f) = (F_rR, F_rZ, F_zR, F_zZ, F_tT);  J = f (a d - b c)
-_IDENTITY5 = np.eye(5)
-_D2_J2 = np.zeros((5, 5))  # second derivative of j2 = a d - b c
-_D2_J2[0, 3] = _D2_J2[3, 0] = 1.0
-_D2_J2[1, 2] = _D2_J2[2, 1] = -1.0
 
 
 class InvertedElementError(ValueError):
@@ -38,8 +34,7 @@ def deformation_gradient(g: np.ndarray) -> np.ndarray:
 
 
 def invariants(x: np.ndarray):
-    """I1, I2, J and their gradients dI1, dI2, dJ with respect to x, plus the pieces reused
-    by the second derivatives."""
+    """I1, I2, J and their gradients dI1, dI2, dJ with respect to x."""
     a, b, c, d, f = (x[..., i] for i in range(5))
     j2 = a * d - b * c  # det of the meridian 2x2 block
     s = a * a + b * b + c * c + d * d
@@ -54,7 +49,7 @@ def invariants(x: np.ndarray):
     dI2[..., 4] += 2.0 * f * s
     dJ = f[..., None] * dj2
     dJ[..., 4] = j2
-    return I1, I2, J, dI1, dI2, dJ, (j2, s, dj2, ds, f)
+    return I1, I2, J, dI1, dI2, dJ
 
 
 @dataclass(frozen=True)
@@ -90,48 +85,74 @@ class MooneyRivlin:
                 + 0.5 * self.kappa * (J - 1.0) ** 2)
 
     def _derivatives(self, I1, I2, J):
-        """First and second derivatives of W(I1, I2, J); W is linear in I1 and I2."""
-        C1, C2, k = self.C1, self.C2, self.kappa
+        """First derivatives of W(I1, I2, J)."""
         Jm13 = np.cbrt(1.0 / J)
-        Jm23 = Jm13 * Jm13
-        Jm43 = Jm23 * Jm23
-        W1 = C1 * Jm23
-        W2 = C2 * Jm43
-        iJ = 1.0 / J
-        WJ = -2.0 / 3.0 * W1 * I1 * iJ - 4.0 / 3.0 * W2 * I2 * iJ + k * (J - 1.0)
-        W1J = -2.0 / 3.0 * W1 * iJ
-        W2J = -4.0 / 3.0 * W2 * iJ
-        WJJ = (10.0 / 9.0 * W1 * I1 + 28.0 / 9.0 * W2 * I2) * iJ * iJ + k
-        return W1, W2, WJ, W1J, W2J, WJJ
+        W1 = self.C1 * Jm13 * Jm13
+        W2 = self.C2 * Jm13**4
+        WJ = (-2.0 / 3.0 * W1 * I1 - 4.0 / 3.0 * W2 * I2) / J + self.kappa * (J - 1.0)
+        return W1, W2, WJ
 
     def stress(self, x: np.ndarray) -> np.ndarray:
         """First Piola-Kirchhoff stress P = dW/dF, the 5 components of x."""
-        I1, I2, J, dI1, dI2, dJ, _ = invariants(x)
-        W1, W2, WJ, *_ = self._derivatives(I1, I2, J)
+        I1, I2, J, dI1, dI2, dJ = invariants(x)
+        W1, W2, WJ = self._derivatives(I1, I2, J)
         return W1[..., None] * dI1 + W2[..., None] * dI2 + WJ[..., None] * dJ
 
     def stress_tangent(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """P (..., 5) and A = dP/dF (..., 5, 5) in one pass."""
-        I1, I2, J, dI1, dI2, dJ, (j2, s, dj2, ds, f) = invariants(x)
-        W1, W2, WJ, W1J, W2J, WJJ = self._derivatives(I1, I2, J)
-        P = W1[..., None] * dI1 + W2[..., None] * dI2 + WJ[..., None] * dJ
-        ex = lambda v: v[..., None, None]  # noqa: E731  (broadcast a scalar field)
-        outer = lambda u, v: u[..., :, None] * v[..., None, :]  # noqa: E731
-        # d2I1 = 2 I;  d2I2 = 2 dj2 dj2 + 2 j2 d2j2 + f^2 d2s + 2 f (e_f ds + ds e_f) + 2 s e_f e_f
-        d2I2 = 2.0 * outer(dj2, dj2) + 2.0 * ex(j2) * _D2_J2
-        d2I2[..., [0, 1, 2, 3], [0, 1, 2, 3]] += 2.0 * (f * f)[..., None]
-        d2I2[..., 4, :] += 2.0 * f[..., None] * ds
-        d2I2[..., :, 4] += 2.0 * f[..., None] * ds
-        d2I2[..., 4, 4] += 2.0 * s
-        # d2J = f d2j2 + e_f dj2 + dj2 e_f
-        d2J = ex(f) * _D2_J2
-        d2J[..., 4, :] += dj2
-        d2J[..., :, 4] += dj2
-        A = (2.0 * ex(W1) * _IDENTITY5 + ex(W2) * d2I2 + ex(WJ) * d2J
-             + ex(W1J) * (outer(dI1, dJ) + outer(dJ, dI1))
-             + ex(W2J) * (outer(dI2, dJ) + outer(dJ, dI2))
-             + ex(WJJ) * outer(dJ, dJ))
-        return P, A
+        """P (..., 5) and A = dP/dF (..., 5, 5) in one pass.
+
+        A = 2 W1 I + W2 d2I2 + WJ d2J + W1J (dI1 dJ + dJ dI1) + W2J (dI2 dJ + dJ dI2)
+        + WJJ dJ dJ, written as v dJ^T + dJ v^T + 2 W2 dj2 dj2^T (v = W1J dI1 + W2J dI2
+        + WJJ/2 dJ) plus the sparse rest.  Computed on component rows (x as (5, n), A as
+        (5, 5, n)) so that every NumPy operation runs over n contiguous numbers: on (..., 5)
+        arrays most of the time went to loops of length 5 (benchmarks/assembly_throughput.py).
+        """
+        shape = x.shape[:-1]
+        xt = np.ascontiguousarray(x.reshape(-1, 5).T)  # (5, n)
+        a, b, c, d, f = xt
+        n = xt.shape[1]
+        C1, C2, k = self.C1, self.C2, self.kappa
+        j2 = a * d - b * c
+        s = a * a + b * b + c * c + d * d
+        ff = f * f
+        J = f * j2
+        I1 = s + ff
+        I2 = j2 * j2 + ff * s
+        iJ = 1.0 / J
+        Jm23 = np.cbrt(iJ)
+        Jm23 *= Jm23
+        W1 = C1 * Jm23
+        W2 = C2 * (Jm23 * Jm23)
+        W1I1, W2I2 = W1 * I1, W2 * I2
+        WJ = (-2.0 / 3.0 * W1I1 - 4.0 / 3.0 * W2I2) * iJ + k * (J - 1.0)
+        W1J = -2.0 / 3.0 * W1 * iJ
+        W2J = -4.0 / 3.0 * W2 * iJ
+        WJJ = (10.0 / 9.0 * W1I1 + 28.0 / 9.0 * W2I2) * (iJ * iJ) + k
+        dj2 = np.empty((5, n))
+        dj2[0], dj2[1], dj2[2], dj2[3], dj2[4] = d, -c, -b, a, 0.0
+        dJ = f * dj2
+        dJ[4] = j2
+        dI2 = (2.0 * j2) * dj2  # dI2 = 2 j2 dj2 + f^2 ds, ds = 2 (a, b, c, d, 0); dI2_4 = 2 f s
+        dI2[:4] += (2.0 * ff) * xt[:4]
+        dI2[4] = 2.0 * f * s
+        P = (2.0 * W1) * xt + W2 * dI2 + WJ * dJ  # dI1 = 2 x
+        v = (2.0 * W1J) * xt + W2J * dI2 + (0.5 * WJJ) * dJ
+        A = v[:, None] * dJ[None]  # (5, 5, n)
+        A += A.transpose(1, 0, 2).copy()
+        A += (2.0 * W2 * dj2)[:, None] * dj2[None]
+        diag = 2.0 * W1 + 2.0 * W2 * ff  # 2 W1 I + W2 f^2 d2s on the meridian block
+        for i in range(4):
+            A[i, i] += diag
+        A[4, 4] += 2.0 * W1 + 2.0 * W2 * s
+        cD = 2.0 * W2 * j2 + WJ * f  # times d2(ad - bc)
+        A[0, 3] += cD
+        A[3, 0] += cD
+        A[1, 2] -= cD
+        A[2, 1] -= cD
+        w = (4.0 * W2 * f) * xt[:4] + WJ * dj2[:4]  # e_f w^T + w e_f^T
+        A[4, :4] += w
+        A[:4, 4] += w
+        return P.T.reshape(*shape, 5), np.ascontiguousarray(A.reshape(25, n).T).reshape(*shape, 5, 5)
 
 
 def NeoHooke(C1: float, kappa: float) -> MooneyRivlin:

@@ -327,10 +327,20 @@ def _evaluate(model: Model, u_f, lam) -> Evaluation:
 
 
 def _factorize(K):
+    """K^-1 as a function; a singular tangent (at factorization or solve) fails the step."""
+    message = "singular tangent ({}): is the model supported against rigid motion?"
     try:
-        return factorize(K)
+        solve = factorize(K)
     except SingularTangentError as exc:
-        raise StepFailed(f"singular tangent ({exc}): is the model supported against rigid motion?") from exc
+        raise StepFailed(message.format(exc)) from exc
+
+    def checked(b):
+        try:
+            return solve(b)
+        except SingularTangentError as exc:
+            raise StepFailed(message.format(exc)) from exc
+
+    return checked
 
 
 def _newton_load(model, u_f, lam, opts, floor):
