@@ -224,3 +224,28 @@ def test_hertz_sphere_on_elastic_half_space():
     assert r[touching].max() < a < r[~touching].min()
     assert rep["pressure"].max() == pytest.approx(2 * Es * a / (np.pi * R), rel=0.02)
     assert rep["penetration"] < 1e-3 * d
+
+
+@pytest.mark.parametrize("element", ["q4", "sfr"])
+def test_no_node_ends_a_step_deeper_than_the_reported_penetration(element, tmp_path):
+    """The toric plate (paper 4.2): at every converged step, every slave node's exact signed
+    distance to the torus is above minus the penetration reported for that step."""
+    from axiform.case import build, load
+    from pathlib import Path
+    case = load(Path(__file__).resolve().parents[1] / "examples" / "toric_plate.toml",
+                [f"mesh.element={element}", "mesh.divisions=[20,2]", "solver.target=4.0", "solver.steps=16"])
+    built = build(case)
+    pair = built.model.contacts[0]
+    worst = []
+
+    def check(step):
+        x = pair.X + step.u.reshape(-1, built.model.dpn)[pair.nodes, :2]
+        dist = np.linalg.norm(x - np.array([4.5, 3.0]), axis=1) - 1.5
+        rep = pair.report()
+        assert dist.min() >= -rep["penetration"] * (1 + 1e-9) - 1e-12
+        worst.append((dist.min(), rep["penetration"]))
+
+    res = solve(built.model, built.control, built.options, on_step=check)
+    assert res.status == "finished"
+    assert max(p for _, p in worst) > 0  # it did touch
+    assert max(p for _, p in worst) < 0.02 * 0.5  # and the default penalty keeps it small
