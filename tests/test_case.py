@@ -251,6 +251,10 @@ def test_toric_plate_case_with_sticky_contact(tmp_path):
     pen = summary["contact"][0]["penetration"]
     assert 0 <= pen < 0.01 * 0.5  # the default penalty leaves < 1 % of the thickness
     assert float(rows[-1]["penetration"]) == pytest.approx(pen)
+    import meshio
+    last = meshio.read(sorted((out / "fields").glob("*.vtu"))[-1])
+    p = last.point_data["contact_pressure"]
+    assert p.max() > 0 and (p >= 0).all()
 
 
 CONTACT_BAD = [

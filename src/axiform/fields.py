@@ -1,5 +1,5 @@
 """Nodal fields for output: displacement, fibre rotation, J, Cauchy and von Mises stress,
-principal stretches.
+principal stretches, contact pressure.
 
 Quadrature-point values are averaged to the nodes (each element's mean, then the mean over
 the elements around a node): enough for pictures, not for error estimates.
@@ -44,4 +44,11 @@ def point_fields(model, u_full: np.ndarray) -> dict[str, np.ndarray]:
     }
     if dpn == 3:
         out["fibre_rotation"] = u[:, 2].copy()
+    if model.contacts:
+        pressure = np.zeros(mesh.n_nodes)
+        for pair in model.contacts:
+            if pair.last is not None:
+                rep = pair.report()
+                pressure[rep["node"]] += rep["pressure"]
+        out["contact_pressure"] = pressure
     return out
