@@ -25,3 +25,15 @@ def distorted_rectangle(r, z, divisions, element, amount=0.25, seed=0):
 @pytest.fixture(params=["q4", "q8", "sfr"])
 def element(request):
     return request.param
+
+
+def difference_tangent(model, u_f, lam, h):
+    """Central differences of the residual of a finalized model: dR/du (n, n) and dR/dlambda."""
+    n = model.n_free
+    num = np.empty((n, n))
+    for j in range(n):
+        e = np.zeros(n)
+        e[j] = h
+        num[:, j] = (model.evaluate(u_f + e, lam, tangent=False).r - model.evaluate(u_f - e, lam, tangent=False).r) / (2 * h)
+    dl = (model.evaluate(u_f, lam + h, tangent=False).r - model.evaluate(u_f, lam - h, tangent=False).r) / (2 * h)
+    return num, dl

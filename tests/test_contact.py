@@ -11,7 +11,7 @@ from axiform import LoadControl, Model, NeoHooke, rectangle, select_nodes, solve
 from axiform.contact import search
 from axiform.contact.pair import ContactPair
 from axiform.contact.surfaces import Circle, Polyline
-from conftest import distorted_rectangle
+from conftest import difference_tangent, distorted_rectangle
 
 coords = st.floats(-10, 10, allow_nan=False, allow_infinity=False)
 
@@ -118,14 +118,8 @@ def test_contact_tangent_matches_difference_of_residual(element, surface, law):
     elif "friction" in law:
         assert (status == 2).sum() >= 2, status  # (mostly) slip
     K = ev.K.toarray()
-    h = 1e-7
-    num = np.empty_like(K)
-    for j in range(model.n_free):
-        e = np.zeros(model.n_free)
-        e[j] = h
-        num[:, j] = (model.evaluate(u_f + e, lam, tangent=False).r - model.evaluate(u_f - e, lam, tangent=False).r) / (2 * h)
+    num, dl = difference_tangent(model, u_f, lam, 1e-7)
     assert np.abs(K - num).max() < 1e-6 * np.abs(K).max()
-    dl = (model.evaluate(u_f, lam + h, tangent=False).r - model.evaluate(u_f, lam - h, tangent=False).r) / (2 * h)
     assert np.allclose(ev.dr_dlam, dl, atol=1e-6 * np.abs(dl).max())
 
 
