@@ -9,7 +9,7 @@ import meshio
 import numpy as np
 import pytest
 
-from axiform import Model, MooneyRivlin, rectangle
+from axiform import rectangle
 from axiform.cli import main
 from axiform.mesh import layered
 from axiform.profile import Arc, Line, Profile

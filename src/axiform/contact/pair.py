@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..mesh import Mesh
-from .surfaces import Projection, RigidSurface
+from .surfaces import RigidSurface
 
 STATUS = {0: "open", 1: "stick", 2: "slip", 3: "sticky"}  # slip: |ft| > tanh(1) mu fn
 
