@@ -3,7 +3,8 @@
 MKL PARDISO through pypardiso where it is installed (x86-64), otherwise SciPy's SuperLU.
 benchmarks/newton_iteration.py measured both on these tangents (one core): PARDISO
 factorizes and solves 2 to 4 times faster than the best SuperLU ordering at 1e5 to 3e5 dofs
-(Q4 and SFR), and only with it does a Newton iteration at 1e5 dofs take under 1 s.
+(Q4 and SFR): a Newton iteration at 1e5 dofs takes 0.73 s (Q4) and 1.03 s (SFR) on one
+core with it, 0.55 and 0.75 s with two (benchmarks/README.md).
 
 SuperLU's column ordering: minimum degree on K^T K, which bounds the fill whatever rows
 partial pivoting picks.  Minimum degree on K^T + K (used before) assumes diagonal pivots:

@@ -105,7 +105,7 @@ class MooneyRivlin:
         + WJJ dJ dJ, written as v dJ^T + dJ v^T + 2 W2 dj2 dj2^T (v = W1J dI1 + W2J dI2
         + WJJ/2 dJ) plus the sparse rest.  Computed on component rows (x as (5, n), A as
         (5, 5, n)) so that every NumPy operation runs over n contiguous numbers: on (..., 5)
-        arrays most of the time went to loops of length 5 (benchmarks/assembly_throughput.py).
+        arrays most of the time went to loops of length 5 (7x slower; benchmarks/README.md).
         """
         shape = x.shape[:-1]
         xt = np.ascontiguousarray(x.reshape(-1, 5).T)  # (5, n)
