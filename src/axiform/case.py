@@ -150,8 +150,9 @@ class MaterialSpec(Strict):
     def build(self) -> MooneyRivlin:
         C2 = self.C2 or 0.0
         C1 = self.C1 if self.C1 is not None else self.E / (4.0 * (1.0 + self.nu))  # mu / 2
-        kappa = self.kappa if self.kappa is not None else self.E / (3.0 * (1.0 - 2.0 * self.nu))
-        return MooneyRivlin(C1, C2, kappa)
+        if self.kappa is None:
+            return MooneyRivlin.from_E_nu(C1, C2, self.E, self.nu)
+        return MooneyRivlin(C1, C2, self.kappa)
 
 
 class FixSpec(Strict):

@@ -78,10 +78,6 @@ class ElementKind:
     def dofs(self) -> int:
         return self.nodes * self.dofs_per_node
 
-    @property
-    def corner_nodes(self) -> int:
-        return 4
-
     def shape(self, xi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return q8_shape(xi) if self.nodes == 8 else q4_shape(xi)
 

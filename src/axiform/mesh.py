@@ -31,10 +31,8 @@ class Mesh:
         self.fibre_s: np.ndarray | None = None  # reference arc length of each station
         self.points = np.asarray(self.points, dtype=float)
         self.cells = np.asarray(self.cells, dtype=np.int64)
-        edges, owner, side = boundary_edges(self.cells, self.element)
-        self.boundary_edges = edges  # (m, edge_nodes) ordered as the owning cell runs (CCW)
-        self.boundary_owner = owner  # owning cell of each boundary edge
-        self.boundary_side = side  # local edge number 0..3 in the owning cell
+        # (m, edge_nodes), ordered as the owning cell runs (counter-clockwise)
+        self.boundary_edges = boundary_edges(self.cells, self.element)
 
     @property
     def n_nodes(self) -> int:
@@ -81,7 +79,7 @@ def boundary_edges(cells: np.ndarray, kind: ElementKind):
     _, inv, count = np.unique(ends, axis=0, return_inverse=True, return_counts=True)
     once = count[inv.ravel()] == 1
     idx = np.flatnonzero(once)
-    return all_edges.reshape(-1, local.shape[1])[idx], idx // 4, idx % 4
+    return all_edges.reshape(-1, local.shape[1])[idx]
 
 
 def _structured(grid: np.ndarray, kind: ElementKind):

@@ -36,7 +36,6 @@ class Evaluation:
     K: sp.csr_matrix | None
     r_full: np.ndarray
     f_ext_full: np.ndarray
-    f_int_full: np.ndarray
     force_scale: float
     noise: float = 0.0
 
@@ -215,4 +214,4 @@ class Model:
         if K is not None and K.nnz:
             row_sums = np.add.reduceat(np.abs(K.data), K.indptr[:-1][np.diff(K.indptr) > 0])
             noise = float(np.finfo(float).eps * row_sums.max() * np.linalg.norm(u))
-        return Evaluation(r_eq[: dm.nf], dr_dlam, K, r_full, f_ext, f_int, scale, noise)
+        return Evaluation(r_eq[: dm.nf], dr_dlam, K, r_full, f_ext, scale, noise)
