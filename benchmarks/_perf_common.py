@@ -47,7 +47,7 @@ def build_model(element: str, divisions: tuple[int, int], pressure: float = 5.0,
     whole face between two supported ends gives a symmetric assembled K_ff: pressed=1).
     finalize=False leaves `model.finalize()` to the caller (to time it)."""
     mesh = rectangle((1.0, 2.0), (0.0, 1.0), divisions, element)
-    model = Model(mesh, MATERIAL)
+    model = Model(mesh, MATERIAL, formulation="displacement")
     model.fix(mesh.node_sets["bottom"], ["uz"])
     if top_displacement is not None:
         model.prescribe(mesh.node_sets["top"], ["uz"], top_displacement)

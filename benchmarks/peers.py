@@ -100,7 +100,7 @@ def plate_model(element: str, nr: int, nz: int, kappa: float = KAPPA):
     """The plate in axiform's Python API: the finalized model and the driven dof (uz of the
     centre of the upper face)."""
     mesh = plate_mesh(element, nr, nz)
-    model = af.Model(mesh, af.MooneyRivlin(C1=C1, C2=C2, kappa=kappa))
+    model = af.Model(mesh, af.MooneyRivlin(C1=C1, C2=C2, kappa=kappa), formulation="displacement")
     model.fix(af.select_nodes(mesh, {"r": R}), ["ur", "uz", "rot"])
     model.fix(af.select_nodes(mesh, {"r": 0.0}), ["ur"])
     model.pressure(af.select_edges(mesh, {"z": 0.0}), 1.0)
@@ -444,7 +444,7 @@ def cax4_diagnostics(workdir: Path) -> dict:
         row = {"n": n}
         for element, etype in (("q4", "CAX4"), ("q8", "CAX8")):
             mesh = af.rectangle((a, b), (0.0, length), (n, 1), element)
-            model = af.Model(mesh, af.MooneyRivlin(C1, C2, kappa))
+            model = af.Model(mesh, af.MooneyRivlin(C1, C2, kappa), formulation="displacement")
             model.fix(af.select_nodes(mesh, {"z": 0.0}), ["uz"])
             model.fix(af.select_nodes(mesh, {"z": length}), ["uz"])
             model.pressure(af.select_edges(mesh, {"r": a}), p)

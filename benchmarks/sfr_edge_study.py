@@ -110,7 +110,7 @@ def edge_bow(mesh, u: np.ndarray, edges: np.ndarray) -> float:
 def plate(element: str, nt: int, nr: int, rule: str = "tie", rim_rot: bool = False) -> dict:
     """Solve the clamped plate on an nt x nr mesh; p, w and the centre thickness per step."""
     mesh = rectangle((0.0, RADIUS), (0.0, THICK), (nr, nt), element)
-    model = Model(mesh, MATERIAL, sfr_edges=rule)
+    model = Model(mesh, MATERIAL, formulation="displacement", sfr_edges=rule)
     rim = select_nodes(mesh, {"r": RADIUS})
     model.fix(rim, ["ur", "uz", "rot"] if rim_rot else ["ur", "uz"])
     model.fix(select_nodes(mesh, {"r": 0.0}), ["ur"])
@@ -140,7 +140,7 @@ def plate(element: str, nt: int, nr: int, rule: str = "tie", rim_rot: bool = Fal
 def small_deflection(element: str, nt: int, nr: int, kappa: float, w: float = 0.05) -> float:
     """Pressure of the plate at centre deflection w (one step), rule tie."""
     mesh = rectangle((0.0, RADIUS), (0.0, THICK), (nr, nt), element)
-    model = Model(mesh, MooneyRivlin(C1, C2, kappa))
+    model = Model(mesh, MooneyRivlin(C1, C2, kappa), formulation="displacement")
     model.fix(select_nodes(mesh, {"r": RADIUS}), ["ur", "uz"])
     model.fix(select_nodes(mesh, {"r": 0.0}), ["ur"])
     model.pressure(select_edges(mesh, {"z": 0.0}), 1.0)
@@ -154,7 +154,7 @@ def small_deflection(element: str, nt: int, nr: int, kappa: float, w: float = 0.
 # ------------------------------------------------------------------------- the cylinder
 def cylinder(element: str, nr: int, rule: str = "tie") -> dict:
     mesh = rectangle((A, B), (0.0, H), (nr, NZ), element)
-    model = Model(mesh, MATERIAL, sfr_edges=rule)
+    model = Model(mesh, MATERIAL, formulation="displacement", sfr_edges=rule)
     model.fix(select_nodes(mesh, {"z": 0.0}), ["uz"])
     model.fix(select_nodes(mesh, {"z": H}), ["uz"])
     model.pressure(select_edges(mesh, {"r": A}), 1.0)

@@ -37,3 +37,8 @@ def difference_tangent(model, u_f, lam, h):
         num[:, j] = (model.evaluate(u_f + e, lam, tangent=False).r - model.evaluate(u_f - e, lam, tangent=False).r) / (2 * h)
     dl = (model.evaluate(u_f, lam + h, tangent=False).r - model.evaluate(u_f, lam - h, tangent=False).r) / (2 * h)
     return num, dl
+
+
+@pytest.fixture(params=["mixed", "displacement"])
+def formulation(request):
+    return request.param

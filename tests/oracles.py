@@ -115,3 +115,47 @@ class RadialBVP:
     def pressures(self, a_values) -> np.ndarray:
         """p at each inner radius."""
         return np.array([self.solve(a)[0] for a in np.ravel(a_values)])
+
+
+class SphereBVP:
+    """Thick sphere R in [A, B] under internal follower pressure p, the compressible law
+    exactly as implemented, reduced to the 1D radial problem (solve_bvp).  Principal stretches
+    (1 + u', 1 + u/R, 1 + u/R) are put in x = (F_rR, F_rZ, F_zR, F_zZ, F_tT) as
+    (1 + u', 0, 0, 1 + u/R, 1 + u/R): the law is isotropic, so P_zZ = P_tT is the hoop stress.
+
+    Equilibrium in the reference configuration: dP_R/dR + 2 (P_R - P_H)/R = 0 with
+    dP_R/dR = A_RR u'' + (A_RZ + A_RT) d(u/R)/dR.  Boundary conditions: the follower pressure
+    on the bore, P_R(A) = -p (a/A)^2 (Cauchy -p on the current area), and P_R(B) = 0."""
+
+    def __init__(self, material, A: float, B: float, tol: float = 1e-9, nodes: int = 81):
+        self.material, self.A, self.B, self.tol, self.nodes = material, A, B, tol, nodes
+
+    def _x(self, R, u, du):
+        x = np.zeros(np.shape(R) + (5,))
+        x[..., 0] = 1.0 + du
+        x[..., 3] = 1.0 + u / R
+        x[..., 4] = 1.0 + u / R
+        return x
+
+    def _rhs(self, R, y):
+        u, du = y
+        P, Am = self.material.stress_tangent(self._x(R, u, du))
+        d2u = (-2.0 * (P[..., 0] - P[..., 4]) / R - (Am[..., 0, 3] + Am[..., 0, 4]) * (du - u / R) / R) / Am[..., 0, 0]
+        return np.vstack([du, d2u])
+
+    def bore_displacement(self, p: float, guess: float = 0.0) -> float:
+        """u(A) at internal pressure p."""
+        R = np.linspace(self.A, self.B, self.nodes)
+        y0 = np.vstack([guess * (self.A / R) ** 2, -2 * guess * self.A**2 / R**3])
+
+        def P_R(R, u, du):
+            return self.material.stress_tangent(self._x(np.asarray(R, float), np.asarray(u), np.asarray(du)))[0][..., 0]
+
+        def bc(ya, yb):
+            a = self.A + ya[0]
+            return np.array([P_R(self.A, ya[0], ya[1]) + p * (a / self.A) ** 2, P_R(self.B, yb[0], yb[1])])
+
+        sol = solve_bvp(self._rhs, bc, R, y0, tol=self.tol, max_nodes=200000)
+        if sol.status != 0:
+            raise RuntimeError(f"solve_bvp did not converge at p = {p}: {sol.message}")
+        return float(sol.y[0, 0])

@@ -25,9 +25,9 @@ def full_vector(model, uw):
 
 
 @pytest.mark.parametrize("distortion", [0.0, 0.3])
-def test_patch_residual_vanishes_inside(element, distortion):
+def test_patch_residual_vanishes_inside(element, formulation, distortion):
     mesh = distorted_rectangle((0.5, 2.0), (0.0, 1.0), (4, 4), element, distortion, seed=3)
-    model = Model(mesh, LAW).finalize()
+    model = Model(mesh, LAW, formulation=formulation).finalize()
     u = full_vector(model, homogeneous(mesh.points))
     fe, _ = model.solid.evaluate(u, tangent=False)
     f = np.bincount(model.solid.dofs.ravel(), weights=fe.ravel(), minlength=model.n_full).reshape(-1, model.dpn)
@@ -40,11 +40,11 @@ def test_patch_residual_vanishes_inside(element, distortion):
     assert np.allclose(x, [1.3, 0, 0, 0.8, 1.3], atol=1e-12)
 
 
-def test_patch_solved_with_boundary_prescribed(element):
+def test_patch_solved_with_boundary_prescribed(element, formulation):
     """Boundary displacements prescribed from the homogeneous field, interior solved by Newton:
     the interior nodes land exactly on the field (SFR: with zero fibre rotations)."""
     mesh = distorted_rectangle((0.5, 2.0), (0.0, 1.0), (4, 4), element, 0.3, seed=4)
-    model = Model(mesh, LAW)
+    model = Model(mesh, LAW, formulation=formulation)
     boundary = np.unique(mesh.boundary_edges)
     exact = homogeneous(mesh.points)
     for n in boundary:
@@ -59,26 +59,26 @@ def test_patch_solved_with_boundary_prescribed(element):
         assert np.abs(u[:, 2] - u[0, 2]).max() < 1e-10  # theta uniform: no displacement
 
 
-def test_rigid_axial_translation_is_force_free(element):
+def test_rigid_axial_translation_is_force_free(element, formulation):
     mesh = distorted_rectangle((0.0, 2.0), (0.0, 1.0), (3, 3), element, 0.2, seed=5)
-    model = Model(mesh, LAW).finalize()
+    model = Model(mesh, LAW, formulation=formulation).finalize()
     u = full_vector(model, np.column_stack([np.zeros(mesh.n_nodes), 0.7 * np.ones(mesh.n_nodes)]))
     fe, _ = model.solid.evaluate(u, tangent=False)
     assert np.abs(fe).max() < 1e-12
 
 
-def _pressure_model(element, seed):
+def _pressure_model(element, seed, formulation="mixed"):
     mesh = distorted_rectangle((0.3, 2.0), (0.0, 1.0), (3, 3), element, 0.25, seed=seed)
-    model = Model(mesh, LAW)
+    model = Model(mesh, LAW, formulation=formulation)
     model.fix(select_nodes(mesh, {"z": 0.0}), ["uz"])
     model.pressure(select_edges(mesh, {"r": 0.3}), 0.7)
     model.pressure(select_edges(mesh, {"z": 1.0}), -0.3)
     return model.finalize()
 
 
-def test_tangent_matches_difference_of_residual(element):
+def test_tangent_matches_difference_of_residual(element, formulation):
     """K = dR/du (material + follower pressure) against a central difference of R."""
-    model = _pressure_model(element, seed=6)
+    model = _pressure_model(element, seed=6, formulation=formulation)
     rng = np.random.default_rng(7)
     u_f = 0.02 * rng.standard_normal(model.n_free)
     lam = 1.3
@@ -102,12 +102,12 @@ def test_pressure_resultant_is_pressure_times_projected_area(element):
     assert fz == pytest.approx(-np.pi * (2.0 * 1.2) ** 2, rel=1e-12)
 
 
-def test_newton_converges_quadratically(element):
+def test_newton_converges_quadratically(element, formulation):
     """Large-strain inflation of the clamped plate, 1 in of centre deflection per step.  With
     e_k = r_k / r_1 the residual relative to the first iteration's, quadratic convergence means
     the number of digits doubles: log e_(k+1) / log e_k -> 2 (linear convergence gives -> 1)."""
     mesh = rectangle((0.0, 7.5), (0.0, 0.5), (20, 2), element)
-    model = Model(mesh, MooneyRivlin(80.0, 20.0, 1e4))
+    model = Model(mesh, MooneyRivlin(80.0, 20.0, 1e4), formulation=formulation)
     model.fix(select_nodes(mesh, {"r": 7.5}), ["ur", "uz", "rot"])
     model.fix(select_nodes(mesh, {"r": 0.0}), ["ur"])
     model.pressure(select_edges(mesh, {"z": 0.0}), 1.0)

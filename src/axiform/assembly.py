@@ -40,6 +40,10 @@ class SolidAssembly:
         ue = u_full[self.dofs]
         return deformation_gradient(np.matmul(self._G2, ue[:, :, None]).reshape(e, q, 5))
 
+    def stress(self, x: np.ndarray, sl: slice = slice(None)) -> np.ndarray:
+        """First Piola-Kirchhoff stress P (e, q, 5) at the gradients x of the elements sl."""
+        return self.material.stress(x)
+
     @staticmethod
     def check_inverted(x: np.ndarray, offset: int = 0) -> None:
         J = x[..., 4] * (x[..., 0] * x[..., 3] - x[..., 1] * x[..., 2])

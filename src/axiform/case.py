@@ -91,6 +91,7 @@ class MeshSpec(Strict):
     thickness: PositiveFloat | Annotated[list[tuple[float, PositiveFloat]], Field(min_length=2)] | None = None
     layers: Annotated[int, Field(ge=1)] | None = None
     sfr_edges: Literal["tie", "fix", "free"] = "tie"
+    formulation: Literal["mixed", "displacement"] = "mixed"
 
     @model_validator(mode="after")
     def _kind(self):
@@ -523,7 +524,8 @@ def build(case: Case, base: str | Path = ".") -> Built:
     base = Path(base)
     try:
         mesh = _mesh(case.mesh, base)
-        model = Model(mesh, case.material.build(), sfr_edges=case.mesh.sfr_edges)
+        model = Model(mesh, case.material.build(), formulation=case.mesh.formulation,
+                      sfr_edges=case.mesh.sfr_edges)
     except MeshError as exc:
         raise CaseError(f"mesh: {exc}") from None
     try:

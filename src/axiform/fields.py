@@ -1,5 +1,6 @@
 """Nodal fields for output: displacement, fibre rotation, J, Cauchy and von Mises stress,
-principal stretches, contact pressure.
+pressure (-tr sigma / 3, volume-averaged over each element), principal stretches, contact
+pressure.
 
 Quadrature-point values are averaged to the nodes (each element's mean, then the mean over
 the elements around a node): enough for pictures, not for error estimates.
@@ -18,10 +19,13 @@ def point_fields(model, u_full: np.ndarray) -> dict[str, np.ndarray]:
     u = u_full.reshape(-1, dpn)
     solid = model.solid
     x = solid.gradient(u_full)
-    P = model.material.stress(x)
+    P = solid.stress(x)  # the formulation's stress (mixed: with the element pressure)
     J = x[..., 4] * (x[..., 0] * x[..., 3] - x[..., 1] * x[..., 2])
     sig = cauchy_stress(x, P)  # (e, q, 4): rr, zz, tt, rz
     s_rr, s_zz, s_tt, s_rz = (sig[..., i] for i in range(4))
+    # pressure p = -tr(sigma)/3, positive in compression, averaged over the current volume
+    dv = J * solid.dV
+    pressure = -((s_rr + s_zz + s_tt) * dv).sum(1) / (3.0 * dv.sum(1))
     mises = np.sqrt(0.5 * ((s_rr - s_zz) ** 2 + (s_zz - s_tt) ** 2 + (s_tt - s_rr) ** 2) + 3 * s_rz**2)
     # principal stretches: eigenvalues of the meridian block of C = F^T F, and the hoop stretch
     a, b, c, d = x[..., 0], x[..., 1], x[..., 2], x[..., 3]
@@ -29,7 +33,7 @@ def point_fields(model, u_full: np.ndarray) -> dict[str, np.ndarray]:
     mean, dev = 0.5 * (C11 + C22), np.sqrt(0.25 * (C11 - C22) ** 2 + C12**2)
     l1, l2 = np.sqrt(mean + dev), np.sqrt(np.maximum(mean - dev, 0.0))
     stretches = np.stack([l1, l2, x[..., 4]], axis=-1)
-    cell_values = np.column_stack([J.mean(1), sig.mean(1), mises.mean(1), stretches.mean(1)])  # (e, 9)
+    cell_values = np.column_stack([J.mean(1), sig.mean(1), mises.mean(1), stretches.mean(1), pressure])  # (e, 10)
     count = np.bincount(mesh.cells.ravel(), minlength=mesh.n_nodes)
     nodal = np.zeros((mesh.n_nodes, cell_values.shape[1]))
     for k in range(mesh.cells.shape[1]):
@@ -41,6 +45,7 @@ def point_fields(model, u_full: np.ndarray) -> dict[str, np.ndarray]:
         "cauchy_stress": nodal[:, 1:5],  # rr, zz, tt, rz
         "von_mises": nodal[:, 5],
         "principal_stretches": nodal[:, 6:9],  # in-plane major, minor, hoop
+        "pressure": nodal[:, 9],
     }
     if dpn == 3:
         out["fibre_rotation"] = u[:, 2].copy()

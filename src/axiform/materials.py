@@ -9,7 +9,7 @@ and second derivatives; the chain rule through I1, I2 and J is shared.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -97,6 +97,10 @@ class MooneyRivlin:
         I1, I2, J, dI1, dI2, dJ = invariants(x)
         W1, W2, WJ = self._derivatives(I1, I2, J)
         return W1[..., None] * dI1 + W2[..., None] * dI2 + WJ[..., None] * dJ
+
+    def iso_stress_tangent(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """P_iso and A_iso of the isochoric part W_iso alone (kappa = 0), for mixed elements."""
+        return replace(self, kappa=0.0).stress_tangent(x)
 
     def stress_tangent(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """P (..., 5) and A = dP/dF (..., 5, 5) in one pass.

@@ -16,10 +16,14 @@ from scipy.sparse.csgraph import connected_components
 from .assembly import SolidAssembly
 from .constraints import DofMap, SparsePattern
 from .loads import FollowerPressure
+from .mixed import MixedAssembly
 from .mesh import Mesh
 
 DOF_NAMES = {"ur": 0, "uz": 1, "rot": 2}
 SFR_EDGE_RULES = ("tie", "fix", "free")
+FORMULATIONS = ("mixed", "displacement")
+# the pressure space of each mixed element (benchmarks/MIXED.md measures P0 against P1 for SFR)
+PRESSURE_SPACE = {"q4": "p0", "q8": "p1", "sfr": "p0"}
 
 
 @dataclass
@@ -44,6 +48,11 @@ class Evaluation:
 class Model:
     """Build a model step by step (fix, prescribe, pressure, point_load), then `finalize`.
 
+    formulation: "mixed" (default): the three-field u-p-J_bar element, pressure and dilatation
+    condensed on each element (axiform.mixed), free of volumetric locking; "displacement":
+    the plain displacement element of the paper, which locks as kappa/mu grows.
+    pressure_space: "p0" or "p1" for the mixed element (default: PRESSURE_SPACE).
+
     sfr_edges: what happens to the fibre rotations of an SFR edge whose normal displacement
     is held at both nodes (clamped edge, axis, symmetry plane): "tie" them to one shared value
     (default), "fix" them to zero, or leave them "free" (the edge then bows).
@@ -51,7 +60,9 @@ class Model:
 
     mesh: Mesh
     material: object
+    formulation: str = "mixed"
     sfr_edges: str = "tie"
+    pressure_space: str | None = None
     fixed: dict[int, float] = field(default_factory=dict)
     pressures: list[FollowerPressure] = field(default_factory=list)
     point_loads: list[tuple[int, float]] = field(default_factory=list)
@@ -60,6 +71,10 @@ class Model:
     def __post_init__(self):
         if self.sfr_edges not in SFR_EDGE_RULES:
             raise ValueError(f"sfr_edges must be one of {SFR_EDGE_RULES}, not {self.sfr_edges!r}")
+        if self.formulation not in FORMULATIONS:
+            raise ValueError(f"formulation must be one of {FORMULATIONS}, not {self.formulation!r}")
+        if self.pressure_space is None:
+            self.pressure_space = PRESSURE_SPACE[self.mesh.element.name]
         self.mesh.check()
         self.dpn = self.mesh.element.dofs_per_node
         self.n_full = self.mesh.n_nodes * self.dpn
@@ -141,7 +156,10 @@ class Model:
         fixed = dict(self.fixed)
         ties = self._sfr_constraints(fixed) if self.dpn == 3 else []
         self.dofmap = DofMap(self.n_full, fixed, ties)
-        self.solid = SolidAssembly(self.mesh, self.material)
+        if self.formulation == "mixed":
+            self.solid = MixedAssembly(self.mesh, self.material, self.pressure_space)
+        else:
+            self.solid = SolidAssembly(self.mesh, self.material)
         self.pattern = SparsePattern(self.dofmap, [self.solid.dofs] + [p.dofs for p in self.pressures])
         self._solid_pos = self.pattern.positions(self.solid.dofs)
         self._pressure_pos = [self.pattern.positions(p.dofs) for p in self.pressures]

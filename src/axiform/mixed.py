@@ -1,0 +1,135 @@
+"""Mixed (u-p-J_bar) elements: the three-field variation of Simo, Taylor and Pister with the
+pressure and the dilatation condensed on each element.
+
+The strain energy is split W = W_iso(F_bar) + U(J), U(J) = kappa/2 (J - 1)^2 (eqs. 11-12).
+In the mixed element the volumetric part is evaluated with an element-wise dilatation
+J_bar instead of J:
+
+    Pi(u) = int W_iso(F) dV + int U(J_bar) dV,     J_bar = the L2 projection of J = det F
+                                                  on the element's pressure space.
+
+With the pressure space spanned by N_p (np functions per element, constant included),
+M = int N_p N_p^T dV and h = int N_p J dV give J_bar = N_p . M^-1 h, and the pressure
+p = U'(J_bar) = kappa (J_bar - 1) (the condensed Lagrange multiplier, positive in tension).
+Then (dJ = dJ/dF, H_J = d2J/dF2, B = int N_p dJ^T G dV  of shape (np, nd)):
+
+    f_e = sum_q G^T (P_iso + p dJ) dV
+    K_e = sum_q G^T (A_iso + p H_J) G dV + kappa B^T M^-1 B
+
+which is the exact derivative of f_e (quadratic Newton), symmetric, and of the size and
+pattern of the displacement element: nothing is added to the global system.
+
+Pressure spaces: P0 (np = 1: the mean dilatation of Q4) and discontinuous P1 = (1, R, Z)
+(np = 3) in the reference coordinates of the element, centred and scaled by its size.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .assembly import SolidAssembly
+from .materials import deformation_gradient
+
+PRESSURE_SPACES = ("p0", "p1")
+
+
+def pressure_basis(space: str, Xq: np.ndarray, dV: np.ndarray) -> np.ndarray:
+    """N_p at the quadrature points (e, q, np) of the reference points Xq (e, q, 2)."""
+    e, q = dV.shape
+    if space == "p0":
+        return np.ones((e, q, 1))
+    if space != "p1":
+        raise ValueError(f"pressure space must be one of {PRESSURE_SPACES}, not {space!r}")
+    V = dV.sum(axis=1)
+    centre = np.einsum("eq,eqd->ed", dV, Xq) / V[:, None]
+    size = np.sqrt(np.ptp(Xq[..., 0], axis=1) ** 2 + np.ptp(Xq[..., 1], axis=1) ** 2)
+    d = (Xq - centre[:, None, :]) / size[:, None, None]
+    return np.concatenate([np.ones((e, q, 1)), d], axis=2)
+
+
+def volumetric_derivatives(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """J = det F and dJ = dJ/dF (..., 5) for x = (F_rR, F_rZ, F_zR, F_zZ, F_tT)."""
+    a, b, c, d, f = (x[..., i] for i in range(5))
+    j2 = a * d - b * c
+    dJ = np.stack([f * d, -f * c, -f * b, f * a, j2], axis=-1)
+    return f * j2, dJ
+
+
+def add_pressure_hessian(A: np.ndarray, x: np.ndarray, p: np.ndarray) -> None:
+    """A += p d2J/dF2 in place (..., 5, 5): J = f (a d - b c) is quadratic in each pair."""
+    a, b, c, d, f = (x[..., i] for i in range(5))
+    pf = p * f
+    A[..., 0, 3] += pf
+    A[..., 3, 0] += pf
+    A[..., 1, 2] -= pf
+    A[..., 2, 1] -= pf
+    for i, v in ((0, d), (1, -c), (2, -b), (3, a)):
+        pv = p * v
+        A[..., 4, i] += pv
+        A[..., i, 4] += pv
+
+
+class MixedAssembly(SolidAssembly):
+    """Internal forces and tangents of the mixed elements (module docstring), same interface
+    and dof layout as SolidAssembly.  The law must give the isochoric part alone:
+    `material.iso_stress_tangent(x)` -> (P_iso, A_iso), and its bulk modulus `kappa`."""
+
+    chunk = 1024
+
+    def __init__(self, mesh, material, pressure_space: str):
+        super().__init__(mesh, material)
+        from .elements import gauss_quad, jacobian
+
+        self.pressure_space = pressure_space
+        xi, _ = gauss_quad(mesh.element.gauss)
+        Xq = jacobian(mesh.element, mesh.points[mesh.cells], xi)[3]
+        self.Np = pressure_basis(pressure_space, Xq, self.dV)  # (e, q, np)
+        NpdV = self.Np * self.dV[..., None]
+        M = np.einsum("eqi,eqj->eij", NpdV, self.Np)
+        self.Minv = np.linalg.inv(M)  # (e, np, np)
+        self.NpdV = NpdV
+
+    def pressure(self, u_full: np.ndarray) -> np.ndarray:
+        """The element pressures p = kappa (J_bar - 1) at the quadrature points (e, q)."""
+        x = self.gradient(u_full)
+        return self._pressure(x, slice(None))[0]
+
+    def _pressure(self, x: np.ndarray, sl: slice):
+        J, dJ = volumetric_derivatives(x)
+        h = np.einsum("eqi,eq->ei", self.NpdV[sl], J)
+        Jhat = np.einsum("eij,ej->ei", self.Minv[sl], h)
+        Jbar = np.einsum("eqi,ei->eq", self.Np[sl], Jhat)
+        return self.material.kappa * (Jbar - 1.0), dJ
+
+    def stress(self, x: np.ndarray, sl: slice = slice(None)) -> np.ndarray:
+        """P = P_iso + p dJ/dF (e, q, 5) with the element pressure p."""
+        p, dJ = self._pressure(x, sl)
+        P_iso, _ = self.material.iso_stress_tangent(x)
+        return P_iso + p[..., None] * dJ
+
+    def evaluate(self, u_full: np.ndarray, tangent: bool = True):
+        """Element internal forces fe (e, nd) and, if asked, element tangents Ke (e, nd, nd)."""
+        e, q, _, nd = self.G.shape
+        fe = np.empty((e, nd))
+        Ke = np.empty((e, nd, nd)) if tangent else None
+        kappa = self.material.kappa
+        for start in range(0, e, self.chunk):
+            sl = slice(start, min(start + self.chunk, e))
+            m = sl.stop - sl.start
+            ue = u_full[self.dofs[sl]]
+            x = deformation_gradient(np.matmul(self._G2[sl], ue[:, :, None]).reshape(m, q, 5))
+            self.check_inverted(x, start)
+            p, dJ = self._pressure(x, sl)
+            P, A = self.material.iso_stress_tangent(x)
+            P += p[..., None] * dJ
+            GdV_T = self._GdV[sl].transpose(0, 2, 1)
+            np.matmul(GdV_T, P.reshape(m, q * 5, 1), out=fe[sl, :, None])
+            if tangent:
+                add_pressure_hessian(A, x, p)
+                AG = np.matmul(A, self.G[sl]).reshape(m, q * 5, nd)
+                np.matmul(GdV_T, AG, out=Ke[sl])
+                # B = int N_p dJ^T G dV (m, np, nd); K += kappa B^T M^-1 B
+                dJG = np.matmul(dJ[:, :, None, :], self.G[sl])[:, :, 0, :]  # (m, q, nd)
+                B = np.einsum("eqi,eqn->ein", self.NpdV[sl], dJG)
+                Ke[sl] += kappa * np.matmul(B.transpose(0, 2, 1), np.matmul(self.Minv[sl], B))
+        return fe, Ke
