@@ -179,7 +179,7 @@ def measure_case(element: str, n_elements: int, min_time: float, unique_limit: i
     keys = np.concatenate([model.pattern._keys(b).ravel()
                            for b in [model.solid.dofs] + [p.dofs for p in model.pressures]])
     if keys.size <= unique_limit:  # NumPy 2.4's np.unique: seconds at 1e5 elements
-        uniq, build["unique"] = timed_once(lambda: np.unique(keys))
+        uniq, build["unique"] = timed_once(lambda: np.unique(keys))  # noqa: F821 (bound before the del below)
         assert np.array_equal(uniq, model.pattern.keys)
         del uniq
     del keys

@@ -197,7 +197,7 @@ def run(element: str, dof_targets: list[int], names: list[str], repeat: int, bud
                     continue
                 try:
                     (solve, fill), tf = timed(lambda: available[name](K))
-                    X, ts = timed(lambda: solve(B))
+                    X, ts = timed(lambda: solve(B))  # noqa: F821
                 except Exception as exc:  # noqa: BLE001  (a solver that fails is reported)
                     r["error"] = f"{type(exc).__name__}: {exc}"[:80]
                     log(f"  {name}: failed: {r['error']}")
