@@ -13,7 +13,9 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from .cavity import CavityError
 from .contact.pair import ContactPair
+from .curves import PROPORTIONAL, Curve
 from .contact.surfaces import Circle, Polyline
 from .materials import MooneyRivlin
 from .mesh import Mesh, MeshError, layered, read_gmsh, rectangle
@@ -24,6 +26,8 @@ from .solver import ArcLengthControl, DisplacementControl, LoadControl, NewtonOp
 
 DofName = Literal["ur", "uz", "rot"]
 PositiveFloat = Annotated[float, Field(gt=0)]
+# a load curve [[t0, f0], [t1, f1], ...]: t increasing, the applied value is value x f(t)
+CurveKnots = Annotated[list[tuple[float, float]], Field(min_length=1)]
 
 
 class CaseError(ValueError):
@@ -156,21 +160,63 @@ class MaterialSpec(Strict):
         return MooneyRivlin(C1, C2, self.kappa)
 
 
-class FixSpec(Strict):
+class CurveMixin(Strict):
+    curve: CurveKnots | None = None
+
+    @model_validator(mode="after")
+    def _curve(self):
+        if self.curve is not None:
+            t = [k[0] for k in self.curve]
+            if any(b <= a for a, b in zip(t, t[1:])):
+                raise ValueError("curve: the times must increase")
+        return self
+
+    def build_curve(self) -> Curve:
+        return PROPORTIONAL if self.curve is None else Curve(self.curve)
+
+
+class FixSpec(CurveMixin):
     at: Selector
     dofs: Annotated[list[DofName], Field(min_length=1)]
     value: float = 0.0
 
 
-class PressureSpec(Strict):
+class PressureSpec(CurveMixin):
     on: Selector
     value: float
 
 
-class PointLoadSpec(Strict):
+class PointLoadSpec(CurveMixin):
     at: Selector
     dof: Literal["ur", "uz"]
     value: float
+
+
+class CavitySpec(CurveMixin):
+    """A gas cavity (DESIGN 10.5): the wall edges that bound the gas, and its control."""
+
+    name: Annotated[str, Field(min_length=1)]
+    boundary: Selector
+    control: Literal["pressure", "volume", "gas"] = "pressure"
+    pressure: float | None = None
+    volume: PositiveFloat | None = None
+    content: PositiveFloat | None = None
+    ambient: PositiveFloat | None = None
+
+    @model_validator(mode="after")
+    def _control(self):
+        need = {"pressure": ("pressure",), "volume": ("volume",), "gas": ("content", "ambient")}[self.control]
+        for key in need:
+            if getattr(self, key) is None:
+                raise ValueError(f"control = \"{self.control}\" needs '{key}'")
+        for key in ("pressure", "volume", "content", "ambient"):
+            if key not in need and getattr(self, key) is not None:
+                raise ValueError(f"'{key}' does not belong to control = \"{self.control}\"")
+        return self
+
+    @property
+    def value(self) -> float:
+        return {"pressure": self.pressure, "volume": self.volume, "gas": self.content}[self.control]
 
 
 class MonitorSpec(Strict):
@@ -182,13 +228,22 @@ class MonitorSpec(Strict):
     reaction: Selector | None = None
     dof: DofName | None = None
     contact: Annotated[int, Field(ge=0)] | None = None
-    quantity: Literal["force-r", "force-z", "area", "penetration"] | None = None
+    cavity: str | None = None
+    quantity: Literal["force-r", "force-z", "area", "penetration", "pressure", "volume"] | None = None
 
     @model_validator(mode="after")
     def _one(self):
-        given = [k for k in ("at", "reaction", "contact") if getattr(self, k) is not None]
+        given = [k for k in ("at", "reaction", "contact", "cavity") if getattr(self, k) is not None]
         if len(given) != 1:
-            raise ValueError("a monitor needs exactly one of 'at', 'reaction' or 'contact'")
+            raise ValueError("a monitor needs exactly one of 'at', 'reaction', 'contact' or 'cavity'")
+        if self.cavity is not None:
+            if self.quantity not in ("pressure", "volume"):
+                raise ValueError("a cavity monitor needs quantity = \"pressure\" or \"volume\"")
+            if self.dof is not None:
+                raise ValueError("'dof' does not belong to a cavity monitor")
+            return self
+        if self.quantity in ("pressure", "volume"):
+            raise ValueError(f"quantity = \"{self.quantity}\" belongs to a cavity monitor")
         if self.contact is None:
             if self.dof is None:
                 raise ValueError(f"a monitor with '{given[0]}' needs 'dof'")
@@ -252,7 +307,9 @@ class SurfaceSpec(Strict):
         return self
 
 
-class MotionSpec(Strict):
+class MotionSpec(CurveMixin):
+    """A rigid translation of the mould, applied as (ur, uz) x f(t)."""
+
     ur: float = 0.0
     uz: float = 0.0
 
@@ -332,6 +389,7 @@ class Case(Strict):
     point_load: list[PointLoadSpec] = []
     monitor: list[MonitorSpec] = []
     contact: list[ContactSpec] = []
+    cavity: list[CavitySpec] = []
     solver: SolverSpec = SolverSpec()
     output: OutputSpec = OutputSpec()
 
@@ -416,16 +474,19 @@ _CONTACT_QUANTITY = {"force-r": "force_r", "force-z": "force_z", "area": "contac
 
 @dataclass
 class Monitor:
-    """A named scalar read off each converged step: one dof, a sum of reactions, or a
-    contact pair's total force, contact area or penetration."""
+    """A named scalar read off each converged step: one dof, a sum of reactions, a contact
+    pair's total force, contact area or penetration, or a cavity's pressure or volume."""
 
     name: str
     dofs: np.ndarray | None = None
     reaction: bool = False
     pair: object = None
     quantity: str = ""
+    cavity: object = None
 
     def value(self, step) -> float:
+        if self.cavity is not None:
+            return float(self.cavity.pressure_now if self.quantity == "pressure" else self.cavity.volume_now)
         if self.pair is not None:
             return float(self.pair.report()[_CONTACT_QUANTITY[self.quantity]])
         if self.reaction:
@@ -503,6 +564,7 @@ def _surface(spec: SurfaceSpec, motion: tuple[float, float], base: Path, where: 
 
 def _contact(mesh: Mesh, model: Model, spec: ContactSpec, base: Path, where: str) -> ContactPair:
     surface = _surface(spec.surface, (spec.motion.ur, spec.motion.uz), base, where)
+    surface.curve = spec.motion.build_curve()
     slaves = select_nodes(mesh, spec.slaves.model_dump(), f"{where}.slaves")
     penalty = spec.penalty if spec.penalty is not None else default_penalty(model.material, mesh)
     try:
@@ -530,16 +592,31 @@ def build(case: Case, base: str | Path = ".") -> Built:
         raise CaseError(f"mesh: {exc}") from None
     try:
         for i, f in enumerate(case.fix):
-            model.prescribe(select_nodes(mesh, f.at.model_dump(), f"fix[{i}].at"), f.dofs, f.value)
+            model.prescribe(select_nodes(mesh, f.at.model_dump(), f"fix[{i}].at"), f.dofs, f.value, f.build_curve())
         for i, p in enumerate(case.pressure):
-            model.pressure(select_edges(mesh, p.on.model_dump(), f"pressure[{i}].on"), p.value)
+            model.pressure(select_edges(mesh, p.on.model_dump(), f"pressure[{i}].on"), p.value, p.build_curve())
         for i, pl in enumerate(case.point_load):
-            model.point_load(select_nodes(mesh, pl.at.model_dump(), f"point_load[{i}].at"), pl.dof, pl.value)
+            model.point_load(select_nodes(mesh, pl.at.model_dump(), f"point_load[{i}].at"), pl.dof, pl.value,
+                             pl.build_curve())
+        cavities = {}
+        for i, c in enumerate(case.cavity):
+            if c.name in cavities:
+                raise CaseError(f"cavity[{i}].name: '{c.name}' is used twice")
+            edges = select_edges(mesh, c.boundary.model_dump(), f"cavity[{i}].boundary")
+            try:
+                cavities[c.name] = model.cavity(edges, c.name, c.control, c.value, c.ambient or 0.0, c.build_curve())
+            except CavityError as exc:
+                raise CaseError(f"cavity[{i}].boundary: {exc}") from None
         pairs = [_contact(mesh, model, c, base, f"contact[{i}]") for i, c in enumerate(case.contact)]
         for pair in pairs:
             model.contact(pair)
         monitors = []
         for i, m in enumerate(case.monitor):
+            if m.cavity is not None:
+                if m.cavity not in cavities:
+                    raise CaseError(f"monitor[{i}].cavity: no [[cavity]] is named '{m.cavity}'")
+                monitors.append(Monitor(m.name, cavity=cavities[m.cavity], quantity=m.quantity))
+                continue
             if m.contact is not None:
                 if m.contact >= len(pairs):
                     raise CaseError(f"monitor[{i}].contact: there are {len(pairs)} [[contact]] tables (from 0)")
@@ -575,9 +652,11 @@ def build(case: Case, base: str | Path = ".") -> Built:
         else:
             control = LoadControl(1.0 if s.target is None else s.target, s.steps)
         moving = any(c.motion.ur or c.motion.uz for c in case.contact)
-        if not case.pressure and not case.point_load and not any(f.value for f in case.fix) and not moving:
+        gas = any(c.control != "pressure" or c.pressure for c in case.cavity)
+        if not case.pressure and not case.point_load and not any(f.value for f in case.fix) and not moving \
+                and not gas:
             raise CaseError("nothing loads the model: give [[pressure]], [[point_load]], a [[fix]] with a "
-                            "value or a moving [[contact]] surface")
+                            "value, a moving [[contact]] surface or a [[cavity]]")
     except SelectorError as exc:
         raise CaseError(str(exc)) from None
     model.finalize()

@@ -49,9 +49,9 @@ class DofMap:
     def n_eq(self) -> int:
         return self.nf + self.np
 
-    def expand(self, u_f: np.ndarray, lam: float) -> np.ndarray:
-        """Full displacement vector from the free unknowns and the load factor."""
-        return np.concatenate([u_f, lam * self.prescribed_ref])[self.eq]
+    def expand(self, u_f: np.ndarray, prescribed: np.ndarray) -> np.ndarray:
+        """Full displacement vector from the free unknowns (nf,) and the prescribed values (np,)."""
+        return np.concatenate([u_f[: self.nf], prescribed])[self.eq]
 
     def gather(self, v_full: np.ndarray) -> np.ndarray:
         """Sum a full vector (forces) into the equations of the extended system."""

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .assembly import element_dofs
+from .curves import PROPORTIONAL, Curve
 from .elements import edge_interpolation
 from .mesh import Mesh
 
@@ -14,8 +15,9 @@ class FollowerPressure:
     (eq. 14): f_ext = -2 pi p int r H^T n ds, n the current outward normal.  The element's
     own interpolation is used along the edge (the theta bubble for SFR), 3-point Gauss."""
 
-    def __init__(self, mesh: Mesh, edges: np.ndarray, value: float):
+    def __init__(self, mesh: Mesh, edges: np.ndarray, value: float, curve: Curve = PROPORTIONAL):
         self.value = float(value)
+        self.curve = curve  # the applied pressure is value * curve(t)
         self.nodes = mesh.boundary_edges[edges]  # (m, edge_nodes), owner orientation
         self.dofs = element_dofs(self.nodes, mesh.element.dofs_per_node)
         self.Xs, self.dXs, self.H, self.dH, self.w = edge_interpolation(

@@ -15,6 +15,8 @@ from scipy.sparse.csgraph import connected_components
 
 from .assembly import SolidAssembly
 from .constraints import DofMap, SparsePattern
+from .cavity import Cavity
+from .curves import PROPORTIONAL, Curve
 from .loads import FollowerPressure
 from .mixed import MixedAssembly
 from .mesh import Mesh
@@ -28,8 +30,9 @@ PRESSURE_SPACE = {"q4": "p0", "q8": "p1", "sfr": "p0"}
 
 @dataclass
 class Evaluation:
-    """Residual and tangent at one state: r (free eqs), dR/dlambda (free eqs), K_ff, the full
-    residual (reactions at supported dofs), the full external load per unit lambda, and the
+    """Residual and tangent at one state: r (free eqs, then cavity constraints), dR/dt, K_ff
+    (bordered by the cavity pressures), the full residual (reactions at supported dofs), the
+    applied external load at t (full vector), and the
     norm of the assembled magnitudes of the element forces (the scale against which the
     residual is small: it does not cancel where large stresses balance), and the round-off
     level of the residual, eps ||K||_inf ||u||: the residual of u rounded to double precision,
@@ -42,6 +45,13 @@ class Evaluation:
     f_ext_full: np.ndarray
     force_scale: float
     noise: float = 0.0
+    nf: int | None = None  # force equations first in r; the rest are cavity constraints
+    constraint_error: float = 0.0  # max |C| of the cavity constraints, relative to V0 (or p V0)
+
+    @property
+    def force_norm(self) -> float:
+        """||R|| over the force equations (the constraints are measured apart)."""
+        return float(np.linalg.norm(self.r[: self.nf]))
 
 
 @dataclass
@@ -64,9 +74,11 @@ class Model:
     sfr_edges: str = "tie"
     pressure_space: str | None = None
     fixed: dict[int, float] = field(default_factory=dict)
+    fixed_curve: dict[int, Curve] = field(default_factory=dict)
     pressures: list[FollowerPressure] = field(default_factory=list)
-    point_loads: list[tuple[int, float]] = field(default_factory=list)
+    point_loads: list[tuple[int, float, Curve]] = field(default_factory=list)
     contacts: list = field(default_factory=list)
+    cavities: list[Cavity] = field(default_factory=list)
 
     def __post_init__(self):
         if self.sfr_edges not in SFR_EDGE_RULES:
@@ -85,28 +97,43 @@ class Model:
         """Full dof numbers of a named dof ("ur", "uz", "rot") at nodes."""
         return np.asarray(nodes) * self.dpn + DOF_NAMES[name]
 
-    def prescribe(self, nodes: Iterable[int], dofs: Sequence[str], value: float = 0.0) -> None:
-        """Prescribe dofs at nodes to value * lambda (value 0: fixed).  "rot" is ignored by
-        elements without rotations."""
+    def prescribe(self, nodes: Iterable[int], dofs: Sequence[str], value: float = 0.0,
+                  curve: Curve = PROPORTIONAL) -> None:
+        """Prescribe dofs at nodes to value * f(t) (value 0: fixed; f(t) = t without a curve).
+        "rot" is ignored by elements without rotations."""
         for name in dofs:
             if name == "rot" and self.dpn == 2:
                 continue
             for d in self.dof(np.asarray(nodes), name):
                 self.fixed[int(d)] = float(value)
+                self.fixed_curve[int(d)] = curve
         self.dofmap = None
 
     fix = prescribe
 
-    def pressure(self, edges: np.ndarray, value: float) -> None:
-        """Follower pressure value * lambda on boundary edges (indices of mesh.boundary_edges)."""
-        self.pressures.append(FollowerPressure(self.mesh, np.asarray(edges), value))
+    def pressure(self, edges: np.ndarray, value: float, curve: Curve = PROPORTIONAL) -> None:
+        """Follower pressure value * f(t) on boundary edges (indices of mesh.boundary_edges)."""
+        self.pressures.append(FollowerPressure(self.mesh, np.asarray(edges), value, curve))
         self.dofmap = None
 
-    def point_load(self, nodes: Iterable[int], dof: str, value: float) -> None:
-        """A force value * lambda on each node: the total force on the revolved ring."""
+    def point_load(self, nodes: Iterable[int], dof: str, value: float, curve: Curve = PROPORTIONAL) -> None:
+        """A force value * f(t) on each node: the total force on the revolved ring."""
         for d in self.dof(np.asarray(nodes), dof):
-            self.point_loads.append((int(d), float(value)))
+            self.point_loads.append((int(d), float(value), curve))
         self.dofmap = None
+
+    def cavity(self, edges: np.ndarray, name: str, control: str = "pressure", value: float = 0.0,
+               ambient: float = 0.0, curve: Curve = PROPORTIONAL) -> Cavity:
+        """A gas cavity bounded by boundary edges (axiform.cavity): control "pressure" (value:
+        the gauge pressure), "volume" (value: the volume at f = 1) or "gas" (value: the
+        content p_abs V at f = 1, ambient: the absolute ambient pressure).  Add the supports
+        first: an open end of the boundary off the axis must have its uz held."""
+        held = np.zeros(self.mesh.n_nodes, bool)
+        held[[d // self.dpn for d in self.fixed if d % self.dpn == 1]] = True
+        cav = Cavity(self.mesh, np.asarray(edges), name, control, value, ambient, curve, held)
+        self.cavities.append(cav)
+        self.dofmap = None
+        return cav
 
     def contact(self, pair) -> None:
         """Add a contact pair (axiform.contact.ContactPair)."""
@@ -160,76 +187,167 @@ class Model:
             self.solid = MixedAssembly(self.mesh, self.material, self.pressure_space)
         else:
             self.solid = SolidAssembly(self.mesh, self.material)
-        self.pattern = SparsePattern(self.dofmap, [self.solid.dofs] + [p.dofs for p in self.pressures])
+        self.pattern = SparsePattern(self.dofmap, [self.solid.dofs] + [p.dofs for p in self.pressures]
+                                     + [c.dofs for c in self.cavities])
         self._solid_pos = self.pattern.positions(self.solid.dofs)
         self._pressure_pos = [self.pattern.positions(p.dofs) for p in self.pressures]
+        self._cavity_pos = [self.pattern.positions(c.dofs) for c in self.cavities]
         self._contact_dofs = [c.dofs(self.dpn) for c in self.contacts]
         self._contact_pos = [self.pattern.positions(d) for d in self._contact_dofs]
-        self.f_point = np.zeros(self.n_full)
-        for d, v in self.point_loads:
-            self.f_point[d] += v
+        # point loads grouped by curve: [(curve, full vector of the values)]
+        self._point = {}
+        for d, v, c in self.point_loads:
+            self._point.setdefault(c, np.zeros(self.n_full))[d] += v
+        # prescribed equations grouped by curve: value_i f_c(t)
+        dm = self.dofmap
+        curve_of_eq = {int(dm.eq[d]) - dm.nf: self.fixed_curve.get(d, PROPORTIONAL) for d in fixed}
+        self._presc_curves = list(dict.fromkeys(curve_of_eq.values())) or [PROPORTIONAL]
+        index = {c: i for i, c in enumerate(self._presc_curves)}
+        self._presc_curve = np.array([index[curve_of_eq[k]] for k in range(dm.np)], dtype=np.int64)
+        self._unknown = [c for c in self.cavities if c.unknown]  # cavities whose pressure is solved for
+        # round-off floor of the residual from the model's own force scale 2 pi mu L^2, which
+        # is not zero at u = 0 (a state in equilibrium converges whatever the load)
+        span = float(np.ptp(self.mesh.points, axis=0).max())
+        mu = float(getattr(self.material, "shear_modulus", 1.0))
+        self._noise_floor = 16 * np.finfo(float).eps * 2 * np.pi * mu * span**2 * np.sqrt(dm.nf)
         return self
 
     @property
     def n_free(self) -> int:
-        return self.dofmap.nf
+        """Unknowns: the free displacement equations, then one pressure per cavity under
+        volume or gas control."""
+        return self.dofmap.nf + len(self._unknown)
+
+    def knots(self) -> np.ndarray:
+        """Every time at which some curve of the model changes its slope (sorted)."""
+        curves = ([p.curve for p in self.pressures] + list(self._point) + self._presc_curves
+                  + [c.curve for c in self.cavities] + [getattr(c.surface, "curve", PROPORTIONAL) for c in self.contacts])
+        return np.unique(np.concatenate([np.empty(0)] + [c.knots() for c in curves]))
+
+    def prescribed(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Values of the prescribed equations at time t and their rates (np,)."""
+        f = np.array([c(t) for c in self._presc_curves])
+        df = np.array([c.slope(t) for c in self._presc_curves])
+        ref = self.dofmap.prescribed_ref
+        return ref * f[self._presc_curve], ref * df[self._presc_curve]
+
+    def cavity_pressures(self, u_f: np.ndarray, t: float) -> list[float]:
+        """The gauge pressure of every cavity at the state (u_f, t)."""
+        it = iter(u_f[self.dofmap.nf:])
+        return [float(next(it)) if c.unknown else c.target(t)[0] for c in self.cavities]
 
     def commit(self) -> None:
         """A step converged at the last evaluated state: update the history variables
-        (contact stick points, sticky nodes, positions for the crossing test)."""
+        (contact stick points, sticky nodes, positions for the crossing test, the cavities'
+        pressure and volume)."""
         for pair in self.contacts:
             pair.commit()
+        for cav in self.cavities:
+            cav.pressure_now, cav.volume_now = cav.last
 
     # ---- evaluation ------------------------------------------------------------------------
-    def expand(self, u_f: np.ndarray, lam: float) -> np.ndarray:
-        return self.dofmap.expand(u_f, lam)
+    def expand(self, u_f: np.ndarray, t: float) -> np.ndarray:
+        """Full displacement vector (n_full,) from the unknowns and the time t."""
+        return self.dofmap.expand(u_f, self.prescribed(t)[0])
 
-    def external_load(self, u_full: np.ndarray, tangent: bool = True):
-        """f_ext per unit lambda (full vector) and, if asked, its derivative's pattern data."""
-        f = self.f_point.copy()
+    def external_load(self, u_full: np.ndarray, t: float = 1.0, tangent: bool = True):
+        """The applied external load at time t (full vector), its rate d/dt, and, if asked,
+        the pattern data of its derivative d f_ext / du (follower pressures)."""
+        f = np.zeros(self.n_full)
+        df = np.zeros(self.n_full)
+        for c, v in self._point.items():
+            f += c(t) * v
+            df += c.slope(t) * v
         data = None
         for p, pos in zip(self.pressures, self._pressure_pos):
+            ft, dft = p.curve(t), p.curve.slope(t)
+            if ft == 0.0 and dft == 0.0:
+                continue
             fe, Ke = p.evaluate(u_full, tangent)
-            f += np.bincount(p.dofs.ravel(), weights=fe.ravel(), minlength=self.n_full)
+            fp = np.bincount(p.dofs.ravel(), weights=fe.ravel(), minlength=self.n_full)
+            f += ft * fp
+            df += dft * fp
             if tangent:
-                data = self.pattern.accumulate(pos, Ke, data)
-        return f, data
+                data = self.pattern.accumulate(pos, ft * Ke, data)
+        return f, df, data
 
-    def evaluate(self, u_f: np.ndarray, lam: float, tangent: bool = True) -> Evaluation:
-        """Residual R = f_int - lambda f_ext on the free equations, dR/dlambda and K_ff."""
+    def evaluate(self, u_f: np.ndarray, t: float, tangent: bool = True) -> Evaluation:
+        """Residual R = f_int - f_ext(t) - f_contact - sum p g (cavities) on the free
+        equations, then the cavity constraints; dR/dt; the (bordered) tangent."""
         dm = self.dofmap
-        u = dm.expand(u_f, lam)
+        nf = dm.nf
+        presc, dpresc = self.prescribed(t)
+        u = dm.expand(u_f, presc)
         fe, Ke = self.solid.evaluate(u, tangent)
         f_int = np.bincount(self.solid.dofs.ravel(), weights=fe.ravel(), minlength=self.n_full)
         f_abs = np.bincount(self.solid.dofs.ravel(), weights=np.abs(fe).ravel(), minlength=self.n_full)
-        f_ext, dfext = self.external_load(u, tangent)
-        r_full = f_int - lam * f_ext
-        # contact: R -= f_c, K -= df_c/dx; a moving surface adds dR/dlambda = (df_c/dx) motion
-        dr_contact = np.zeros(self.n_full)
+        f_ext, df_ext, dfext = self.external_load(u, t, tangent)
+        r_full = f_int - f_ext
+        dr_full = -df_ext  # dR/dt at fixed u
+        # contact: R -= f_c, K -= df_c/dx; a moving surface adds dR/dt = (df_c/dx) velocity
         contact_data = []
         u2 = u.reshape(-1, self.dpn)[:, :2]
         for pair, dofs in zip(self.contacts, self._contact_dofs):
-            fc, Kc, _ = pair.evaluate(u2, lam)
+            fc, Kc, _ = pair.evaluate(u2, t)
             np.add.at(r_full, dofs.ravel(), -fc.ravel())
-            motion = np.asarray(pair.surface.motion, float)
-            if motion.any():
-                np.add.at(dr_contact, dofs.ravel(), (Kc @ motion).ravel())
+            velocity = pair.surface.velocity(t)
+            if velocity.any():
+                np.add.at(dr_full, dofs.ravel(), (Kc @ velocity).ravel())
             contact_data.append(-Kc)
+        # cavities: R -= p g, K -= p dg/du; under volume/gas control p is an unknown
+        p_cav = self.cavity_pressures(u_f, t)
+        g_eq, cav_data, constraints = [], [], []
+        for k, (cav, p) in enumerate(zip(self.cavities, p_cav)):
+            V, ge, He = cav.evaluate(u, tangent)
+            g = np.bincount(cav.dofs.ravel(), weights=ge.ravel(), minlength=self.n_full)
+            r_full -= p * g
+            cav.last = (p, V)
+            if cav.unknown:
+                goal, rate = cav.target(t)
+                if cav.control == "volume":  # C = V - V(t)
+                    constraints.append((V - goal, -rate, 1.0, 0.0, cav.V0))
+                else:  # C = (p + ambient) V - content(t)
+                    constraints.append(((p + cav.ambient) * V - goal, -rate, p + cav.ambient, V,
+                                        cav.ambient * cav.V0))
+                g_eq.append(dm.gather(g))
+            else:
+                dr_full -= cav.target(t)[1] * g
+            if tangent:
+                cav_data.append(-p * He)
         r_eq = dm.gather(r_full)
-        dr_dlam = (dm.gather(dr_contact) - dm.gather(f_ext))[: dm.nf]
+        dr_dt = dm.gather(dr_full)[:nf]
         K = None
         if tangent:
             data = self.pattern.accumulate(self._solid_pos, Ke)
             if dfext is not None:
-                data -= lam * dfext
+                data -= dfext
             for pos, Kc in zip(self._contact_pos, contact_data):
                 data = self.pattern.accumulate(pos, Kc, data)
+            for pos, Hc in zip(self._cavity_pos, cav_data):
+                data = self.pattern.accumulate(pos, Hc, data)
             K, K_fp = self.pattern.blocks(data)
             if dm.np:
-                dr_dlam = dr_dlam + K_fp @ dm.prescribed_ref
-        scale = float(np.linalg.norm(f_abs) + abs(lam) * np.linalg.norm(f_ext))
-        noise = 0.0
+                dr_dt = dr_dt + K_fp @ dpresc
+        r = r_eq[:nf]
+        if constraints:
+            # bordered system [[K, -G], [dC/du, dC/dp]] for the unknown cavity pressures
+            G = np.column_stack([g[:nf] for g in g_eq])  # (nf, m)
+            C = np.array([c[0] for c in constraints])
+            dC_dt = np.array([c[1] for c in constraints])
+            # prescribed displacements move the wall: dC/dt += dC/du_p du_p/dt
+            dC_dt += np.array([c[2] * (g[nf:] @ dpresc) for c, g in zip(constraints, g_eq)])
+            Cu = np.array([c[2] for c in constraints])[:, None] * G.T
+            Cp = np.diag([c[3] for c in constraints])
+            r = np.concatenate([r, C])
+            dr_dt = np.concatenate([dr_dt, dC_dt])
+            if K is not None:
+                K = sp.bmat([[K, sp.csr_matrix(-G)], [sp.csr_matrix(Cu), sp.csr_matrix(Cp)]], format="csr")
+            constraint_error = float(np.max(np.abs(C) / np.array([c[4] for c in constraints])))
+        else:
+            constraint_error = 0.0
+        scale = float(np.linalg.norm(f_abs) + np.linalg.norm(f_ext))
+        noise = self._noise_floor
         if K is not None and K.nnz:
             row_sums = np.add.reduceat(np.abs(K.data), K.indptr[:-1][np.diff(K.indptr) > 0])
-            noise = float(np.finfo(float).eps * row_sums.max() * np.linalg.norm(u))
-        return Evaluation(r_eq[: dm.nf], dr_dlam, K, r_full, f_ext, scale, noise)
+            noise = max(noise, float(np.finfo(float).eps * row_sums.max() * np.linalg.norm(u)))
+        return Evaluation(r, dr_dt, K, r_full, f_ext, scale, noise, nf, constraint_error)

@@ -88,6 +88,9 @@ class ResultsWriter:
         self.newton_iterations += step.iterations
         self.summary.update(steps=self.steps, newton_iterations=self.newton_iterations,
                             load_factor=float(step.lam), monitors=values)
+        if self.model.cavities:
+            self.summary["cavities"] = {c.name: {"pressure": float(c.pressure_now), "volume": float(c.volume_now),
+                                                 "initial_volume": float(c.V0)} for c in self.model.cavities}
         if step.number % self.every == 0:
             self._write_fields(step)
         self._last_step = step

@@ -128,17 +128,17 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
     nominal = path.nominal
     size = nominal
     while not path.done():
-        size = path.clip(size)
+        trial = path.clip(size)  # shortened to land on a knot or the end; size is kept
         try:
-            u_new, lam_new, its, res, ev = path.attempt(size)
+            u_new, lam_new, its, res, ev = path.attempt(trial)
         except StepFailed as exc:
-            size /= 2.0
+            size = trial / 2.0
             if abs(size) < opts.min_step * abs(nominal):
                 result.status = "stopped"
                 result.message = f"no convergence with the step cut below the minimum ({exc})"
                 break
             continue
-        path.accept(u_new, lam_new, size)
+        path.accept(u_new, lam_new, trial)
         model.commit()
         result.newton_iterations += its
         step = Step(len(result.steps) + 1, lam_new, its, res, u_new, model.expand(u_new, lam_new), ev)
@@ -175,20 +175,30 @@ class _Path:
 
 
 class _Load(_Path):
+    """lambda = t from 0 to the target; every knot of every curve is a step's end."""
+
     def __init__(self, model, control: LoadControl, opts):
         super().__init__(model, opts)
         self.target = control.target
         self.nominal = control.target / control.steps
+        k = model.knots()
+        lo, hi = sorted((0.0, self.target))
+        self.stops = np.append(k[(k > lo) & (k < hi)][:: 1 if self.target > 0 else -1], self.target)
 
     def done(self):
         return abs(self.target - self.lam) <= 1e-12 * abs(self.target)
 
+    def _next_stop(self) -> float:
+        ahead = (self.stops - self.lam) * np.sign(self.target) > 1e-12 * abs(self.target)
+        return float(self.stops[np.argmax(ahead)]) if ahead.any() else self.target
+
     def clip(self, size):
-        remaining = self.target - self.lam
+        remaining = self._next_stop() - self.lam
         return remaining if abs(size) > abs(remaining) else size
 
     def attempt(self, size):
-        lam = self.target if abs(self.target - self.lam - size) <= 1e-12 * abs(self.target) else self.lam + size
+        stop = self._next_stop()
+        lam = stop if abs(stop - self.lam - size) <= 1e-12 * abs(self.target) else self.lam + size
         return _newton_load(self.model, self.u_f, lam, self.opts, self.floor)
 
 
@@ -228,7 +238,8 @@ class _ArcLength(_Path):
         # (thin walls); smaller weights let SFR balloons wander at the limit point
         rep = model.dofmap.free_dof % model.dpn
         span = float(np.linalg.norm(np.ptp(model.mesh.points, axis=0)))
-        self.weight = np.where(rep < 2, 1.0, span**2)
+        # cavity pressures (after the displacements) are not part of the arc
+        self.weight = np.concatenate([np.where(rep < 2, 1.0, span**2), np.zeros(model.n_free - len(rep))])
         self.previous = None  # last converged increment, for the direction of the next one
         self.stop = None
         if control.stop_dof is not None:
@@ -278,7 +289,7 @@ class _ArcLength(_Path):
         sign = np.sign(np.dot(W * t, self.previous)) if self.previous is not None else np.sign(self.control.target)
         dlam = (sign or 1.0) * dl / max(self._norm(t), 1e-300)
         du = dlam * t
-        residuals = [float(np.linalg.norm(ev.r))]
+        residuals = [ev.force_norm]
         for it in range(1, opts.max_iterations + 1):
             lam = self.lam + dlam
             ev = _evaluate(model, self.u_f + du, lam)
@@ -309,14 +320,14 @@ class _ArcLength(_Path):
 
 
 def _check(ev: Evaluation, lam: float, opts: NewtonOptions, floor: float, residuals: list[float]) -> bool:
-    norm = float(np.linalg.norm(ev.r))
-    if not np.isfinite(norm):
+    norm = ev.force_norm
+    if not np.isfinite(norm) or not np.isfinite(ev.constraint_error):
         raise StepFailed("the residual is not finite")
     residuals.append(norm)
     ref = _reference_force(ev, lam, floor)
     if norm > 1e10 * ref:
         raise StepFailed("Newton diverges")
-    return norm <= max(opts.tolerance * ref, ev.noise)
+    return norm <= max(opts.tolerance * ref, ev.noise) and ev.constraint_error <= opts.tolerance
 
 
 def _evaluate(model: Model, u_f, lam) -> Evaluation:
@@ -358,9 +369,9 @@ def _newton_load(model, u_f, lam, opts, floor):
         du = -_factorize(ev.K)(ev.r)
         trial = _evaluate(model, u_f + du, lam)
         if model.contacts:
-            norm = np.linalg.norm(ev.r)
+            norm = ev.force_norm
             for _ in range(3):
-                if np.linalg.norm(trial.r) <= norm:
+                if trial.force_norm <= norm:
                     break
                 du *= 0.5
                 trial = _evaluate(model, u_f + du, lam)
@@ -378,7 +389,7 @@ def _newton_displacement(model, u_f, lam, c, target, opts, floor):
         if it > 0 and _check(ev, lam, opts, floor, residuals):
             return u_f, lam, it, residuals, ev
         if it == 0:
-            residuals.append(float(np.linalg.norm(ev.r)))
+            residuals.append(ev.force_norm)
         if it == opts.max_iterations:
             break
         solve = _factorize(ev.K)

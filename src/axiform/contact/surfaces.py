@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..curves import PROPORTIONAL, Curve
 from . import search
 
 
@@ -43,10 +44,18 @@ class Projection:
 
 @dataclass
 class RigidSurface:
-    motion: tuple[float, float] = (0.0, 0.0)
+    """motion: the rigid translation (r, z) applied as motion * curve(t) (curve: f(t) = t
+    unless given)."""
 
-    def offset(self, lam: float) -> np.ndarray:
-        return lam * np.asarray(self.motion, float)
+    motion: tuple[float, float] = (0.0, 0.0)
+    curve: Curve = PROPORTIONAL
+
+    def offset(self, t: float) -> np.ndarray:
+        return self.curve(t) * np.asarray(self.motion, float)
+
+    def velocity(self, t: float) -> np.ndarray:
+        """d offset / dt."""
+        return self.curve.slope(t) * np.asarray(self.motion, float)
 
 
 @dataclass
