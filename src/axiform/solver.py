@@ -246,12 +246,15 @@ class _ArcLength(_Path):
             self.stop = int(model.dofmap.eq[control.stop_dof])
             if self.stop >= model.n_free:
                 raise ValueError("the stop dof is prescribed")
+        self.load_step = abs(control.target / control.steps)
         if control.arc_length is not None:
             self.nominal = control.arc_length
         else:
             ev = _evaluate(model, self.u_f, 0.0)
             t = -_factorize(ev.K)(ev.dr_dlam)
-            self.nominal = abs(control.target / control.steps) * self._norm(t)
+            self.nominal = self.load_step * self._norm(t)
+            if not self.nominal > 0:  # nothing responds to the load yet (a tool still in the air)
+                self.nominal = self.load_step * span
         self.finished = False
 
     def _norm(self, v):
@@ -265,6 +268,8 @@ class _ArcLength(_Path):
 
     def attempt(self, size):
         u_new, lam_new, its, res, ev = self._arc_step(size)
+        if self.previous is not None and np.dot(self.weight * (u_new - self.u_f), self.previous) < 0:
+            raise StepFailed("the path turned back")
         c = self.control
         if self._crossed(self.lam, lam_new, c.target):
             out = _newton_load(self.model, self.u_f, c.target, self.opts, self.floor)
@@ -286,6 +291,11 @@ class _ArcLength(_Path):
         model, opts, W = self.model, self.opts, self.weight
         ev = _evaluate(model, self.u_f, self.lam)
         t = -_factorize(ev.K)(ev.dr_dlam)  # du/dlambda along the tangent
+        if not self._norm(t) > 0:
+            # the structure does not respond to the load (only a tool moves, not touching yet):
+            # no arc can be measured, so take a load step, sized like the arc
+            dlam = np.sign(self.control.target) * self.load_step * dl / self.nominal
+            return _newton_load(model, self.u_f, self.lam + dlam, opts, self.floor)
         sign = np.sign(np.dot(W * t, self.previous)) if self.previous is not None else np.sign(self.control.target)
         dlam = (sign or 1.0) * dl / max(self._norm(t), 1e-300)
         du = dlam * t
