@@ -106,7 +106,7 @@ def with_unit(label: str, quantity: str, units: dict[str, str]) -> str:
 def short(value: float) -> str:
     """A number rounded for a title: three significant digits (172, 33.4, 0.0276), an
     exponent only below 1e-3 or from 1e5 on."""
-    a = abs(value)
+    a = float(f"{abs(value):.3g}")
     if a == 0:
         return "0"
     if a < 1e-3 or a >= 1e5:

@@ -157,14 +157,17 @@ def thickness_figure(thickness: Path, info: FolderInfo, history: dict[str, np.nd
     thick_label = with_unit("thickness", "length", info.units)
     earlier = sorted((Path(thickness).parent / "thickness").glob("step_*.csv"))
     earlier = [p for p in earlier if int(p.stem.split("_")[1]) < step]
-    for k, path in enumerate(earlier[:: max(1, -(-len(earlier) // 5))]):
+    earlier = earlier[:: max(1, -(-len(earlier) // 5))]
+    t_top = t["thickness"].max()
+    for k, path in enumerate(earlier):
         e, e_step = _read_thickness(path)
-        a_s.plot(e["s_current"], e["thickness"], "-", lw=1, color=plt.cm.Greys(0.3 + 0.4 * k / 5),
+        a_s.plot(e["s_current"], e["thickness"], "-", lw=1.2, color=plt.cm.Blues(0.25 + 0.45 * k / len(earlier)),
                  label=f"step {e_step}")
+        t_top = max(t_top, e["thickness"].max())
     a_s.plot(t["s_current"], t["thickness"], "o-", ms=2.5, color="C0", label=f"step {step}")
     t0 = t["initial_thickness"]
     if t0.max() <= 3 * t["thickness"].max():
-        a_s.plot(t["s_current"], t0, "--", color="C1", label="initial (at its station)")
+        a_s.plot(t["s_current"], t0, "--", color="C1", label="initial")
     else:
         span = short(t0.mean()) if np.ptp(t0) < 0.01 * t0.max() else f"{short(t0.min())} to {short(t0.max())}"
         a_s.text(0.02, 0.04, f"initial thickness {span}" + (f" {length}" if length else ""),
@@ -176,9 +179,10 @@ def thickness_figure(thickness: Path, info: FolderInfo, history: dict[str, np.nd
     if one:
         a_ratio.axhline(1.0, color="0.5", lw=0.8, ls="--")
     arc = with_unit("current arc length s", "length", info.units)
-    t_top = max(t["thickness"].max(), t0.max() if t0.max() <= 3 * t["thickness"].max() else 0.0)
-    for ax, xlabel, ylabel, top in ((a_s, arc, thick_label, t_top),
-                                    (a_z, with_unit("current z", "length", info.units), thick_label, t_top),
+    s_top = max(t_top, t0.max() if t0.max() <= 3 * t["thickness"].max() else 0.0)
+    z_top = max(t["thickness"].max(), s_top if s_top <= 3 * t["thickness"].max() else 0.0)
+    for ax, xlabel, ylabel, top in ((a_s, arc, thick_label, s_top),
+                                    (a_z, with_unit("current z", "length", info.units), thick_label, z_top),
                                     (a_ratio, arc, "thickness ratio t / t0", max(t["ratio"].max(), float(one)))):
         ax.set_ylim(0.0, 1.1 * top)
         ax.set_xlabel(xlabel)
