@@ -244,3 +244,24 @@ def test_thin_wall_and_uniform_field_stay_readable(tmp_path):
     assert ratio_axis.get_ylim()[0] == 0.0  # a 0.1 % variation is a flat line, not a cliff
     with open(out / "thickness.csv") as fh:
         assert next(csv.reader(fh))[0].startswith("# step")
+
+
+def test_cavity_pressure_monitor_is_the_load_axis(tmp_path):
+    """A cavity pressure monitor carries the load: it is the load axis of every other
+    monitor's panel and has no panel of its own; a volume is in length cubed."""
+    monitor = SimpleNamespace(name="p_bottle", cavity="bottle", quantity="pressure", contact=None, reaction=None)
+    volume = SimpleNamespace(name="v_bottle", cavity="bottle", quantity="volume", contact=None, reaction=None)
+    case = SimpleNamespace(monitor=[volume, monitor], pressure=[], point_load=[], fix=[], contact=[],
+                           units=SimpleNamespace(model_dump=lambda: {"length": "mm", "pressure": "MPa"}))
+    labels = case_labels(case)
+    assert labels["load"] == {"quantity": "pressure", "monitor": "p_bottle", "name": "bottle pressure"}
+    assert labels["monitor_quantities"] == {"v_bottle": "volume", "p_bottle": "pressure"}
+    (tmp_path / "summary.json").write_text(json.dumps({"title": "", **labels}))
+    (tmp_path / "history.csv").write_text("step,load_factor,iterations,v_bottle,p_bottle\n"
+                                          "1,0.5,3,12.0,0.2\n2,1.0,3,20.0,0.3\n")
+    fig = load_curve_figure(tmp_path / "history.csv", FolderInfo.read(tmp_path))
+    (ax,) = fig.axes
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("v_bottle (mm³)", "bottle pressure (MPa)")
+    x, y = ax.lines[0].get_data()
+    assert np.array_equal(x, [12.0, 20.0]) and np.array_equal(y, [0.2, 0.3])  # no false origin
+    assert FolderInfo.read(tmp_path).state(2, history(tmp_path)) == "step 2, bottle pressure = 0.300 MPa"
