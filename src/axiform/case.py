@@ -549,8 +549,6 @@ def build(case: Case, base: str | Path = ".") -> Built:
             model.prescribe(select_nodes(mesh, f.at.model_dump(), f"fix[{i}].at"), f.dofs, f.value)
         for i, p in enumerate(case.pressure):
             model.pressure(select_edges(mesh, p.on.model_dump(), f"pressure[{i}].on"), p.value)
-        if case.mesh.kind == "rectangle":
-            mesh.set_wall(case.mesh.wall or default_wall(mesh.points, [p.nodes for p in model.pressures]))
         for i, pl in enumerate(case.point_load):
             model.point_load(select_nodes(mesh, pl.at.model_dump(), f"point_load[{i}].at"), pl.dof, pl.value)
         pairs = [_contact(mesh, model, c, base, f"contact[{i}]") for i, c in enumerate(case.contact)]
@@ -598,6 +596,9 @@ def build(case: Case, base: str | Path = ".") -> Built:
                             "value or a moving [[contact]] surface")
     except SelectorError as exc:
         raise CaseError(str(exc)) from None
+    if case.mesh.kind == "rectangle":  # the wall is normal to the faces that carry the pressure
+        loaded = model.pressures + getattr(model, "cavities", [])
+        mesh.set_wall(case.mesh.wall or default_wall(mesh.points, [p.nodes for p in loaded]))
     model.finalize()
     options = NewtonOptions(tolerance=s.tolerance, max_iterations=s.max_iterations,
                             min_step=s.min_step, growth=s.growth)

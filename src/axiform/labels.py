@@ -51,12 +51,16 @@ def _scaled(quantity: str, value: float, name: str, curve: list | None) -> dict[
 
 
 def loaded_quantity(case: Any) -> dict[str, Any] | None:
-    """The physical quantity lambda scales, in this order: a cavity pressure monitor, the
-    pressures (the largest, named by its table when they differ), the point loads, the
-    prescribed displacements and mould motions; None when there is none."""
+    """The physical quantity lambda scales, in this order: a cavity pressure monitor, a
+    cavity under pressure control, the pressures (the largest, named by its table when they
+    differ), the point loads, the prescribed displacements and mould motions; None when there
+    is none."""
     for m in case.monitor:
         if getattr(m, "cavity", None) is not None and m.quantity == "pressure":
             return {"quantity": "pressure", "monitor": m.name, "name": f"{m.cavity} pressure"}
+    for c in getattr(case, "cavity", []):
+        if c.control == "pressure" and c.pressure:
+            return _scaled("pressure", c.pressure, f"{c.name} pressure", _curve(c))
     for kind, specs in (("pressure", case.pressure), ("force", case.point_load)):
         if specs:
             k = int(np.argmax([abs(p.value) for p in specs]))
