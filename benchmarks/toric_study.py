@@ -222,8 +222,8 @@ def read_history(folder: Path) -> dict[str, np.ndarray]:
 
 
 def read_thickness(folder: Path) -> dict[str, np.ndarray]:
-    data = np.loadtxt(folder / "thickness.csv", delimiter=",", skiprows=2)
-    return dict(zip(["s", "r", "z", "thickness", "initial_thickness", "ratio"], data.T))
+    data = np.genfromtxt(folder / "thickness.csv", delimiter=",", names=True, skip_header=1)
+    return {k: data[k] for k in ("s", "r", "z", "thickness", "initial_thickness", "ratio")}
 
 
 def plan(quick: bool):

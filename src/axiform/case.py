@@ -23,6 +23,7 @@ from .profile import Arc, Line, Profile, ProfileError
 from .model import Model
 from .selectors import SelectorError, select_edges, select_nodes
 from .solver import ArcLengthControl, DisplacementControl, LoadControl, NewtonOptions
+from .thickness import default_wall
 
 DofName = Literal["ur", "uz", "rot"]
 PositiveFloat = Annotated[float, Field(gt=0)]
@@ -93,6 +94,7 @@ class MeshSpec(Strict):
     start: tuple[float, float] | None = None
     profile: Annotated[list[PieceSpec], Field(min_length=1)] | None = None
     thickness: PositiveFloat | Annotated[list[tuple[float, PositiveFloat]], Field(min_length=2)] | None = None
+    wall: Literal["r", "z"] | None = None  # rectangle: direction through the wall (thickness)
     layers: Annotated[int, Field(ge=1)] | None = None
     sfr_edges: Literal["tie", "fix", "free"] = "tie"
     formulation: Literal["mixed", "displacement"] = "mixed"
@@ -106,6 +108,8 @@ class MeshSpec(Strict):
                     raise ValueError(f"a {kind} mesh needs '{key}'")
                 if kind != self.kind and given and key not in _GRID_KEYS[self.kind]:
                     raise ValueError(f"'{key}' belongs to kind = \"{kind}\"")
+        if self.wall is not None and self.kind != "rectangle":
+            raise ValueError("'wall' belongs to kind = \"rectangle\" (a layered wall knows its own)")
         if self.kind == "rectangle":
             if not self.r[0] < self.r[1] or not self.z[0] < self.z[1]:
                 raise ValueError("r and z must be given as [min, max] with min < max")
@@ -378,6 +382,19 @@ class OutputSpec(Strict):
     gid: bool = False
     plots: bool = True
     revolved: Annotated[int, Field(ge=0)] = 0  # sectors of a 3D revolved copy of the last step
+    thickness_every: Annotated[int, Field(ge=1)] | None = None  # thickness/step_NNNN.csv every k-th step
+
+
+Unit = Annotated[str, Field(min_length=1)]
+
+
+class UnitsSpec(Strict):
+    """The units the case's numbers are in: labels for plots and summary.json, no conversion."""
+
+    length: Unit | None = None
+    pressure: Unit | None = None
+    force: Unit | None = None
+    time: Unit | None = None
 
 
 class Case(Strict):
@@ -392,6 +409,7 @@ class Case(Strict):
     cavity: list[CavitySpec] = []
     solver: SolverSpec = SolverSpec()
     output: OutputSpec = OutputSpec()
+    units: UnitsSpec = UnitsSpec()
 
 
 def _loc(loc: tuple) -> str:
@@ -659,6 +677,9 @@ def build(case: Case, base: str | Path = ".") -> Built:
                             "value, a moving [[contact]] surface or a [[cavity]]")
     except SelectorError as exc:
         raise CaseError(str(exc)) from None
+    if case.mesh.kind == "rectangle":  # the wall is normal to the faces that carry the pressure
+        loaded = model.pressures + getattr(model, "cavities", [])
+        mesh.set_wall(case.mesh.wall or default_wall(mesh.points, [p.nodes for p in loaded]))
     model.finalize()
     options = NewtonOptions(tolerance=s.tolerance, max_iterations=s.max_iterations,
                             min_step=s.min_step, growth=s.growth)

@@ -12,6 +12,7 @@ from pathlib import Path
 
 from . import __version__
 from .case import CaseError, build, load
+from .labels import case_labels
 from .results import ResultsWriter
 from .solver import solve
 
@@ -50,7 +51,8 @@ def run(case_path: str, out: str | None, quiet: bool = False, overrides: list[st
     out_dir = Path(out) if out else Path("results") / case_file.stem
     o = case.output
     writer = ResultsWriter(out_dir, built.model, built.monitors, case.title, every=o.every, vtu=o.vtu,
-                           gid_files=o.gid, revolved=o.revolved, plots=o.plots)
+                           gid_files=o.gid, revolved=o.revolved, plots=o.plots,
+                           thickness_every=o.thickness_every, labels=case_labels(case))
     model, control = built.model, built.control
     progress = Progress(sys.stderr, quiet)
     # progress: the driven dof, the stop dof of an arc length, or the load factor
@@ -90,15 +92,20 @@ def check(case_path: str, overrides: list[str] = ()) -> int:
     return 0
 
 
-def plot(folder: str, field: str) -> int:
-    from .plots import plot_folder
+def plot(folder: str, field: str, animate: bool = False) -> int:
+    from .plots import FieldError, plot_folder
 
     path = Path(folder)
     if not (path / "history.csv").exists():
         print(f"axiform: {folder} is not a results folder (no history.csv)", file=sys.stderr)
         return 2
-    for png in plot_folder(path, field):
-        print(png)
+    try:
+        made = plot_folder(path, field, animate)
+    except FieldError as exc:
+        print(f"axiform: --field: {exc}", file=sys.stderr)
+        return 2
+    for picture in made:
+        print(picture)
     return 0
 
 
@@ -119,10 +126,15 @@ def main(argv: list[str] | None = None) -> int:
     p_plot = sub.add_parser("plot", help="write the PNG plots of a results folder")
     p_plot.add_argument("folder")
     p_plot.add_argument("--field", default="von_mises",
-                        help="nodal field colouring the deformed shape (von_mises, J, fibre_rotation, ...)")
+                        help="nodal field colouring the deformed shape (von_mises, J, thickness, ...; "
+                             "a component as cauchy_stress:zz or displacement:uz; vectors and tensors "
+                             "alone: their magnitude)")
+    p_plot.add_argument("--animate", action="store_true",
+                        help="also write forming.gif: the deformed wall, moulds and thickness, one frame "
+                             "per written step")
     args = parser.parse_args(argv)
     if args.command == "plot":
-        return plot(args.folder, args.field)
+        return plot(args.folder, args.field, args.animate)
     if args.command == "run":
         return run(args.case, args.out, args.quiet, args.set)
     return check(args.case, args.set)

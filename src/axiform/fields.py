@@ -4,6 +4,9 @@ pressure.
 
 Quadrature-point values are averaged to the nodes (each element's mean, then the mean over
 the elements around a node): enough for pictures, not for error estimates.
+
+Meshes with fibres (rectangles, layered walls) also get the wall thickness, and contact
+pairs that record contact times the time of first contact.
 """
 
 from __future__ import annotations
@@ -11,9 +14,14 @@ from __future__ import annotations
 import numpy as np
 
 from .materials import cauchy_stress
+from .thickness import contact_times, nodal_thickness, thickness_table
 
 
 def point_fields(model, u_full: np.ndarray) -> dict[str, np.ndarray]:
+    """Nodal fields (n,) or (n, k) of the state u_full (all dofs): displacement (ur, uz, 0),
+    J, cauchy_stress (rr, zz, tt, rz), von_mises, principal_stretches (in-plane major, minor,
+    hoop); fibre_rotation (SFR); thickness (meshes with fibres); contact_pressure and
+    first_contact (the time a slave node first touched, -1 where never) with contact."""
     mesh = model.mesh
     dpn = model.dpn
     u = u_full.reshape(-1, dpn)
@@ -49,6 +57,9 @@ def point_fields(model, u_full: np.ndarray) -> dict[str, np.ndarray]:
     }
     if dpn == 3:
         out["fibre_rotation"] = u[:, 2].copy()
+    table = thickness_table(mesh, u[:, :2])
+    if table is not None:
+        out["thickness"] = nodal_thickness(mesh, table)
     if model.contacts:
         pressure = np.zeros(mesh.n_nodes)
         for pair in model.contacts:
@@ -56,4 +67,7 @@ def point_fields(model, u_full: np.ndarray) -> dict[str, np.ndarray]:
                 rep = pair.report()
                 pressure[rep["node"]] += rep["pressure"]
         out["contact_pressure"] = pressure
+        when = contact_times(mesh, model.contacts)
+        if when is not None:
+            out["first_contact"] = np.nan_to_num(when, nan=-1.0)
     return out

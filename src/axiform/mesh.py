@@ -29,6 +29,9 @@ class Mesh:
     def __post_init__(self):
         self.fibres: np.ndarray | None = None  # (stations, corner nodes through the thickness)
         self.fibre_s: np.ndarray | None = None  # reference arc length of each station
+        self.node_s: np.ndarray | None = None  # (n,) reference arc length of each node's station
+        self.wall: str | None = None  # rectangles: "r" or "z", the direction through the wall
+        self._walls: dict[str, tuple[np.ndarray, np.ndarray]] = {}  # wall -> (grid numbering, s)
         self.points = np.asarray(self.points, dtype=float)
         self.cells = np.asarray(self.cells, dtype=np.int64)
         # (m, edge_nodes), ordered as the owning cell runs (counter-clockwise)
@@ -68,6 +71,15 @@ class Mesh:
             raise MeshError(
                 f"inverted or degenerate element(s) {bad[:10].tolist()} (detJ <= 0; nodes must run "
                 f"counter-clockwise in the (r, z) plane): first one has nodes {self.cells[bad[0]].tolist()}")
+
+    def set_wall(self, wall: str) -> None:
+        """Rectangles: measure the thickness through "z" (a plate: fibres are the lines of
+        nodes along z, stations along r) or through "r" (a cylinder: fibres along r, stations
+        along z)."""
+        if wall not in self._walls:
+            raise MeshError(f"wall = {wall!r}: the mesh offers {sorted(self._walls) or 'no choice of wall'}")
+        _set_fibres(self, *self._walls[wall])
+        self.wall = wall
 
 
 def boundary_edges(cells: np.ndarray, kind: ElementKind):
@@ -113,10 +125,15 @@ def _add_grid_sets(mesh: Mesh, number: np.ndarray, names: dict[str, tuple]) -> N
 
 
 def _set_fibres(mesh: Mesh, number: np.ndarray, s: np.ndarray) -> None:
-    """The through-thickness lines of corner nodes at each station (thickness output)."""
+    """The through-thickness lines of corner nodes at each station (thickness output), from
+    the grid numbering (stations, through the wall) and the arc length s of each grid line;
+    every node (mid-side ones too) gets the arc length of its grid line as node_s."""
     step = 2 if mesh.element.nodes == 8 else 1
     mesh.fibres = number[::step, ::step]
     mesh.fibre_s = s[::step]
+    used = number >= 0
+    mesh.node_s = np.empty(mesh.n_nodes)
+    mesh.node_s[number[used]] = np.broadcast_to(s[:, None], number.shape)[used]
 
 
 def graded(a: float, b: float, n: int, ratio: float = 1.0, per_division: int = 1) -> np.ndarray:
@@ -133,12 +150,14 @@ def graded(a: float, b: float, n: int, ratio: float = 1.0, per_division: int = 1
 
 
 def rectangle(r: tuple[float, float], z: tuple[float, float], divisions: tuple[int, int],
-              element: str = "q4", grading: tuple[float, float] = (1.0, 1.0)) -> Mesh:
+              element: str = "q4", grading: tuple[float, float] = (1.0, 1.0), wall: str = "z") -> Mesh:
     """Structured mesh of [r0, r1] x [z0, z1] with divisions (nr, nz); Q8 gets mid-side nodes.
     grading: size of the last element over the first, radially and axially (geometric).
 
     Named node and edge sets: "left" (r = r0), "right" (r = r1), "bottom" (z = z0), "top" (z = z1).
-    The fibres (for thickness output) are the vertical lines of nodes.
+    wall: the direction through the wall for thickness output: "z" (a plate; the fibres are
+    the lines of nodes along z) or "r" (a cylinder; the fibres run along r); Mesh.set_wall
+    changes it.
     """
     kind = ELEMENTS[element]
     f = 2 if kind.nodes == 8 else 1
@@ -148,7 +167,8 @@ def rectangle(r: tuple[float, float], z: tuple[float, float], divisions: tuple[i
     mesh = Mesh(points, cells, kind)
     _add_grid_sets(mesh, number, {"left": (0, slice(None)), "right": (-1, slice(None)),
                                   "bottom": (slice(None), 0), "top": (slice(None), -1)})
-    _set_fibres(mesh, number, R[:, 0] - r[0])
+    mesh._walls = {"z": (number, R[:, 0] - r[0]), "r": (number.T, Z[0, :] - z[0])}
+    mesh.set_wall(wall)
     return mesh
 
 

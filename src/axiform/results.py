@@ -3,8 +3,10 @@ thickness.csv, optional GiD files and a 3D revolved copy, and PNG plots at the e
 
 history.csv: one row per converged step (step, load_factor, iterations, then one column per
 monitor).  summary.json: status, steps, newton_iterations, wall_time_s, dofs, elements,
-element (and more).  fields/: a ParaView series (step_NNNN.vtu listed in fields.pvd).
-thickness.csv: the wall thickness along the body at the last written step.
+element, units, load (what the load factor scales), monitor_quantities (and more).
+fields/: a ParaView series (step_NNNN.vtu listed in fields.pvd; surfaces_NNNN.csv the moulds
+at that step).  thickness.csv: the wall thickness along the body at the last written step;
+thickness/step_NNNN.csv every `thickness_every` steps.
 """
 
 from __future__ import annotations
@@ -27,7 +29,9 @@ class ResultsWriter:
     converged step."""
 
     def __init__(self, out: str | Path, model, monitors=(), title: str = "", every: int = 1,
-                 vtu: bool = True, gid_files: bool = False, revolved: int = 0, plots: bool = True):
+                 vtu: bool = True, gid_files: bool = False, revolved: int = 0, plots: bool = True,
+                 thickness_every: int | None = None, labels: dict | None = None):
+        """labels: units, load and monitor_quantities for summary.json (labels.case_labels)."""
         self.out = Path(out)
         self.out.mkdir(parents=True, exist_ok=True)
         self.model = model
@@ -37,6 +41,7 @@ class ResultsWriter:
         self.gid = gid_files
         self.revolved = revolved
         self.plots = plots
+        self.thickness_every = thickness_every
         self.t0 = time.perf_counter()
         self.steps = 0
         self.newton_iterations = 0
@@ -55,15 +60,23 @@ class ResultsWriter:
             "element": model.mesh.element.name,
             "load_factor": 0.0,
             "monitors": {},
+            "units": {},
+            "load": None,
+            "monitor_quantities": {},
         }
+        self.summary.update(labels or {})
         with open(self.out / "history.csv", "w", newline="") as fh:
             csv.writer(fh).writerow(["step", "load_factor", "iterations"] + [m.name for m in self.monitors])
         if vtu:
             (self.out / "fields").mkdir(exist_ok=True)
             for old in (self.out / "fields").glob("step_*.vtu"):
                 old.unlink()
-        for stale in ("thickness.csv", "contact.csv", "surfaces.csv", "fields.pvd", "revolved.vtu", "load_curve.png", "thickness.png",
-                      "deformed.png"):
+        for old in [*(self.out / "fields").glob("surfaces_*.csv"), *(self.out / "thickness").glob("step_*.csv")]:
+            old.unlink()
+        if thickness_every and model.mesh.fibres is not None:
+            (self.out / "thickness").mkdir(exist_ok=True)
+        for stale in ("thickness.csv", "contact.csv", "surfaces.csv", "fields.pvd", "revolved.vtu", "load_curve.png",
+                      "thickness.png", "deformed.png", "forming.gif"):
             (self.out / stale).unlink(missing_ok=True)
         if self.gid:
             gid.write_mesh(self.out / "axiform.post.msh", model.mesh.points, model.mesh.cells)
@@ -93,6 +106,8 @@ class ResultsWriter:
                                                  "initial_volume": float(c.V0)} for c in self.model.cavities}
         if step.number % self.every == 0:
             self._write_fields(step)
+        if self.thickness_every and step.number % self.thickness_every == 0:
+            self._write_thickness_step(step)
         self._last_step = step
         self._write_summary()
         return values
@@ -112,11 +127,7 @@ class ResultsWriter:
                 lines.append(f"{k},{node},{r:.10g},{z:.10g},{g:.6g},{p:.6g},{STATUS[int(st)]}")
             totals.append({q: rep[q] for q in ("force_r", "force_z", "contact_area", "penetration")})
         (self.out / "contact.csv").write_text("\n".join(lines) + "\n")
-        outline = ["pair,r,z"]
-        for k, pair in enumerate(self.model.contacts):
-            pts = pair.surface.polyline() + pair.surface.offset(float(step.lam))
-            outline += [f"{k},{r:.10g},{z:.10g}" for r, z in pts]
-        (self.out / "surfaces.csv").write_text("\n".join(outline) + "\n")
+        (self.out / "surfaces.csv").write_text(mould_outlines(self.model.contacts, float(step.lam)))
         self.summary["contact"] = totals
 
     def _write_fields(self, step):
@@ -126,9 +137,12 @@ class ResultsWriter:
         mesh = self.model.mesh
         self._last_written = step.number
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
-        table = thickness_table(mesh, u)
+        table = thickness_table(mesh, u, self.model.contacts)
         if table is not None:
             write_thickness_csv(self.out / "thickness.csv", table, step.number, float(step.lam))
+        if self.vtu and self.model.contacts:
+            (self.out / "fields" / f"surfaces_{step.number:04d}.csv").write_text(
+                mould_outlines(self.model.contacts, float(step.lam)))
         if not (self.vtu or self.gid):
             return
         data = point_fields(self.model, step.u)
@@ -147,6 +161,14 @@ class ResultsWriter:
             ET.SubElement(coll, "DataSet", timestep=repr(t), part="0", file=f)
         ET.ElementTree(root).write(self.out / "fields.pvd")
 
+    def _write_thickness_step(self, step):
+        """thickness/step_NNNN.csv: the thickness table of one step."""
+        u = step.u.reshape(-1, self.model.dpn)[:, :2]
+        table = thickness_table(self.model.mesh, u, self.model.contacts)
+        if table is not None:
+            write_thickness_csv(self.out / "thickness" / f"step_{step.number:04d}.csv", table, step.number,
+                                float(step.lam))
+
     def _write_revolved(self, step):
         from .revolve import revolve
 
@@ -161,6 +183,8 @@ class ResultsWriter:
         the plots."""
         if self.steps and self._last_written != self.steps:
             self._write_fields(self._last_step)
+        if self.steps and self.thickness_every and self.steps % self.thickness_every:
+            self._write_thickness_step(self._last_step)
         if self.steps and self.revolved:
             self._write_revolved(self._last_step)
         self.summary["status"] = status
@@ -171,3 +195,12 @@ class ResultsWriter:
             from .plots import plot_folder
 
             plot_folder(self.out)
+
+
+def mould_outlines(pairs, lam: float) -> str:
+    """The rigid surfaces at load factor lam as CSV text: pair, r, z per outline point."""
+    outline = ["pair,r,z"]
+    for k, pair in enumerate(pairs):
+        pts = pair.surface.polyline() + pair.surface.offset(lam)
+        outline += [f"{k},{r:.10g},{z:.10g}" for r, z in pts]
+    return "\n".join(outline) + "\n"

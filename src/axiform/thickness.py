@@ -1,25 +1,41 @@
 """Wall thickness along a layered body, from the through-thickness fibres of corner nodes
 (mesh.fibres, set by the rectangle and layered generators): the fibre's chord projected on
 the normal of the current mid-surface, so that a sheared fibre (near a clamp) is not taken
-for a thick wall."""
+for a thick wall.
+
+thickness.csv has one row per station: s (reference arc length along the wall), r, z (the
+current mid-surface), thickness, initial_thickness, ratio (= thickness / initial_thickness),
+first_contact (the time t at which a node of the station's faces first touched a mould;
+empty where never) and s_current (the current arc length of the mid-surface).
+"""
 
 from __future__ import annotations
+
+from pathlib import Path
+from typing import Sequence
 
 import numpy as np
 
 from .mesh import Mesh
 
+COLUMNS = ("s", "r", "z", "thickness", "initial_thickness", "ratio", "first_contact", "s_current")
 
-def thickness_table(mesh: Mesh, u: np.ndarray) -> dict[str, np.ndarray] | None:
-    """Per station: reference arc length s, initial and current thickness, their ratio, and
-    the current r, z of the fibre's middle.  None for meshes without fibres."""
+
+def thickness_table(mesh: Mesh, u: np.ndarray, contacts: Sequence = ()) -> dict[str, np.ndarray] | None:
+    """Per station (arrays of shape (stations,)): reference arc length s, current r, z of the
+    fibre's middle, current and initial thickness, their ratio, the time of first contact
+    of the station's faces (NaN where never) and the current arc length s_current.
+    u: nodal displacements (n, 2); contacts: the model's contact pairs.  None for meshes
+    without fibres."""
     if mesh.fibres is None:
         return None
     f = mesh.fibres
     t0, _ = _normal_thickness(mesh.points, f)
     t, mid = _normal_thickness(mesh.points + u, f)
+    s_current = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(mid, axis=0), axis=1))])
     return {"s": mesh.fibre_s, "r": mid[:, 0], "z": mid[:, 1], "thickness": t,
-            "initial_thickness": t0, "ratio": t / t0}
+            "initial_thickness": t0, "ratio": t / t0,
+            "first_contact": first_contact(mesh, contacts), "s_current": s_current}
 
 
 def _normal_thickness(x: np.ndarray, fibres: np.ndarray):
@@ -31,8 +47,53 @@ def _normal_thickness(x: np.ndarray, fibres: np.ndarray):
     return np.abs(np.einsum("ij,ij->i", top - bottom, normal)), mid
 
 
-def write_thickness_csv(path, table: dict[str, np.ndarray], step: int, load_factor: float) -> None:
-    names = ["s", "r", "z", "thickness", "initial_thickness", "ratio"]
-    header = f"# step {step}, load_factor {load_factor!r}\n" + ",".join(names)
-    np.savetxt(path, np.column_stack([table[n] for n in names]), delimiter=",", header=header,
-               comments="", fmt="%.10g")
+def contact_times(mesh: Mesh, contacts: Sequence) -> np.ndarray | None:
+    """(n,) the time of first contact of every node, the earliest over the pairs (each
+    pair's `first_contact`: an array over pair.nodes, NaN where never); NaN where never.
+    None when no pair records contact times."""
+    pairs = [p for p in contacts if getattr(p, "first_contact", None) is not None]
+    if not pairs:
+        return None
+    when = np.full(mesh.n_nodes, np.inf)
+    for pair in pairs:
+        times = np.asarray(pair.first_contact, float)
+        np.minimum.at(when, pair.nodes, np.where(np.isnan(times), np.inf, times))
+    return np.where(np.isinf(when), np.nan, when)
+
+
+def first_contact(mesh: Mesh, contacts: Sequence) -> np.ndarray:
+    """(stations,) the earliest time of first contact of the slave nodes that end the
+    station's fibre (on either face); NaN where never or without contact."""
+    when = contact_times(mesh, contacts)
+    if when is None:
+        return np.full(len(mesh.fibres), np.nan)
+    return np.fmin(when[mesh.fibres[:, 0]], when[mesh.fibres[:, -1]])
+
+
+def nodal_thickness(mesh: Mesh, table: dict[str, np.ndarray]) -> np.ndarray:
+    """(n,) the thickness at every node: that of its station, linear between stations (the
+    mid-side nodes of Q8 lie between two)."""
+    return np.interp(mesh.node_s, table["s"], table["thickness"])
+
+
+def default_wall(points: np.ndarray, loaded_edges: Sequence[np.ndarray]) -> str:
+    """The direction through the wall of a rectangle: normal to the faces that carry the
+    pressure ("z" for edges along r, "r" for edges along z, by loaded length), "z" when
+    nothing decides.  loaded_edges: arrays of edge nodes (m, edge_nodes), ends first."""
+    along_r = along_z = 0.0
+    for edges in loaded_edges:
+        d = np.abs(points[edges[:, 1]] - points[edges[:, 0]])
+        along_r += d[d[:, 0] > d[:, 1], 0].sum()
+        along_z += d[d[:, 1] > d[:, 0], 1].sum()
+    return "r" if along_z > along_r else "z"
+
+
+def write_thickness_csv(path: str | Path, table: dict[str, np.ndarray], step: int, load_factor: float) -> None:
+    """thickness.csv: a first line '# step N, load_factor L', the header row, one row per
+    station; first_contact is left empty where never."""
+    rows = np.column_stack([table[n] for n in COLUMNS])
+    text = np.char.mod("%.10g", rows)
+    text[np.isnan(rows)] = ""
+    lines = [f"# step {step}, load_factor {load_factor!r}", ",".join(COLUMNS)]
+    lines += [",".join(row) for row in text]
+    Path(path).write_text("\n".join(lines) + "\n")

@@ -1,0 +1,118 @@
+"""What the numbers of a results folder are: the case's units, the physical quantity that
+the load factor lambda scales, and the quantity of each monitor.  The results writer puts
+them in summary.json (`units`, `load`, `monitor_quantities`), so that `axiform plot DIR`
+labels every axis from the folder alone.
+
+`load` is None (the axis is the load factor) or a dict: {"quantity": "pressure" | "force" |
+"displacement", "value": v, "name": label, "curve": [[t, f], ...]} (the loaded quantity is
+v f(lambda), f(lambda) = lambda without a curve), or {"quantity": "pressure", "monitor":
+column} when a cavity pressure monitor of history.csv carries it.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+QUANTITY_UNIT = {"pressure": "pressure", "stress": "pressure", "force": "force", "displacement": "length",
+                 "length": "length", "time": "time"}  # quantity -> key of [units]
+
+
+def case_labels(case: Any) -> dict[str, Any]:
+    """units, load and monitor_quantities of a validated case (axiform.case.Case)."""
+    return {"units": {k: v for k, v in case.units.model_dump().items() if v},
+            "load": loaded_quantity(case),
+            "monitor_quantities": {m.name: monitor_quantity(m) for m in case.monitor}}
+
+
+def monitor_quantity(m: Any) -> str:
+    """"displacement", "rotation", "force", "area", "pressure" or "volume" of a monitor spec."""
+    cavity_quantity = getattr(m, "cavity", None) is not None and m.quantity
+    if cavity_quantity:
+        return cavity_quantity
+    if m.contact is not None:
+        return {"force-r": "force", "force-z": "force", "area": "area"}.get(m.quantity, "displacement")
+    if m.reaction is not None:
+        return "force"
+    return "rotation" if m.dof == "rot" else "displacement"
+
+
+def _curve(spec: Any) -> list | None:
+    curve = getattr(spec, "curve", None)
+    return None if curve is None else [list(map(float, knot)) for knot in curve]
+
+
+def _scaled(quantity: str, value: float, name: str, curve: list | None) -> dict[str, Any]:
+    out = {"quantity": quantity, "value": float(value), "name": name}
+    if curve is not None:
+        out["curve"] = curve
+    return out
+
+
+def loaded_quantity(case: Any) -> dict[str, Any] | None:
+    """The physical quantity lambda scales, in this order: a cavity pressure monitor, a
+    cavity under pressure control, the pressures (the largest, named by its table when they
+    differ), the point loads, the prescribed displacements and mould motions; None when there
+    is none."""
+    for m in case.monitor:
+        if getattr(m, "cavity", None) is not None and m.quantity == "pressure":
+            return {"quantity": "pressure", "monitor": m.name, "name": f"{m.cavity} pressure"}
+    for c in getattr(case, "cavity", []):
+        if c.control == "pressure" and c.pressure:
+            return _scaled("pressure", c.pressure, f"{c.name} pressure", _curve(c))
+    for kind, specs in (("pressure", case.pressure), ("force", case.point_load)):
+        if specs:
+            k = int(np.argmax([abs(p.value) for p in specs]))
+            same = all(p.value == specs[k].value and _curve(p) == _curve(specs[k]) for p in specs)
+            name = kind if same else f"{kind}[{k}]"
+            return _scaled(kind, specs[k].value, name, _curve(specs[k]))
+    for i, f in enumerate(case.fix):
+        if f.value:
+            return _scaled("displacement", f.value, f"fix[{i}] {', '.join(f.dofs)}", _curve(f))
+    for i, c in enumerate(case.contact):
+        ur, uz = c.motion.ur, c.motion.uz
+        if ur or uz:
+            dof = "uz" if abs(uz) >= abs(ur) else "ur"
+            return _scaled("displacement", uz if dof == "uz" else ur, f"mould {i} displacement {dof}", _curve(c.motion))
+    return None
+
+
+def load_values(load: dict[str, Any], lam: np.ndarray) -> np.ndarray:
+    """The loaded quantity v f(lambda) at the load factors lam (a value-scaled load)."""
+    lam = np.asarray(lam, float)
+    curve = load.get("curve")
+    if curve is None:
+        return load["value"] * lam
+    t, f = np.asarray(curve, float).T
+    return load["value"] * np.interp(lam, t, f)
+
+
+def unit_of(quantity: str, units: dict[str, str]) -> str:
+    """The unit of a quantity from the case's [units] ("" when not given): area and volume
+    are length squared and cubed, rotations are in rad."""
+    length = units.get("length")
+    if quantity == "area":
+        return f"{length}²" if length else ""
+    if quantity == "volume":
+        return f"{length}³" if length else ""
+    if quantity == "rotation":
+        return "rad"
+    return units.get(QUANTITY_UNIT.get(quantity, ""), "")
+
+
+def with_unit(label: str, quantity: str, units: dict[str, str]) -> str:
+    """'label (unit)', or the label alone when the unit is not known."""
+    unit = unit_of(quantity, units)
+    return f"{label} ({unit})" if unit else label
+
+
+def short(value: float) -> str:
+    """A number rounded for a title: three significant digits (172, 33.4, 0.0276), an
+    exponent only below 1e-3 or from 1e5 on."""
+    a = float(f"{abs(value):.3g}")
+    if a == 0:
+        return "0"
+    if a < 1e-3 or a >= 1e5:
+        return f"{value:.2e}"
+    return f"{value:.{max(0, 2 - int(np.floor(np.log10(a))))}f}"
