@@ -5,7 +5,9 @@ An invalid case raises CaseError naming the key path and the reason, before any 
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import io
 import itertools
 import json
 import tomllib
@@ -500,12 +502,15 @@ def _mesh(spec: MeshSpec, base: Path) -> Mesh:
     path = path if path.is_absolute() else base / path
     if not path.exists():
         raise CaseError(f"mesh.file: no such file {path}")
+    said = io.StringIO()  # meshio prints its warnings and errors itself
     try:
-        return read_gmsh(path, spec.element)
-    except MeshError:
-        raise
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            return read_gmsh(path, spec.element)
+    except MeshError as exc:
+        raise CaseError(f"mesh.file: {exc}") from None
     except (Exception, SystemExit) as exc:  # noqa: BLE001 - meshio raises anything (and calls sys.exit) on bad files
-        raise CaseError(f"mesh.file: cannot read {path} ({type(exc).__name__}: {exc})") from None
+        why = f"{type(exc).__name__}: {exc}" if not isinstance(exc, SystemExit) else said.getvalue().strip()
+        raise CaseError(f"mesh.file: cannot read {path} as a gmsh mesh ({' '.join(why.split())})") from None
 
 
 def default_penalty(material: MooneyRivlin, mesh: Mesh) -> float:
@@ -592,7 +597,7 @@ def _fix(model: Model, mesh: Mesh, fixes: list[FixSpec]) -> None:
             if clash.any():
                 k = int(np.argmax(clash))
                 raise CaseError(f"fix[{i}].value: {name} of node {int(nodes[k])} is also prescribed by "
-                                f"fix[{owner[d][k]}], with value {value[d][k]!r}, not {f.value!r}")
+                                f"fix[{owner[d][k]}], with value {float(value[d][k])!r}, not {f.value!r}")
             owner[d], value[d] = i, f.value
         model.prescribe(nodes, f.dofs, f.value)
 
