@@ -330,10 +330,12 @@ def test_plot_refuses_unreadable_history_and_unknown_fields(tmp_path, capsys):
     assert main(["plot", str(out), "--field", "nonsense"]) == 2
     assert "--field: no field 'nonsense'" in capsys.readouterr().err
     assert {p.name: p.stat().st_mtime_ns for p in out.glob("*.png")} == pngs  # nothing rewritten
+    (out / "fields.pvd").write_text("<VTKFile><Collection>")
+    assert main(["plot", str(out)]) == 2
     (out / "history.csv").write_text("step,load_factor,iterations,w\n1,abc,3,0.1\n")
     assert main(["plot", str(out)]) == 2
     err = capsys.readouterr().err
-    assert "unreadable results" in err and "Traceback" not in err
+    assert err.count("unreadable results") == 2 and "Traceback" not in err
 
 
 # ---- guarded numerics -----------------------------------------------------------------------
@@ -349,6 +351,43 @@ def test_a_mechanism_never_converges_through_the_python_api():
     result = solve(model, built.control, built.options)
     assert result.status == "stopped" and not result.steps
     assert "step 1:" in result.message and "a mechanism" in result.message
+
+
+HELD_BY_A_MOULD_ONLY = """
+[mesh]
+r = [0.0, 2.0]
+z = [0.0, 0.2]
+divisions = [4, 1]
+element = "q4"
+[material]
+model = "neo-hooke"
+C1 = 10.0
+kappa = 1000.0
+[[fix]]
+at = { r = 0.0 }
+dofs = ["ur"]
+[[pressure]]
+on = { z = 0.0 }
+value = 1.0
+[[contact]]
+surface = { polyline = [[3.0, 1.0], [0.0, 1.0]] }
+slaves = { z = 0.2 }
+[solver]
+control = "arc-length"
+steps = 3
+[output]
+plots = false
+"""
+
+
+def test_a_body_held_only_by_an_open_mould_stops_before_the_first_step(tmp_path, capsys):
+    """The case check lets contact count as a support; the mould is not touched yet, so the
+    arc length's first tangent meets the free translation: stopped (exit 1), not a crash."""
+    (tmp_path / "mould.toml").write_text(HELD_BY_A_MOULD_ONLY)
+    assert main(["run", str(tmp_path / "mould.toml"), "--out", str(tmp_path / "out"), "-q"]) == 1
+    err = capsys.readouterr().err
+    assert "before the first step: a mechanism" in err and "Traceback" not in err
+    assert summary(tmp_path / "out")["status"] == "stopped"
 
 
 def test_non_finite_residual_names_node_and_element():

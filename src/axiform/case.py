@@ -11,6 +11,7 @@ import io
 import itertools
 import json
 import tomllib
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -359,12 +360,17 @@ class Case(Strict):
     output: OutputSpec = OutputSpec()
 
 
+# the names pydantic gives the members of a union in an error's location: not keys
+_PYDANTIC_TAGS = ("function-", "tuple[", "list[", "dict[", "constrained-", "lax-or-strict[", "json-or-python[",
+                  "tagged-union[", "union[", "nullable[", "is-instance[", "literal[")
+
+
 def _loc(loc: tuple) -> str:
     out = ""
     for part in loc:
         if isinstance(part, int):
             out += f"[{part}]"
-        elif part in ("function-after",) or str(part).startswith(("function-", "tuple[", "list[")):
+        elif str(part).startswith(_PYDANTIC_TAGS) or part in ("float", "int", "str", "bool"):
             continue
         else:
             out += ("." if out else "") + str(part)
@@ -539,9 +545,13 @@ def _surface(spec: SurfaceSpec, motion: tuple[float, float], base: Path, where: 
         path = Path(spec.file)
         path = path if path.is_absolute() else base / path
         try:
-            points = np.loadtxt(path, delimiter=",", ndmin=2, comments="#")
+            with warnings.catch_warnings():  # an empty file: refused below, not warned about
+                warnings.simplefilter("ignore", UserWarning)
+                points = np.loadtxt(path, delimiter=",", ndmin=2, comments="#")
         except (OSError, ValueError) as exc:
             raise CaseError(f"{where}.surface.file: cannot read {path} as r, z rows ({exc})") from None
+        if points.size == 0:
+            raise CaseError(f"{where}.surface.file: {path} holds no r, z rows")
         if points.shape[1] != 2:
             raise CaseError(f"{where}.surface.file: {path} must have two columns, r and z")
         bad = np.flatnonzero(~np.isfinite(points).all(axis=1))

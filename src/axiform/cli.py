@@ -18,10 +18,12 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Self
 
+import numpy as np
+
 from . import __version__
 from .case import CaseError, build, fingerprint, parse, read
 from .results import NonFiniteResult, ResultsWriter
-from .solver import solve
+from .solver import StepFailed, solve
 
 EXIT = {"finished": 0, "stopped": 1, "failed": 3}
 
@@ -209,6 +211,8 @@ def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], st
         status, message = "interrupted", f"{exc}; every converged step is kept"
     except NonFiniteResult as exc:
         status, message = "stopped", str(exc)
+    except StepFailed as exc:  # the path could not even start (arc length's first tangent)
+        status, message = "stopped", f"before the first step: {exc}"
     except Exception as exc:  # noqa: BLE001 - any other error: status "failed", exit 3
         if writer is None:  # the results folder could not be started
             return _failed(exc, f"failed while starting {out_dir}")
@@ -282,7 +286,7 @@ def plot(folder: str, field: str) -> int:
     try:
         read_history(path / "history.csv")
         fields = _fields_of(path)
-    except (OSError, ValueError, KeyError, IndexError) as exc:
+    except (OSError, ValueError, KeyError, IndexError, SyntaxError) as exc:  # SyntaxError: XML
         _say(f"axiform: {folder}: unreadable results ({type(exc).__name__}: {exc})")
         return 2
     if fields is not None and field not in fields:
@@ -326,11 +330,12 @@ def main(argv: list[str] | None = None) -> int:
                              "default von_mises)")
     args = parser.parse_args(argv)
     try:
-        if args.command == "plot":
-            return plot(args.folder, args.field)
-        if args.command == "run":
-            return run(args.case, args.out, args.quiet, args.set)
-        return check(args.case, args.set)
+        with np.errstate(all="ignore"):  # overflow and NaN are caught by the guards, not printed
+            if args.command == "plot":
+                return plot(args.folder, args.field)
+            if args.command == "run":
+                return run(args.case, args.out, args.quiet, args.set)
+            return check(args.case, args.set)
     except KeyboardInterrupt:
         _say("axiform: interrupted")
         return 130

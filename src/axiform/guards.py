@@ -45,8 +45,10 @@ def _crossing_pairs(a: np.ndarray, b: np.ndarray, skip: np.ndarray, block: int =
     end); skip is a function of two index arrays returning a boolean array.  Work in blocks
     of rows, so memory stays at block * n."""
     n = len(a)
-    scale = max(float(np.ptp(np.vstack([a, b]), axis=0).max()), 1e-300)
-    eps = 1e-12 * scale * scale
+    both = np.vstack([a, b])
+    lo, scale = both.min(axis=0), float(np.ptp(both, axis=0).max())
+    a, b = (a - lo) / (scale or 1.0), (b - lo) / (scale or 1.0)  # in a unit box: no overflow
+    eps = 1e-12
 
     def orient(p, q, r):
         return (q[..., 0] - p[..., 0]) * (r[..., 1] - p[..., 1]) - (q[..., 1] - p[..., 1]) * (r[..., 0] - p[..., 0])
