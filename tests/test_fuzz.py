@@ -10,7 +10,7 @@ node or several nodes; moulds with one point, repeated points, crossing polyline
 their circle, CSV files with text, NaN or one column; gmsh files missing, empty, corrupt,
 binary or holding triangles only; TOML that does not parse, binary and non-UTF-8 files.
 
-In the suite: AXIFORM_FUZZ_EXAMPLES cases (default 600, about 15 s), derandomized so the run
+In the suite: AXIFORM_FUZZ_EXAMPLES cases (default 600, about 8 s), derandomized so the run
 is the same each time.  The long run (README): AXIFORM_FUZZ_EXAMPLES=10000 AXIFORM_FUZZ_SEED=
 <any> python -m pytest -s tests/test_fuzz.py (prints the exit codes met).
 """
