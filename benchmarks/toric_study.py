@@ -222,7 +222,7 @@ def read_history(folder: Path) -> dict[str, np.ndarray]:
 
 
 def read_thickness(folder: Path) -> dict[str, np.ndarray]:
-    data = np.genfromtxt(folder / "thickness.csv", delimiter=",", names=True, skip_header=1)
+    data = np.genfromtxt(folder / "thickness.csv", delimiter=",", names=True)
     return {k: data[k] for k in ("s", "r", "z", "thickness", "initial_thickness", "ratio")}
 
 

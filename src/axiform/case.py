@@ -5,22 +5,36 @@ An invalid case raises CaseError naming the key path and the reason, before any 
 
 from __future__ import annotations
 
+import contextlib
+import hashlib
+import io
+import itertools
+import json
 import tomllib
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from .cavity import CavityError
 from .contact.pair import ContactPair
 from .curves import PROPORTIONAL, Curve
 from .contact.surfaces import Circle, Polyline
+from .guards import boundary_crossing, chain_crossing, free_to_slide, not_numbers
 from .materials import MooneyRivlin
 from .mesh import Mesh, MeshError, layered, read_gmsh, rectangle
-from .profile import Arc, Line, Profile, ProfileError
 from .model import Model
+from .profile import Arc, Line, Profile, ProfileError
 from .selectors import SelectorError, select_edges, select_nodes
 from .solver import ArcLengthControl, DisplacementControl, LoadControl, NewtonOptions
 from .thickness import default_wall
@@ -117,7 +131,7 @@ class MeshSpec(Strict):
                 raise ValueError("r must be >= 0 (the meridian plane)")
         if self.kind == "layered" and isinstance(self.thickness, list):
             s = [row[0] for row in self.thickness]
-            if any(b <= a for a, b in zip(s, s[1:])):
+            if any(b <= a for a, b in itertools.pairwise(s)):
                 raise ValueError("thickness table: arc lengths must increase")
         return self
 
@@ -223,6 +237,9 @@ class CavitySpec(CurveMixin):
         return {"pressure": self.pressure, "volume": self.volume, "gas": self.content}[self.control]
 
 
+HISTORY_COLUMNS = ("step", "load_factor", "iterations")  # history.csv's first columns
+
+
 class MonitorSpec(Strict):
     """One node's displacement (at + dof), the reaction summed over nodes (reaction + dof), or
     a quantity of a contact pair (contact = index of the [[contact]] table + quantity)."""
@@ -234,6 +251,14 @@ class MonitorSpec(Strict):
     contact: Annotated[int, Field(ge=0)] | None = None
     cavity: str | None = None
     quantity: Literal["force-r", "force-z", "area", "penetration", "pressure", "volume"] | None = None
+
+    @field_validator("name")
+    @classmethod
+    def _name(cls, name: str) -> str:
+        if not name.strip() or name in HISTORY_COLUMNS or name != name.strip():
+            raise ValueError(f"{name!r}: a monitor name must not be empty, begin or end with blanks, or be "
+                             f"one of the columns {', '.join(HISTORY_COLUMNS)}")
+        return name
 
     @model_validator(mode="after")
     def _one(self):
@@ -412,12 +437,17 @@ class Case(Strict):
     units: UnitsSpec = UnitsSpec()
 
 
+# the names pydantic gives the members of a union in an error's location: not keys
+_PYDANTIC_TAGS = ("function-", "tuple[", "list[", "dict[", "constrained-", "lax-or-strict[", "json-or-python[",
+                  "tagged-union[", "union[", "nullable[", "is-instance[", "literal[")
+
+
 def _loc(loc: tuple) -> str:
     out = ""
     for part in loc:
         if isinstance(part, int):
             out += f"[{part}]"
-        elif part in ("function-after",) or str(part).startswith(("function-", "tuple[", "list[")):
+        elif str(part).startswith(_PYDANTIC_TAGS) or part in ("float", "int", "str", "bool"):
             continue
         else:
             out += ("." if out else "") + str(part)
@@ -425,9 +455,15 @@ def _loc(loc: tuple) -> str:
 
 
 def parse(data: dict[str, Any]) -> Case:
-    """Validate a case given as a dict; CaseError lists every problem with its key path."""
+    """Validate a case given as a dict (as TOML reads it); CaseError lists every problem with
+    its key path.  Every number must be finite, and types are strict: no "80" for 80.0, no
+    true for 1 (the tree goes through JSON, whose strict mode still takes arrays for tuples
+    and integers for floats)."""
+    bad = not_numbers(data)
+    if bad:
+        raise CaseError("\n".join(bad))
     try:
-        return Case.model_validate(data)
+        return Case.model_validate_json(json.dumps(data), strict=True)
     except ValidationError as exc:
         lines = []
         for err in exc.errors():
@@ -457,7 +493,7 @@ def override(data: dict[str, Any], assignment: str) -> None:
                 raise CaseError(f"--set {key}: bad index in '{part}'")
             parts.append(int(index[:-1]))
     node: Any = data
-    for p, nxt in zip(parts[:-1], parts[1:]):
+    for p, nxt in itertools.pairwise(parts):
         if isinstance(p, int):
             if not isinstance(node, list) or p >= len(node):
                 raise CaseError(f"--set {key}: there is no entry {p}")
@@ -474,16 +510,33 @@ def override(data: dict[str, Any], assignment: str) -> None:
 
 def load(path: str | Path, overrides: list[str] = ()) -> Case:
     """Read and validate a TOML case file, with optional KEY=VALUE overrides."""
+    return parse(read(path, overrides))
+
+
+def fingerprint(data: dict[str, Any]) -> str:
+    """SHA-256 of a case tree (after overrides): equal for texts that differ only in comments,
+    layout or key order."""
+    return hashlib.sha256(json.dumps(data, sort_keys=True, default=str).encode()).hexdigest()
+
+
+def read(path: str | Path, overrides: list[str] = ()) -> dict[str, Any]:
+    """The tree of a TOML case file with KEY=VALUE overrides applied, not yet validated."""
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(path.read_bytes().decode("utf-8"))
     except FileNotFoundError:
         raise CaseError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise CaseError(f"{path}: is a directory, not a case file") from None
+    except OSError as exc:
+        raise CaseError(f"{path}: cannot read it ({exc.strerror or exc})") from None
+    except UnicodeDecodeError as exc:
+        raise CaseError(f"{path}: not UTF-8 text (byte {exc.start}): a case file is TOML text") from None
     except tomllib.TOMLDecodeError as exc:
         raise CaseError(f"{path}: not valid TOML ({exc})") from None
     for assignment in overrides:
         override(data, assignment)
-    return parse(data)
+    return data
 
 
 _CONTACT_QUANTITY = {"force-r": "force_r", "force-z": "force_z", "area": "contact_area",
@@ -535,12 +588,15 @@ def _mesh(spec: MeshSpec, base: Path) -> Mesh:
     path = path if path.is_absolute() else base / path
     if not path.exists():
         raise CaseError(f"mesh.file: no such file {path}")
+    said = io.StringIO()  # meshio prints its warnings and errors itself
     try:
-        return read_gmsh(path, spec.element)
-    except MeshError:
-        raise
-    except Exception as exc:  # meshio's own errors for unreadable files
-        raise CaseError(f"mesh.file: cannot read {path} ({exc})") from None
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            return read_gmsh(path, spec.element)
+    except MeshError as exc:
+        raise CaseError(f"mesh.file: {exc}") from None
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 - meshio raises anything (and calls sys.exit) on bad files
+        why = f"{type(exc).__name__}: {exc}" if not isinstance(exc, SystemExit) else said.getvalue().strip()
+        raise CaseError(f"mesh.file: cannot read {path} as a gmsh mesh ({' '.join(why.split())})") from None
 
 
 def default_penalty(material: MooneyRivlin, mesh: Mesh) -> float:
@@ -569,19 +625,38 @@ def _surface(spec: SurfaceSpec, motion: tuple[float, float], base: Path, where: 
         path = Path(spec.file)
         path = path if path.is_absolute() else base / path
         try:
-            points = np.loadtxt(path, delimiter=",", ndmin=2, comments="#")
+            with warnings.catch_warnings():  # an empty file: refused below, not warned about
+                warnings.simplefilter("ignore", UserWarning)
+                points = np.loadtxt(path, delimiter=",", ndmin=2, comments="#")
         except (OSError, ValueError) as exc:
             raise CaseError(f"{where}.surface.file: cannot read {path} as r, z rows ({exc})") from None
+        if points.size == 0:
+            raise CaseError(f"{where}.surface.file: {path} holds no r, z rows")
         if points.shape[1] != 2:
             raise CaseError(f"{where}.surface.file: {path} must have two columns, r and z")
+        bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
+        if bad.size:
+            raise CaseError(f"{where}.surface.file: {path} row {bad[0] + 1} of the data is not two finite numbers")
     try:
         return Polyline(motion=motion, points=points)
     except ValueError as exc:
         raise CaseError(f"{where}.surface: {exc}") from None
 
 
+def _uncrossed(surface, where: str):
+    """Refuse a mould outline (sampled arcs included) that crosses or runs back over itself."""
+    if isinstance(surface, Polyline):
+        pts = surface.polyline()
+        found = chain_crossing(pts)
+        if found is not None:
+            i, j = found
+            raise CaseError(f"{where}.surface: the outline crosses or runs back over itself (near r, z = "
+                            f"{pts[i][0]:.6g}, {pts[i][1]:.6g} and {pts[j][0]:.6g}, {pts[j][1]:.6g})")
+    return surface
+
+
 def _contact(mesh: Mesh, model: Model, spec: ContactSpec, base: Path, where: str) -> ContactPair:
-    surface = _surface(spec.surface, (spec.motion.ur, spec.motion.uz), base, where)
+    surface = _uncrossed(_surface(spec.surface, (spec.motion.ur, spec.motion.uz), base, where), where)
     surface.curve = spec.motion.build_curve()
     slaves = select_nodes(mesh, spec.slaves.model_dump(), f"{where}.slaves")
     penalty = spec.penalty if spec.penalty is not None else default_penalty(model.material, mesh)
@@ -599,18 +674,47 @@ def _one_node(mesh: Mesh, sel: Selector, where: str) -> int:
     return int(nodes[0])
 
 
+def _fix(model: Model, mesh: Mesh, fixes: list[FixSpec]) -> None:
+    """Prescribe the [[fix]] tables; two tables giving one dof different values are refused."""
+    owner = np.full(model.n_full, -1)
+    value = np.zeros(model.n_full)
+    for i, f in enumerate(fixes):
+        nodes = select_nodes(mesh, f.at.model_dump(), f"fix[{i}].at")
+        for name in f.dofs:
+            if name == "rot" and model.dpn == 2:
+                continue
+            d = model.dof(nodes, name)
+            clash = (owner[d] >= 0) & (value[d] != f.value)
+            if clash.any():
+                k = int(np.argmax(clash))
+                raise CaseError(f"fix[{i}].value: {name} of node {int(nodes[k])} is also prescribed by "
+                                f"fix[{owner[d][k]}], with value {float(value[d][k])!r}, not {f.value!r}")
+            owner[d], value[d] = i, f.value
+        model.prescribe(nodes, f.dofs, f.value, f.build_curve())
+
+
 def build(case: Case, base: str | Path = ".") -> Built:
     """Turn a validated case into a finalized model; errors name the key at fault."""
     base = Path(base)
     try:
         mesh = _mesh(case.mesh, base)
-        model = Model(mesh, case.material.build(), formulation=case.mesh.formulation,
-                      sfr_edges=case.mesh.sfr_edges)
     except MeshError as exc:
         raise CaseError(f"mesh: {exc}") from None
     try:
-        for i, f in enumerate(case.fix):
-            model.prescribe(select_nodes(mesh, f.at.model_dump(), f"fix[{i}].at"), f.dofs, f.value, f.build_curve())
+        material = case.material.build()
+    except ValueError as exc:
+        raise CaseError(f"material: {exc}") from None
+    try:
+        model = Model(mesh, material, formulation=case.mesh.formulation, sfr_edges=case.mesh.sfr_edges)
+    except MeshError as exc:
+        raise CaseError(f"mesh: {exc}") from None
+    crossing = boundary_crossing(mesh.points, mesh.boundary_edges)
+    if crossing is not None:
+        p = mesh.points[mesh.boundary_edges[crossing[0], 0]]
+        raise CaseError(f"mesh: the boundary crosses itself near r, z = {p[0]:.6g}, {p[1]:.6g} "
+                        f"(a profile that crosses itself, or overlapping elements)")
+    try:
+        _fix(model, mesh, case.fix)
         for i, p in enumerate(case.pressure):
             model.pressure(select_edges(mesh, p.on.model_dump(), f"pressure[{i}].on"), p.value, p.build_curve())
         for i, pl in enumerate(case.point_load):
@@ -671,16 +775,25 @@ def build(case: Case, base: str | Path = ".") -> Built:
             control = LoadControl(1.0 if s.target is None else s.target, s.steps)
         moving = any(c.motion.ur or c.motion.uz for c in case.contact)
         gas = any(c.control != "pressure" or c.pressure for c in case.cavity)
-        if not case.pressure and not case.point_load and not any(f.value for f in case.fix) and not moving \
-                and not gas:
-            raise CaseError("nothing loads the model: give [[pressure]], [[point_load]], a [[fix]] with a "
-                            "value, a moving [[contact]] surface or a [[cavity]]")
+        loads = [*case.pressure, *case.point_load, *case.fix]
+        if not any(item.value for item in loads) and not moving and not gas:
+            raise CaseError("pressure: nothing loads the model: every [[pressure]], [[point_load]] and [[fix]] "
+                            "value is zero (or absent), no [[contact]] surface moves and no [[cavity]] is loaded")
     except SelectorError as exc:
         raise CaseError(str(exc)) from None
+    held_uz = [d // model.dpn for d in model.fixed if d % model.dpn == 1]
+    touching = np.concatenate([p.nodes for p in pairs]) if pairs else np.zeros(0, np.int64)
+    free = free_to_slide(mesh.n_nodes, mesh.cells, np.array(held_uz, np.int64), touching)
+    if free:
+        raise CaseError(f"fix: a mechanism: {len(free)} bod{'y' if len(free) == 1 else 'ies'} of the mesh can "
+                        "move rigidly along z (no [[fix]] holds uz on it and no [[contact]] touches it)")
     if case.mesh.kind == "rectangle":  # the wall is normal to the faces that carry the pressure
         loaded = model.pressures + getattr(model, "cavities", [])
         mesh.set_wall(case.mesh.wall or default_wall(mesh.points, [p.nodes for p in loaded]))
-    model.finalize()
+    try:
+        model.finalize()
+    except ValueError as exc:  # a tied fibre rotation prescribed twice
+        raise CaseError(f"fix: {exc}") from None
     options = NewtonOptions(tolerance=s.tolerance, max_iterations=s.max_iterations,
                             min_step=s.min_step, growth=s.growth)
     return Built(case, model, control, options, monitors)

@@ -1,38 +1,103 @@
-"""`axiform run CASE.toml --out DIR`, `axiform check CASE.toml`, `axiform plot DIR`.
+"""`axiform run CASE.toml [--out DIR]`, `axiform check CASE.toml`, `axiform plot DIR`.
 
-Exit codes: 0 finished, 1 stopped short (converged steps kept), 2 invalid case.
+Exit codes: 0 finished, 1 stopped (converged steps kept), 2 invalid case (refused before any
+work), 3 failed (an unexpected error), 130 / 143 interrupted by SIGINT / SIGTERM.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
+import signal
 import sys
+import threading
 import time
+import traceback
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Self
+
+import numpy as np
 
 from . import __version__
-from .case import CaseError, build, load
+from .case import CaseError, build, fingerprint, parse, read
 from .labels import case_labels
-from .results import ResultsWriter
-from .solver import solve
+from .results import NonFiniteResult, ResultsWriter
+from .solver import StepFailed, solve
+
+EXIT = {"finished": 0, "stopped": 1, "failed": 3}
+
+
+class Interrupted(Exception):
+    """SIGINT or SIGTERM arrived; signum says which."""
+
+    def __init__(self, signum: int):
+        self.signum = signum
+        super().__init__(f"interrupted by {signal.Signals(signum).name}")
+
+
+class Stops:
+    """While active (a `with` block), SIGINT and SIGTERM raise Interrupted where the program
+    is, except inside `held()` blocks (a result file being written): there the signal waits
+    for the block's end.  Later signals are ignored while the run winds up."""
+
+    def __init__(self):
+        self.signum: int | None = None
+        self.raised = False
+        self.depth = 0
+        self._old = {}
+
+    def __enter__(self) -> Self:
+        if threading.current_thread() is threading.main_thread():
+            for s in (signal.SIGINT, signal.SIGTERM):
+                self._old[s] = signal.signal(s, self._handle)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        for s, handler in self._old.items():
+            signal.signal(s, handler)
+
+    def _handle(self, signum, frame) -> None:
+        self.signum = self.signum or signum
+        if not self.depth and not self.raised:
+            self.raised = True
+            raise Interrupted(signum)
+
+    @contextmanager
+    def held(self):
+        self.depth += 1
+        try:
+            yield
+        finally:
+            self.depth -= 1
+        if not self.depth and self.signum is not None and not self.raised:
+            self.raised = True
+            raise Interrupted(self.signum)
 
 
 class Progress:
-    """One line per converged step on a terminal (rewritten in place), a summary at the end."""
+    """One line per converged step: on a terminal rewritten in place, elsewhere (a log, CI)
+    printed line after line; nothing with -q."""
 
     def __init__(self, stream, quiet: bool):
         self.stream = stream
+        self.quiet = quiet
         self.tty = stream.isatty() and not quiet
         self.t0 = time.perf_counter()
 
     def __call__(self, step, frac: float, values: dict[str, float]):
-        if not self.tty:
+        if self.quiet:
             return
-        frac = min(max(frac, 0.0), 1.0)
-        bar = "#" * int(30 * frac) + "-" * (30 - int(30 * frac))
         mon = "  ".join(f"{k} {v:.4g}" for k, v in list(values.items())[:3])
-        self.stream.write(f"\r[{bar}] {100 * frac:5.1f}%  step {step.number}  lambda {step.lam:.5g}  "
-                          f"its {step.iterations}  {mon}  {time.perf_counter() - self.t0:.1f} s\x1b[K")
+        text = (f"step {step.number}  lambda {step.lam:.5g}  its {step.iterations}  {mon}  "
+                f"{time.perf_counter() - self.t0:.1f} s")
+        if self.tty:
+            frac = min(max(frac, 0.0), 1.0)
+            bar = "#" * int(30 * frac) + "-" * (30 - int(30 * frac))
+            self.stream.write(f"\r[{bar}] {100 * frac:5.1f}%  {text}\x1b[K")
+        else:
+            self.stream.write(text + "\n")
         self.stream.flush()
 
     def close(self):
@@ -40,19 +105,81 @@ class Progress:
             self.stream.write("\n")
 
 
-def run(case_path: str, out: str | None, quiet: bool = False, overrides: list[str] = ()) -> int:
-    case_file = Path(case_path)
+def _say(*lines: str) -> None:
+    print(*lines, sep="\n", file=sys.stderr)
+
+
+def _invalid(case_file: Path, exc: CaseError) -> int:
+    _say(f"axiform: invalid case {case_file}:", str(exc))
+    return 2
+
+
+def results_folder(case_file: Path, digest: str, root: Path = Path("results")) -> tuple[Path, str]:
+    """The default results folder: root/<case name>/, or root/<case name>-<n>/ (n = 2, 3, ...)
+    when that one holds the results of another case (another fingerprint in its summary.json,
+    or no readable one).  Returns the folder and, when it is not the first choice, why."""
+    name = case_file.stem
+    for n in range(1, 10**6):
+        folder = root / (name if n == 1 else f"{name}-{n}")
+        if not folder.exists():
+            break
+        try:
+            held = json.loads((folder / "summary.json").read_text())["case"]["sha256"]
+        except (OSError, ValueError, KeyError, TypeError):
+            continue
+        if held == digest:
+            break
+    note = "" if n == 1 else f" ({root / name} holds the results of another case text)"
+    return folder, note
+
+
+def _prepare(folder: Path) -> str | None:
+    """Create the results folder; the reason it cannot be, or None."""
+    for up in (folder, *folder.parents):
+        if up.exists() and not up.is_dir():
+            return f"{up} is a file, not a folder"
+        if up.exists():
+            break
     try:
-        case = load(case_file, overrides)
+        folder.mkdir(parents=True, exist_ok=True)
+        probe = folder / ".axiform-write-test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as exc:
+        return f"cannot create or write {folder} ({exc.strerror or exc})"
+    return None
+
+
+def run(case_path: str, out: str | None, quiet: bool = False, overrides: list[str] = ()) -> int:
+    """Read, check, solve and write a case; returns the exit code."""
+    with Stops() as stops:
+        try:
+            return _run(Path(case_path), out, quiet, list(overrides), stops)
+        except Interrupted as exc:  # before the results folder was there
+            _say(f"axiform: {exc} before the first step")
+            return 128 + exc.signum
+
+
+def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], stops: Stops) -> int:
+    try:
+        data = read(case_file, overrides)
+        case = parse(data)
         built = build(case, case_file.parent)
     except CaseError as exc:
-        print(f"axiform: invalid case {case_file}:\n{exc}", file=sys.stderr)
+        return _invalid(case_file, exc)
+    except Exception as exc:  # noqa: BLE001 - a fault of axiform's, not of the case: exit 3
+        return _failed(exc, f"failed while building the model of {case_file}")
+    digest = fingerprint(data)
+    note = ""
+    if out:
+        out_dir = Path(out)
+    else:
+        out_dir, note = results_folder(case_file, digest)
+    problem = _prepare(out_dir)
+    if problem:
+        _say(f"axiform: invalid output folder:\n--out: {problem}")
         return 2
-    out_dir = Path(out) if out else Path("results") / case_file.stem
     o = case.output
-    writer = ResultsWriter(out_dir, built.model, built.monitors, case.title, every=o.every, vtu=o.vtu,
-                           gid_files=o.gid, revolved=o.revolved, plots=o.plots,
-                           thickness_every=o.thickness_every, labels=case_labels(case))
     model, control = built.model, built.control
     progress = Progress(sys.stderr, quiet)
     # progress: the driven dof, the stop dof of an arc length, or the load factor
@@ -62,69 +189,147 @@ def run(case_path: str, out: str | None, quiet: bool = False, overrides: list[st
         driven, goal = control.stop_dof, control.stop_value
 
     def on_step(step):
-        values = writer.step(step)
+        with stops.held():
+            values = writer.step(step)
         done = step.u[driven] if driven is not None else step.lam
         progress(step, done / goal, values)
 
-    if not quiet:
-        print(f"axiform {__version__}: {case.title or case_file.name}: {model.mesh.n_cells} {model.mesh.element.name} "
-              f"elements, {model.n_free} free dofs -> {out_dir}", file=sys.stderr)
-    result = solve(model, control, built.options, on_step=on_step)
+    t0 = time.perf_counter()
+    result = writer = None
+    try:
+        with stops.held():
+            writer = ResultsWriter(out_dir, model, built.monitors, case.title, every=o.every, vtu=o.vtu,
+                                   gid_files=o.gid, revolved=o.revolved, plots=o.plots,
+                                   thickness_every=o.thickness_every, labels=case_labels(case),
+                                   case={"file": str(case_file), "overrides": overrides, "sha256": digest})
+        if not quiet:
+            _say(f"axiform {__version__}: {case.title or case_file.name}: {model.mesh.n_cells} "
+                 f"{model.mesh.element.name} elements, {model.n_free} free dofs -> {out_dir}{note}")
+        result = solve(model, control, built.options, on_step=on_step)
+        status, message = result.status, result.message
+    except Interrupted as exc:
+        if writer is None:
+            raise
+        status, message = "interrupted", f"{exc}; every converged step is kept"
+    except NonFiniteResult as exc:
+        status, message = "stopped", str(exc)
+    except StepFailed as exc:  # the path could not even start (arc length's first tangent)
+        status, message = "stopped", f"before the first step: {exc}"
+    except Exception as exc:  # noqa: BLE001 - any other error: status "failed", exit 3
+        if writer is None:  # the results folder could not be started
+            return _failed(exc, f"failed while starting {out_dir}")
+        status, message = "failed", f"{type(exc).__name__}: {exc}"
+        _trace(exc)
     progress.close()
-    writer.finish(result.status, result.message)
-    if not quiet or result.status != "finished":
-        print(f"axiform: {result.status} after {len(result.steps)} steps, {result.newton_iterations} Newton "
-              f"iterations, {result.wall_time_s:.2f} s" + (f": {result.message}" if result.message else ""),
-              file=sys.stderr)
-    return 0 if result.status == "finished" else 1
+    stops.raised = True  # wind up whatever comes now
+    try:
+        writer.finish(status, message)
+    except Exception as exc:  # noqa: BLE001 - e.g. a full disk: status "failed", exit 3
+        status, message = "failed", f"{message}; then writing the results failed ({type(exc).__name__}: {exc})"
+        _trace(exc)
+    steps = writer.steps
+    its = writer.newton_iterations
+    wall = result.wall_time_s if result is not None else time.perf_counter() - t0
+    _say(f"axiform: {status} after {steps} steps, {its} Newton iterations, {wall:.2f} s -> {out_dir}"
+         + (f": {message}" if message else ""))
+    if status == "interrupted":
+        return 128 + stops.signum
+    return EXIT.get(status, 1)
+
+
+def _trace(exc: BaseException) -> None:
+    """The traceback of an unexpected error, only with AXIFORM_TRACEBACK=1 (for a bug report)."""
+    if os.environ.get("AXIFORM_TRACEBACK") == "1":
+        traceback.print_exception(exc)
+
+
+def _failed(exc: Exception, what: str) -> int:
+    _say(f"axiform: {what}: {type(exc).__name__}: {exc}")
+    _trace(exc)
+    return 3
 
 
 def check(case_path: str, overrides: list[str] = ()) -> int:
+    """Validate a case and build its model, without solving; returns the exit code."""
     case_file = Path(case_path)
     try:
-        built = build(load(case_file, overrides), case_file.parent)
+        built = build(parse(read(case_file, overrides)), case_file.parent)
     except CaseError as exc:
-        print(f"axiform: invalid case {case_file}:\n{exc}", file=sys.stderr)
-        return 2
+        return _invalid(case_file, exc)
+    except Exception as exc:  # noqa: BLE001 - a fault of axiform's, not of the case: exit 3
+        return _failed(exc, f"failed while building the model of {case_file}")
     m = built.model
     print(f"{case_file}: valid; {m.mesh.n_cells} {m.mesh.element.name} elements, {m.mesh.n_nodes} nodes, "
           f"{m.n_free} free dofs")
     return 0
 
 
+def _fields_of(folder: Path) -> set[str] | None:
+    """The nodal fields of the last VTU file of a results folder (None: no VTU file)."""
+    from xml.etree import ElementTree as ET
+
+    from .plots import last_vtu
+
+    vtu = last_vtu(folder)
+    if vtu is None or not vtu.exists():
+        return None
+    return {a.get("Name") for a in ET.parse(vtu).getroot().iter("DataArray")
+            if a.get("Name") and a.get("Name") not in ("types", "offsets", "connectivity", "Points")}
+
+
 def plot(folder: str, field: str, animate: bool = False) -> int:
-    from .plots import FieldError, plot_folder
+    """(Re)write the PNG plots of a results folder; returns the exit code."""
+    from .plots import FieldError, plot_folder, read_history
 
     path = Path(folder)
-    if not (path / "history.csv").exists():
-        print(f"axiform: {folder} is not a results folder (no history.csv)", file=sys.stderr)
+    if not (path / "history.csv").is_file():
+        _say(f"axiform: {folder} is not a results folder (no history.csv)")
         return 2
     try:
-        made = plot_folder(path, field, animate)
-    except FieldError as exc:
-        print(f"axiform: --field: {exc}", file=sys.stderr)
+        read_history(path / "history.csv")
+        fields = _fields_of(path)
+    except (OSError, ValueError, KeyError, IndexError, SyntaxError) as exc:  # SyntaxError: XML
+        _say(f"axiform: {folder}: unreadable results ({type(exc).__name__}: {exc})")
         return 2
-    for picture in made:
-        print(picture)
+    if fields is not None and field.split(":")[0] not in fields:
+        _say(f"axiform: --field: no field '{field}' in {folder}; there are: {', '.join(sorted(fields))}")
+        return 2
+    try:
+        pngs = plot_folder(path, field, animate)
+    except FieldError as exc:
+        _say(f"axiform: --field: {exc}")
+        return 2
+    except Exception as exc:  # noqa: BLE001 - a fault of axiform's: exit 3
+        return _failed(exc, f"failed while plotting {folder}")
+    for png in pngs:
+        print(png)
     return 0
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="axiform", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="axiform", description=__doc__.splitlines()[0],
+                                     epilog="exit codes: 0 finished, 1 stopped short, 2 invalid input, 3 failed, "
+                                            "130 / 143 interrupted (SIGINT / SIGTERM)")
     parser.add_argument("--version", action="version", version=f"axiform {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
-    p_run = sub.add_parser("run", help="run a case file and write its results folder")
+    p_run = sub.add_parser("run", help="run a case file and write its results folder",
+                           description="Run a case file and write its results folder as the steps converge.")
     p_run.add_argument("case", help="the case file (TOML)")
-    p_run.add_argument("--out", help="results folder (default: results/<case name>)")
-    p_run.add_argument("-q", "--quiet", action="store_true", help="no progress display")
-    p_check = sub.add_parser("check", help="validate a case file and build its model, without solving")
-    p_check.add_argument("case")
+    p_run.add_argument("--out", help="results folder (default: results/<case name>, or results/<case name>-<n> "
+                                     "when that one holds another case's results)")
+    p_run.add_argument("-q", "--quiet", action="store_true", help="print only one line: the final status")
+    p_check = sub.add_parser("check", help="validate a case file and build its model, without solving",
+                             description="Validate a case file and build its model, without solving: exit 0 "
+                                         "if valid, 2 with the key path and the reason if not.")
+    p_check.add_argument("case", help="the case file (TOML)")
     for p in (p_run, p_check):
         p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                        help="override a key, VALUE in TOML syntax: --set mesh.element='\"q8\"' "
-                            "--set mesh.divisions=[40,4]")
-    p_plot = sub.add_parser("plot", help="write the PNG plots of a results folder")
-    p_plot.add_argument("folder")
+                            "--set mesh.divisions=[40,4] --set contact[1].friction=0.0 (repeatable)")
+    p_plot = sub.add_parser("plot", help="write the PNG plots of a results folder",
+                            description="(Re)write the PNG plots of a results folder: load_curve.png, "
+                                        "thickness.png, deformed.png.")
+    p_plot.add_argument("folder", help="a results folder written by `axiform run`")
     p_plot.add_argument("--field", default="von_mises",
                         help="nodal field colouring the deformed shape (von_mises, J, thickness, ...; "
                              "a component as cauchy_stress:zz or displacement:uz; vectors and tensors "
@@ -133,11 +338,16 @@ def main(argv: list[str] | None = None) -> int:
                         help="also write forming.gif: the deformed wall, moulds and thickness, one frame "
                              "per written step")
     args = parser.parse_args(argv)
-    if args.command == "plot":
-        return plot(args.folder, args.field, args.animate)
-    if args.command == "run":
-        return run(args.case, args.out, args.quiet, args.set)
-    return check(args.case, args.set)
+    try:
+        with np.errstate(all="ignore"):  # overflow and NaN are caught by the guards, not printed
+            if args.command == "plot":
+                return plot(args.folder, args.field, args.animate)
+            if args.command == "run":
+                return run(args.case, args.out, args.quiet, args.set)
+            return check(args.case, args.set)
+    except KeyboardInterrupt:
+        _say("axiform: interrupted")
+        return 130
 
 
 if __name__ == "__main__":

@@ -130,14 +130,22 @@ def plot_load_curves(history: Path, out: Path, info: FolderInfo | None = None) -
 
 
 def _read_thickness(path: Path) -> tuple[dict[str, np.ndarray], int]:
-    """A thickness CSV as columns, and the step named on its first line."""
-    first = Path(path).read_text().split("\n", 1)[0]
-    data = np.genfromtxt(path, delimiter=",", names=True, skip_header=1, ndmin=1)
+    """A thickness CSV as columns, and its step: from the name thickness/step_NNNN.csv, or for
+    thickness.csv (the last written step) from summary.json beside it."""
+    path = Path(path)
+    if path.stem.startswith("step_"):
+        step = int(path.stem.split("_")[1])
+    else:
+        try:
+            step = int(json.loads((path.parent / "summary.json").read_text())["steps"])
+        except (OSError, ValueError, KeyError):
+            step = 0
+    data = np.genfromtxt(path, delimiter=",", names=True, ndmin=1)
     table = {k: np.atleast_1d(data[k]) for k in data.dtype.names} if data.size else {}
     if table and "s_current" not in table:
         step = np.hypot(np.diff(table["r"]), np.diff(table["z"]))
         table["s_current"] = np.r_[0.0, np.cumsum(step)]
-    return table, int(first.split(",")[0].split()[-1])
+    return table, step
 
 
 def thickness_figure(thickness: Path, info: FolderInfo, history: dict[str, np.ndarray] | None = None):

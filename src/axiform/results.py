@@ -3,17 +3,22 @@ thickness.csv, optional GiD files and a 3D revolved copy, and PNG plots at the e
 
 history.csv: one row per converged step (step, load_factor, iterations, then one column per
 monitor).  summary.json: status, steps, newton_iterations, wall_time_s, dofs, elements,
-element, units, load (what the load factor scales), monitor_quantities (and more).
-fields/: a ParaView series (step_NNNN.vtu listed in fields.pvd; surfaces_NNNN.csv the moulds
-at that step).  thickness.csv: the wall thickness along the body at the last written step;
-thickness/step_NNNN.csv every `thickness_every` steps.
+element, units, load (what the load factor scales), monitor_quantities, the case's origin
+and fingerprint (and more).  fields/: a ParaView series (step_NNNN.vtu listed in fields.pvd;
+surfaces_NNNN.csv the moulds at that step).  thickness.csv: the wall thickness along the body
+at the last written step; thickness/step_NNNN.csv every `thickness_every` steps.
+Every file is written whole to a temporary name, then renamed over the old one (`atomic`).
 """
 
 from __future__ import annotations
 
 import csv
+import io
 import json
+import os
+import shutil
 import time
+from contextlib import contextmanager
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
@@ -24,14 +29,39 @@ from .fields import point_fields
 from .thickness import thickness_table, write_thickness_csv
 
 
+@contextmanager
+def atomic(path: str | Path):
+    """Yield a temporary path beside `path` to write; on success it replaces `path` in one
+    rename, so a reader (or a run killed at any moment) sees the old file or the new one,
+    never a part."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.tmp")
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def write_atomic(path: str | Path, text: str) -> None:
+    with atomic(path) as tmp:
+        tmp.write_text(text)
+
+
+class NonFiniteResult(ArithmeticError):
+    """A converged step holds NaN or inf: it is not written; the message names the place."""
+
+
 class ResultsWriter:
     """Writes the results folder step by step, so that a run stopped midway keeps every
     converged step."""
 
     def __init__(self, out: str | Path, model, monitors=(), title: str = "", every: int = 1,
                  vtu: bool = True, gid_files: bool = False, revolved: int = 0, plots: bool = True,
-                 thickness_every: int | None = None, labels: dict | None = None):
-        """labels: units, load and monitor_quantities for summary.json (labels.case_labels)."""
+                 thickness_every: int | None = None, labels: dict | None = None,
+                 case: dict | None = None):
+        """labels: units, load and monitor_quantities for summary.json (labels.case_labels);
+        case: where the case came from and its fingerprint."""
         self.out = Path(out)
         self.out.mkdir(parents=True, exist_ok=True)
         self.model = model
@@ -65,8 +95,14 @@ class ResultsWriter:
             "monitor_quantities": {},
         }
         self.summary.update(labels or {})
-        with open(self.out / "history.csv", "w", newline="") as fh:
-            csv.writer(fh).writerow(["step", "load_factor", "iterations"] + [m.name for m in self.monitors])
+        if case is not None:  # where the case came from and its fingerprint (the folder rule)
+            self.summary["case"] = case
+        self._history = io.StringIO()
+        self._csv = csv.writer(self._history, lineterminator="\n")
+        self._csv.writerow(["step", "load_factor", "iterations"] + [m.name for m in self.monitors])
+        write_atomic(self.out / "history.csv", self._history.getvalue())
+        for tmp in self.out.glob(".*.tmp"):
+            tmp.unlink()
         if vtu:
             (self.out / "fields").mkdir(exist_ok=True)
             for old in (self.out / "fields").glob("step_*.vtu"):
@@ -79,22 +115,39 @@ class ResultsWriter:
                       "thickness.png", "deformed.png", "forming.gif"):
             (self.out / stale).unlink(missing_ok=True)
         if self.gid:
-            gid.write_mesh(self.out / "axiform.post.msh", model.mesh.points, model.mesh.cells)
-            gid.start_results(self.out / "axiform.post.res")
+            with atomic(self.out / "axiform.post.msh") as tmp:
+                gid.write_mesh(tmp, model.mesh.points, model.mesh.cells)
+            with atomic(self.out / "axiform.post.res") as tmp:
+                gid.start_results(tmp)
         self._write_summary()
 
     def _write_summary(self):
         self.summary["wall_time_s"] = round(time.perf_counter() - self.t0, 4)
-        tmp = self.out / "summary.json.tmp"
-        tmp.write_text(json.dumps(self.summary, indent=2) + "\n")
-        tmp.replace(self.out / "summary.json")
+        write_atomic(self.out / "summary.json", json.dumps(self.summary, indent=2) + "\n")
+
+    def _guard(self, step, values: dict[str, float]) -> None:
+        """Refuse a step holding NaN or inf (displacements, load factor, monitors)."""
+        bad = np.flatnonzero(~np.isfinite(step.u))
+        if bad.size:
+            node, k = divmod(int(bad[0]), self.model.dpn)
+            element = int(np.argmax((self.model.mesh.cells == node).any(axis=1)))
+            raise NonFiniteResult(f"step {step.number}: the displacement {('ur', 'uz', 'rot')[k]} of node {node} "
+                                  f"(element {element}) is {step.u[bad[0]]}: not written")
+        if not np.isfinite(step.lam):
+            raise NonFiniteResult(f"step {step.number}: the load factor is {step.lam}: not written")
+        for name, v in values.items():
+            if not np.isfinite(v):
+                raise NonFiniteResult(f"step {step.number}: monitor {name} is {v}: not written")
 
     def step(self, step) -> dict[str, float]:
-        """Record a converged step; returns the monitor values."""
+        """Record a converged step; returns the monitor values.  history.csv and summary.json
+        are rewritten whole (atomically), so they always parse; a step holding NaN or inf
+        raises NonFiniteResult and nothing of it is written."""
         values = {m.name: m.value(step) for m in self.monitors}
-        with open(self.out / "history.csv", "a", newline="") as fh:
-            csv.writer(fh).writerow([step.number, repr(float(step.lam)), step.iterations]
-                                    + [repr(v) for v in values.values()])
+        self._guard(step, values)
+        self._csv.writerow([step.number, repr(float(step.lam)), step.iterations]
+                           + [repr(v) for v in values.values()])
+        write_atomic(self.out / "history.csv", self._history.getvalue())
         if self.model.contacts:
             self._write_contact(step)
         self.steps = step.number
@@ -126,8 +179,8 @@ class ResultsWriter:
             for node, (r, z), g, p, st in zip(rep["node"], x, rep["gap"], rep["pressure"], rep["status"]):
                 lines.append(f"{k},{node},{r:.10g},{z:.10g},{g:.6g},{p:.6g},{STATUS[int(st)]}")
             totals.append({q: rep[q] for q in ("force_r", "force_z", "contact_area", "penetration")})
-        (self.out / "contact.csv").write_text("\n".join(lines) + "\n")
-        (self.out / "surfaces.csv").write_text(mould_outlines(self.model.contacts, float(step.lam)))
+        write_atomic(self.out / "contact.csv", "\n".join(lines) + "\n")
+        write_atomic(self.out / "surfaces.csv", mould_outlines(self.model.contacts, float(step.lam)))
         self.summary["contact"] = totals
 
     def _write_fields(self, step):
@@ -139,35 +192,40 @@ class ResultsWriter:
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
         table = thickness_table(mesh, u, self.model.contacts)
         if table is not None:
-            write_thickness_csv(self.out / "thickness.csv", table, step.number, float(step.lam))
+            with atomic(self.out / "thickness.csv") as tmp:
+                write_thickness_csv(tmp, table)
         if self.vtu and self.model.contacts:
-            (self.out / "fields" / f"surfaces_{step.number:04d}.csv").write_text(
-                mould_outlines(self.model.contacts, float(step.lam)))
+            write_atomic(self.out / "fields" / f"surfaces_{step.number:04d}.csv",
+                         mould_outlines(self.model.contacts, float(step.lam)))
         if not (self.vtu or self.gid):
             return
         data = point_fields(self.model, step.u)
         if self.gid:
-            gid.append_results(self.out / "axiform.post.res", step.number, data)
+            res = self.out / "axiform.post.res"
+            with atomic(res) as tmp:
+                shutil.copyfile(res, tmp)
+                gid.append_results(tmp, step.number, data)
         if not self.vtu:
             return
         cell_type = "quad8" if mesh.element.nodes == 8 else "quad"
         pts = np.column_stack([mesh.points, np.zeros(mesh.n_nodes)])
         name = f"step_{step.number:04d}.vtu"
-        meshio.write(self.out / "fields" / name, meshio.Mesh(pts, [(cell_type, mesh.cells)], point_data=data))
+        with atomic(self.out / "fields" / name) as tmp:
+            meshio.write(tmp, meshio.Mesh(pts, [(cell_type, mesh.cells)], point_data=data), file_format="vtu")
         self._pvd.append((float(step.number), f"fields/{name}"))
         root = ET.Element("VTKFile", type="Collection", version="0.1")
         coll = ET.SubElement(root, "Collection")
         for t, f in self._pvd:
             ET.SubElement(coll, "DataSet", timestep=repr(t), part="0", file=f)
-        ET.ElementTree(root).write(self.out / "fields.pvd")
+        with atomic(self.out / "fields.pvd") as tmp:
+            ET.ElementTree(root).write(tmp)
 
     def _write_thickness_step(self, step):
         """thickness/step_NNNN.csv: the thickness table of one step."""
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
         table = thickness_table(self.model.mesh, u, self.model.contacts)
         if table is not None:
-            write_thickness_csv(self.out / "thickness" / f"step_{step.number:04d}.csv", table, step.number,
-                                float(step.lam))
+            write_thickness_csv(self.out / "thickness" / f"step_{step.number:04d}.csv", table)
 
     def _write_revolved(self, step):
         from .revolve import revolve
@@ -176,20 +234,23 @@ class ResultsWriter:
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
         data = point_fields(self.model, step.u)
         keep = {k: data[k] for k in ("displacement", "von_mises", "J")}
-        revolve(mesh.points + u, mesh.cells, self.revolved, keep).write(self.out / "revolved.vtu")
+        with atomic(self.out / "revolved.vtu") as tmp:
+            revolve(mesh.points + u, mesh.cells, self.revolved, keep).write(tmp, file_format="vtu")
 
     def finish(self, status: str, message: str = "") -> None:
-        """Final summary; the last converged step always gets its field output, the 3D copy and
-        the plots."""
+        """Final summary (status "finished", "stopped", "interrupted" or "failed", written
+        first, so it stands whatever happens next); the last converged step then gets its
+        field output, the 3D copy and the plots."""
+        self.summary["status"] = status
+        if message:
+            self.summary["message"] = message
+        self._write_summary()
         if self.steps and self._last_written != self.steps:
             self._write_fields(self._last_step)
         if self.steps and self.thickness_every and self.steps % self.thickness_every:
             self._write_thickness_step(self._last_step)
         if self.steps and self.revolved:
             self._write_revolved(self._last_step)
-        self.summary["status"] = status
-        if message:
-            self.summary["message"] = message
         self._write_summary()
         if self.plots and self.steps:
             from .plots import plot_folder

@@ -14,6 +14,7 @@ from typing import Callable
 
 import numpy as np
 
+from .guards import evaluation_fault
 from .linsolve import SingularTangentError, factorize
 from .materials import InvertedElementError
 from .model import Evaluation, Model
@@ -135,7 +136,7 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
             size = trial / 2.0
             if abs(size) < opts.min_step * abs(nominal):
                 result.status = "stopped"
-                result.message = f"no convergence with the step cut below the minimum ({exc})"
+                result.message = f"step {len(result.steps) + 1}: no convergence with the step cut below the minimum ({exc})"
                 break
             continue
         path.accept(u_new, lam_new, trial)
@@ -341,10 +342,16 @@ def _check(ev: Evaluation, lam: float, opts: NewtonOptions, floor: float, residu
 
 
 def _evaluate(model: Model, u_f, lam) -> Evaluation:
+    """model.evaluate, failing the step on an inverted element, a residual that is not finite
+    or a tangent with a free rigid translation (guards.evaluation_fault)."""
     try:
-        return model.evaluate(u_f, lam)
+        ev = model.evaluate(u_f, lam)
     except InvertedElementError as exc:
         raise StepFailed(str(exc)) from exc
+    fault = evaluation_fault(model, ev.r_full, ev.K)
+    if fault:
+        raise StepFailed(fault)
+    return ev
 
 
 def _factorize(K):

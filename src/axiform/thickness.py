@@ -88,12 +88,12 @@ def default_wall(points: np.ndarray, loaded_edges: Sequence[np.ndarray]) -> str:
     return "r" if along_z > along_r else "z"
 
 
-def write_thickness_csv(path: str | Path, table: dict[str, np.ndarray], step: int, load_factor: float) -> None:
-    """thickness.csv: a first line '# step N, load_factor L', the header row, one row per
-    station; first_contact is left empty where never."""
+def write_thickness_csv(path: str | Path, table: dict[str, np.ndarray]) -> None:
+    """thickness.csv: the header row first (DESIGN 10.12), one row per station; the step and
+    load factor are in summary.json; first_contact is left empty where never."""
     rows = np.column_stack([table[n] for n in COLUMNS])
     text = np.char.mod("%.10g", rows)
     text[np.isnan(rows)] = ""
-    lines = [f"# step {step}, load_factor {load_factor!r}", ",".join(COLUMNS)]
+    lines = [",".join(COLUMNS)]
     lines += [",".join(row) for row in text]
     Path(path).write_text("\n".join(lines) + "\n")
