@@ -286,6 +286,9 @@ def fit(data: Data, model: str, terms: int = 3, kappa: float | None = None) -> F
     if best is None:
         return None
     p = best.x
+    if model == "ogden":  # terms in increasing alpha
+        order = np.argsort(p[n:])
+        p = np.concatenate([p[:n][order], p[n:][order]])
     k = kappa if kappa is not None else 1000.0 * fam.law(p).shear_modulus
     table = fam.table(p)
     law = MaterialSpec.model_validate(table | {"model": model, "kappa": k}).build()
