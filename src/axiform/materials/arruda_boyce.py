@@ -23,7 +23,6 @@ class ArrudaBoyce(InvariantLaw):
     lambda_m: float
     kappa: float
 
-    name = "arruda-boyce"
 
     def coefficients(self) -> np.ndarray:
         """a_i = mu c_i / lambda_m^(2i-2), i = 1..5, so that W_iso = sum a_i (I1_bar^i - 3^i)."""
@@ -34,11 +33,11 @@ class ArrudaBoyce(InvariantLaw):
         """Initial shear modulus 2 dW/dI1_bar at I1_bar = 3."""
         return 2.0 * float(polynomial.polyval(3.0, polynomial.polyder(np.r_[0.0, self.coefficients()])))
 
-    def psi(self, I1b, I2b):
+    def psi(self, I1b: np.ndarray, I2b: np.ndarray | None) -> np.ndarray:
         a = np.r_[0.0, self.coefficients()]
         return polynomial.polyval(I1b, a) - polynomial.polyval(3.0, a)
 
-    def psi_derivatives(self, I1b, I2b, tangent):
+    def psi_derivatives(self, I1b: np.ndarray, I2b: np.ndarray | None, tangent: bool) -> tuple:
         a1 = polynomial.polyder(np.r_[0.0, self.coefficients()])
         W1 = polynomial.polyval(I1b, a1)
         W11 = polynomial.polyval(I1b, polynomial.polyder(a1)) if tangent else None

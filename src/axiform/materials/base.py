@@ -39,7 +39,6 @@ class Hyperelastic(ABC):
     """
 
     kappa: float
-    name: str  # the case-file model name
 
     @property
     @abstractmethod

@@ -19,7 +19,6 @@ class Gent(InvariantLaw):
     Jm: float
     kappa: float
 
-    name = "gent"
 
     @property
     def shear_modulus(self) -> float:
@@ -31,10 +30,10 @@ class Gent(InvariantLaw):
         r = 1.0 - (I1b - 3.0) / self.Jm
         return np.where(r > 0.0, r, np.nan)
 
-    def psi(self, I1b, I2b):
+    def psi(self, I1b: np.ndarray, I2b: np.ndarray | None) -> np.ndarray:
         return -0.5 * self.mu * self.Jm * np.log(self._room(I1b))
 
-    def psi_derivatives(self, I1b, I2b, tangent):
+    def psi_derivatives(self, I1b: np.ndarray, I2b: np.ndarray | None, tangent: bool) -> tuple:
         W1 = 0.5 * self.mu / self._room(I1b)
         W11 = 2.0 / (self.mu * self.Jm) * W1 * W1 if tangent else None
         return W1, None, W11, None, None

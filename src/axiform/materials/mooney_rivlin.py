@@ -27,7 +27,6 @@ class MooneyRivlin(InvariantLaw):
     C2: float
     kappa: float
 
-    name = "mooney-rivlin"
     uses_I2 = True
 
     @property
@@ -40,10 +39,10 @@ class MooneyRivlin(InvariantLaw):
         """kappa = E / (3 (1 - 2 nu)) (eq. 13)."""
         return cls(C1, C2, E / (3.0 * (1.0 - 2.0 * nu)))
 
-    def psi(self, I1b, I2b):
+    def psi(self, I1b: np.ndarray, I2b: np.ndarray | None) -> np.ndarray:
         return self.C1 * (I1b - 3.0) + self.C2 * (I2b - 3.0)
 
-    def psi_derivatives(self, I1b, I2b, tangent):
+    def psi_derivatives(self, I1b: np.ndarray, I2b: np.ndarray | None, tangent: bool) -> tuple:
         return np.full_like(I1b, self.C1), np.full_like(I1b, self.C2), None, None, None
 
     def _rows(self, xt: np.ndarray, kappa: float, tangent: bool):

@@ -77,7 +77,6 @@ class Ogden(ReducedLaw):
     alpha: tuple[float, ...]
     kappa: float
 
-    name = "ogden"
 
     def __post_init__(self):
         object.__setattr__(self, "mu", tuple(float(v) for v in np.atleast_1d(self.mu)))

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from .invariant import InvariantLaw
 
 
@@ -16,18 +18,17 @@ class Yeoh(InvariantLaw):
     C30: float
     kappa: float
 
-    name = "yeoh"
 
     @property
     def shear_modulus(self) -> float:
         """Initial shear modulus mu = 2 C10."""
         return 2.0 * self.C10
 
-    def psi(self, I1b, I2b):
+    def psi(self, I1b: np.ndarray, I2b: np.ndarray | None) -> np.ndarray:
         e = I1b - 3.0
         return e * (self.C10 + e * (self.C20 + e * self.C30))
 
-    def psi_derivatives(self, I1b, I2b, tangent):
+    def psi_derivatives(self, I1b: np.ndarray, I2b: np.ndarray | None, tangent: bool) -> tuple:
         e = I1b - 3.0
         W1 = self.C10 + e * (2.0 * self.C20 + 3.0 * self.C30 * e)
         W11 = 2.0 * self.C20 + 6.0 * self.C30 * e if tangent else None
