@@ -30,8 +30,9 @@ from .cavity import CavityError
 from .contact.pair import ContactPair
 from .curves import PROPORTIONAL, Curve
 from .contact.surfaces import Circle, Polyline
+from .case_material import MaterialSpec
 from .guards import boundary_crossing, chain_crossing, free_to_slide, not_numbers
-from .materials import MooneyRivlin
+from .materials import Hyperelastic
 from .mesh import Mesh, MeshError, layered, read_gmsh, rectangle
 from .model import Model
 from .profile import Arc, Line, Profile, ProfileError
@@ -139,43 +140,6 @@ class MeshSpec(Strict):
         pieces = tuple(Line(p.line.to, p.line.divisions) if p.line else
                        Arc(p.arc.center, p.arc.to, p.arc.divisions, p.arc.ccw) for p in self.profile)
         return Profile(self.start, pieces)
-
-
-class MaterialSpec(Strict):
-    """Mooney-Rivlin (C1, C2) or neo-Hooke (C1, or E and nu); kappa given, or from E and nu."""
-
-    model: Literal["mooney-rivlin", "neo-hooke"]
-    C1: PositiveFloat | None = None
-    C2: Annotated[float, Field(ge=0)] | None = None
-    kappa: PositiveFloat | None = None
-    E: PositiveFloat | None = None
-    nu: Annotated[float, Field(gt=-1.0, lt=0.5)] | None = None
-
-    @model_validator(mode="after")
-    def _constants(self):
-        if (self.E is None) != (self.nu is None):
-            raise ValueError("E and nu go together")
-        if self.kappa is not None and self.E is not None:
-            raise ValueError("give kappa or E and nu, not both")
-        if self.kappa is None and self.E is None:
-            raise ValueError("missing material constant: kappa (or E and nu)")
-        if self.model == "mooney-rivlin":
-            missing = [k for k in ("C1", "C2") if getattr(self, k) is None]
-            if missing:
-                raise ValueError(f"missing material constant: {', '.join(missing)}")
-        else:
-            if self.C2 not in (None, 0.0):
-                raise ValueError("neo-hooke has no C2 (use mooney-rivlin)")
-            if self.C1 is None and self.E is None:
-                raise ValueError("missing material constant: C1 (or E and nu)")
-        return self
-
-    def build(self) -> MooneyRivlin:
-        C2 = self.C2 or 0.0
-        C1 = self.C1 if self.C1 is not None else self.E / (4.0 * (1.0 + self.nu))  # mu / 2
-        if self.kappa is None:
-            return MooneyRivlin.from_E_nu(C1, C2, self.E, self.nu)
-        return MooneyRivlin(C1, C2, self.kappa)
 
 
 class CurveMixin(Strict):
@@ -599,7 +563,7 @@ def _mesh(spec: MeshSpec, base: Path) -> Mesh:
         raise CaseError(f"mesh.file: cannot read {path} as a gmsh mesh ({' '.join(why.split())})") from None
 
 
-def default_penalty(material: MooneyRivlin, mesh: Mesh) -> float:
+def default_penalty(material: Hyperelastic, mesh: Mesh) -> float:
     """10 E / h: E the small-strain Young's modulus of the material, h the smallest element
     edge; the penetration left is then about p h / (10 E) for a contact pressure p."""
     mu, k = material.shear_modulus, material.kappa

@@ -1,4 +1,5 @@
-"""`axiform run CASE.toml [--out DIR]`, `axiform check CASE.toml`, `axiform plot DIR`.
+"""`axiform run CASE.toml [--out DIR]`, `axiform check CASE.toml`, `axiform plot DIR`,
+`axiform fit DATA.csv --model MODEL` (fit.py).
 
 Exit codes: 0 finished, 1 stopped (converged steps kept), 2 invalid case (refused before any
 work), 3 failed (an unexpected error), 130 / 143 interrupted by SIGINT / SIGTERM.
@@ -22,6 +23,7 @@ import numpy as np
 
 from . import __version__
 from .case import CaseError, build, fingerprint, parse, read
+from .case_material import KEYS
 from .labels import case_labels
 from .results import NonFiniteResult, ResultsWriter
 from .solver import StepFailed, solve
@@ -337,9 +339,19 @@ def main(argv: list[str] | None = None) -> int:
     p_plot.add_argument("--animate", action="store_true",
                         help="also write forming.gif: the deformed wall, moulds and thickness, one frame "
                              "per written step")
+    p_fit = sub.add_parser("fit", help="fit a hyperelastic law to uniaxial / equibiaxial / planar test data")
+    p_fit.add_argument("data", nargs="+", help="CSV files with the header mode,stretch,stress")
+    p_fit.add_argument("--model", required=True, choices=list(KEYS), help="the law")
+    p_fit.add_argument("--terms", type=int, help="Ogden: number of terms, 1 to 6 (default 3)")
+    p_fit.add_argument("--out", help="output folder (default: results/fit-<model>)")
+    p_fit.add_argument("--kappa", type=float, help="bulk modulus written (default: 1000 x the initial shear modulus)")
     args = parser.parse_args(argv)
     try:
         with np.errstate(all="ignore"):  # overflow and NaN are caught by the guards, not printed
+            if args.command == "fit":
+                from .fit import run as fit
+
+                return fit(args.data, args.model, args.terms, args.out, args.kappa)
             if args.command == "plot":
                 return plot(args.folder, args.field, args.animate)
             if args.command == "run":

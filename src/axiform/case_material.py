@@ -1,0 +1,160 @@
+"""The `[material]` table of the case file: the law, its constants, the bulk modulus.
+
+    model = "neo-hooke" | "mooney-rivlin" | "yeoh" | "ogden" | "gent" | "arruda-boyce"
+
+with the law's keys (KEYS), and `kappa`, or `E` and `nu` (kappa = E / (3 (1 - 2 nu))).  Where
+one constant sets the initial shear modulus (SHEAR_KEY) it may be left out when E and nu are
+given: the law's mu then stands for E / (2 (1 + nu)).  Every number must be finite and in
+range; an error names the key (material.KEY) or, for a missing or cross-key problem, the table.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, ValidationInfo, field_validator, model_validator
+
+from .materials import ArrudaBoyce, Gent, Hyperelastic, MooneyRivlin, Ogden, Yeoh
+
+Model = Literal["neo-hooke", "mooney-rivlin", "yeoh", "ogden", "gent", "arruda-boyce"]
+
+KEYS: dict[str, tuple[str, ...]] = {
+    "neo-hooke": ("C1",),
+    "mooney-rivlin": ("C1", "C2"),
+    "yeoh": ("C10", "C20", "C30"),
+    "ogden": ("mu", "alpha"),
+    "gent": ("mu", "Jm"),
+    "arruda-boyce": ("mu", "lambda_m"),
+}
+SHEAR_KEY = {"neo-hooke": "C1", "yeoh": "C10", "gent": "mu", "arruda-boyce": "mu"}
+MAX_OGDEN_TERMS = 6
+
+# key -> (test, what the test asks), for the single numbers
+_RANGE = {
+    "C1": (lambda v: v > 0, "must be > 0"),
+    "C2": (lambda v: v >= 0, "must be >= 0"),
+    "C10": (lambda v: v > 0, "must be > 0"),
+    "C20": (lambda v: True, ""),
+    "C30": (lambda v: True, ""),
+    "Jm": (lambda v: v > 0, "must be > 0"),
+    "lambda_m": (lambda v: v > 1, "must be > 1 (a locking stretch)"),
+    "kappa": (lambda v: v > 0, "must be > 0"),
+    "E": (lambda v: v > 0, "must be > 0"),
+    "nu": (lambda v: -1 < v < 0.5, "must lie in (-1, 0.5)"),
+}
+
+
+def _belongs(key: str, info: ValidationInfo) -> str | None:
+    """The model, after checking that the key belongs to it (None if the model is invalid)."""
+    model = info.data.get("model")
+    if model is not None and key not in KEYS[model] + ("kappa", "E", "nu"):
+        raise ValueError(f"does not belong to model = \"{model}\" (its keys: "
+                         f"{', '.join(KEYS[model])}, and kappa or E and nu)")
+    return model
+
+
+def _numbers(value: Any, what: str) -> list[float]:
+    if isinstance(value, bool) or not isinstance(value, list) or not 1 <= len(value) <= MAX_OGDEN_TERMS:
+        raise ValueError(f"{what} must be a list of 1 to {MAX_OGDEN_TERMS} numbers")
+    out = []
+    for v in value:
+        if isinstance(v, bool) or not isinstance(v, int | float) or v != v or abs(v) == float("inf"):
+            raise ValueError(f"{what} must be a list of finite numbers, got {v!r}")
+        out.append(float(v))
+    return out
+
+
+class MaterialSpec(BaseModel):
+    """The [material] table (see the module docstring)."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+    model: Model
+    C1: float | None = None
+    C2: float | None = None
+    C10: float | None = None
+    C20: float | None = None
+    C30: float | None = None
+    mu: Any = None  # a number (gent, arruda-boyce) or a list (ogden)
+    alpha: Any = None
+    Jm: float | None = None
+    lambda_m: float | None = None
+    kappa: float | None = None
+    E: float | None = None
+    nu: float | None = None
+
+    @field_validator(*_RANGE, mode="before")
+    @classmethod
+    def _not_bool(cls, value: Any) -> Any:
+        if isinstance(value, bool):
+            raise ValueError(f"must be a number, got {str(value).lower()}")
+        return value
+
+    @field_validator(*_RANGE)
+    @classmethod
+    def _number(cls, value: float, info: ValidationInfo) -> float:
+        _belongs(info.field_name, info)
+        test, need = _RANGE[info.field_name]
+        if not test(value):
+            raise ValueError(f"{need}, got {value}")
+        return value
+
+    @field_validator("mu", mode="before")
+    @classmethod
+    def _mu(cls, value: Any, info: ValidationInfo) -> Any:
+        model = _belongs("mu", info)
+        if model == "ogden":
+            return _numbers(value, "ogden mu")
+        if isinstance(value, bool) or not isinstance(value, int | float) or value != value \
+                or abs(value) == float("inf"):
+            raise ValueError(f"must be a finite number, got {value!r}")
+        if not value > 0:
+            raise ValueError(f"must be > 0, got {value}")
+        return float(value)
+
+    @field_validator("alpha", mode="before")
+    @classmethod
+    def _alpha(cls, value: Any, info: ValidationInfo) -> list[float]:
+        _belongs("alpha", info)
+        alpha = _numbers(value, "alpha")
+        if 0.0 in alpha:
+            raise ValueError("every alpha must be non-zero")
+        mu = info.data.get("mu")
+        if isinstance(mu, list):
+            if len(mu) != len(alpha):
+                raise ValueError(f"needs as many entries as mu ({len(mu)}), got {len(alpha)}")
+            if not sum(m * a for m, a in zip(mu, alpha)) > 0:
+                raise ValueError("sum of mu_i alpha_i must be > 0 (a positive initial shear modulus)")
+        return alpha
+
+    @model_validator(mode="after")
+    def _constants(self):
+        if (self.E is None) != (self.nu is None):
+            raise ValueError("E and nu go together")
+        if self.kappa is not None and self.E is not None:
+            raise ValueError("give kappa or E and nu, not both")
+        if self.kappa is None and self.E is None:
+            raise ValueError("missing material constant: kappa (or E and nu)")
+        from_E = SHEAR_KEY.get(self.model) if self.E is not None else None
+        missing = [k for k in KEYS[self.model] if getattr(self, k) is None and k != from_E]
+        if missing:
+            raise ValueError(f"missing material constant: {', '.join(missing)}")
+        return self
+
+    def build(self) -> Hyperelastic:
+        """The law, with kappa given or from E and nu, and the shear constant from E and nu
+        where it was left out."""
+        kappa = self.kappa if self.kappa is not None else self.E / (3.0 * (1.0 - 2.0 * self.nu))
+        mu0 = self.E / (2.0 * (1.0 + self.nu)) if self.E is not None else None
+        m = self.model
+        if m in ("neo-hooke", "mooney-rivlin"):
+            return MooneyRivlin(self.C1 if self.C1 is not None else mu0 / 2.0, self.C2 or 0.0, kappa)
+        if m == "yeoh":
+            return Yeoh(self.C10 if self.C10 is not None else mu0 / 2.0, self.C20, self.C30, kappa)
+        if m == "ogden":
+            return Ogden(tuple(self.mu), tuple(self.alpha), kappa)
+        if m == "gent":
+            return Gent(self.mu if self.mu is not None else mu0, self.Jm, kappa)
+        # Abaqus' mu from the initial shear modulus: mu0 / mu depends on lambda_m alone
+        mu = self.mu if self.mu is not None else mu0 / ArrudaBoyce(1.0, self.lambda_m, kappa).shear_modulus
+        return ArrudaBoyce(mu, self.lambda_m, kappa)

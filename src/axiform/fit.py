@@ -1,0 +1,416 @@
+"""`axiform fit`: the constants of a hyperelastic law from incompressible test data.
+
+    axiform fit DATA.csv [DATA2.csv ...] --model MODEL [--terms N] [--out DIR] [--kappa K]
+
+DATA: CSV files with the header `mode,stretch,stress`; mode is uniaxial, equibiaxial or planar,
+stretch the principal stretch lambda in the loading direction, stress the nominal (first
+Piola-Kirchhoff) stress in that direction.  The model stress is that of the law's own
+W_iso (the same code the elements use) in the incompressible homogeneous test, the pressure
+taken from the stress-free thickness direction:
+
+    P = P_iso,11 - (lambda_t / lambda) P_iso,tt,
+
+with F = diag(lambda, lambda_2, lambda_t): uniaxial lambda_2 = lambda_t = lambda^(-1/2),
+equibiaxial lambda_2 = lambda, lambda_t = lambda^(-2), planar lambda_2 = 1, lambda_t = 1/lambda.
+Least squares (scipy.optimize.least_squares) on the relative error (P - data) / |data|.
+The constants a law holds linearly (C1, C2, C10.., mu, mu_i) start from a bounded linear
+least-squares solution for each start of the others (Jm, lambda_m, alpha_i).
+
+Drucker stability: d tau : d eps > 0 for every isochoric d eps, i.e. the Hessian D (2x2) of
+W_iso in the logarithmic principal strains (eps1, eps2, eps3 = -eps1 - eps2) is positive
+definite; checked at stretches 0.1 to 10 of the three modes.
+
+Writes DIR/material.toml ([material] table), DIR/fit.json and DIR/fit_<mode>.png; exit 2 for a
+bad data file (its line named), 1 when no admissible constants were found, 0 otherwise.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import least_squares, lsq_linear
+
+from .case_material import KEYS, MAX_OGDEN_TERMS, MaterialSpec
+from .materials import ArrudaBoyce, Gent, Hyperelastic, MooneyRivlin, Ogden, Yeoh
+
+MODES = ("uniaxial", "equibiaxial", "planar")
+STABILITY_STRETCHES = 10.0 ** np.linspace(-1.0, 1.0, 401)  # 0.1 to 10, 1 in the middle
+ALPHA_BOUND = 25.0  # |alpha_i| of the Ogden fit, so that lambda^alpha stays finite
+OGDEN_ALPHA_STARTS = ((2.0, -2.0, 4.0, -1.0, 6.0, 1.0), (1.3, 5.0, -2.0, 3.0, -4.0, 8.0),
+                      (1.0, 3.0, 6.0, -2.0, -4.0, 9.0), (3.0, -1.0, 8.0, 1.5, -3.0, 5.0),
+                      (0.5, 4.0, -3.0, 2.0, 7.0, -1.0), (6.0, -4.0, 1.0, 3.0, -2.0, 10.0))
+
+
+class FitDataError(ValueError):
+    """A bad data file: the message names the file and the line."""
+
+
+@dataclass
+class Data:
+    """Test points: mode (n) as an index into MODES, stretch (n), nominal stress (n)."""
+
+    mode: np.ndarray
+    stretch: np.ndarray
+    stress: np.ndarray
+    notes: list[str] = field(default_factory=list)
+
+    def count(self, mode: str) -> int:
+        return int(np.sum(self.mode == MODES.index(mode)))
+
+    @cached_property
+    def x(self) -> np.ndarray:
+        """F components (n, 5) of every point's incompressible test."""
+        x = np.empty((len(self.stretch), 5))
+        for i, mode in enumerate(MODES):
+            x[self.mode == i] = kinematics(mode, self.stretch[self.mode == i])
+        return x
+
+
+def read_data(paths: list[str | Path]) -> Data:
+    """Read CSV files with the header mode,stretch,stress; FitDataError names the line."""
+    modes, stretches, stresses, notes = [], [], [], []
+    for path in map(Path, paths):
+        try:
+            text = path.read_text()
+        except OSError as exc:
+            raise FitDataError(f"{path}: cannot read ({exc.strerror or exc})") from None
+        header, rows = None, len(modes)
+        for number, row in enumerate(csv.reader(text.splitlines()), start=1):
+            cells = [c.strip() for c in row]
+            if not any(cells) or cells[0].startswith("#"):
+                continue
+            where = f"{path} line {number}"
+            if header is None:
+                if sorted(c.lower() for c in cells) != ["mode", "stress", "stretch"]:
+                    raise FitDataError(f"{where}: the header must be mode,stretch,stress, got {','.join(cells)}")
+                header = [c.lower() for c in cells]
+                continue
+            if len(cells) != 3:
+                raise FitDataError(f"{where}: expected 3 values (mode,stretch,stress), got {len(cells)}")
+            value = dict(zip(header, cells))
+            mode = value["mode"].lower()
+            if mode not in MODES:
+                raise FitDataError(f"{where}: unknown mode '{value['mode']}' (uniaxial, equibiaxial or planar)")
+            numbers = {}
+            for key in ("stretch", "stress"):
+                try:
+                    numbers[key] = float(value[key])
+                except ValueError:
+                    raise FitDataError(f"{where}: {key} '{value[key]}' is not a number") from None
+                if not math.isfinite(numbers[key]):
+                    raise FitDataError(f"{where}: {key} must be finite, got {value[key]}")
+            lam, stress = numbers["stretch"], numbers["stress"]
+            if lam <= 0:
+                raise FitDataError(f"{where}: stretch must be > 0, got {value['stretch']}")
+            if lam == 1.0:
+                notes.append(f"{where}: stretch 1 skipped (every law gives stress 0 there)")
+                continue
+            if stress == 0:
+                raise FitDataError(f"{where}: stress 0 at stretch {lam:g} (the fit weighs relative errors)")
+            modes.append(MODES.index(mode))
+            stretches.append(lam)
+            stresses.append(stress)
+        if header is None:
+            raise FitDataError(f"{path} line 1: no header mode,stretch,stress")
+        if len(modes) == rows:
+            raise FitDataError(f"{path}: no data rows")
+    return Data(np.array(modes), np.array(stretches), np.array(stresses), notes)
+
+
+def kinematics(mode: str, lam: np.ndarray) -> np.ndarray:
+    """x = F components (n, 5) of the incompressible test, loading direction r, thickness z."""
+    lam = np.asarray(lam, float)
+    one = np.ones_like(lam)
+    lateral, thickness = {"uniaxial": (lam**-0.5, lam**-0.5), "equibiaxial": (lam, lam**-2.0),
+                          "planar": (one, 1.0 / lam)}[mode]
+    zero = np.zeros_like(lam)
+    return np.stack([lam, zero, zero, thickness, lateral], axis=-1)
+
+
+def nominal_stress(law: Hyperelastic, mode: str, lam: np.ndarray) -> np.ndarray:
+    """Nominal stress (n) in the loading direction of the incompressible test."""
+    return _nominal(law, kinematics(mode, lam))
+
+
+def _nominal(law: Hyperelastic, x: np.ndarray) -> np.ndarray:
+    """Nominal stress (n) of the tests x (n, 5): loading direction r, free thickness z."""
+    with np.errstate(all="ignore"):
+        P = law.iso_stress(x)
+    return P[..., 0] - x[..., 3] / x[..., 0] * P[..., 3]
+
+
+def drucker_stable(law: Hyperelastic, mode: str, lam: np.ndarray) -> np.ndarray:
+    """True (n) where the Hessian of W_iso in the log principal strains is positive definite."""
+    x = kinematics(mode, lam)
+    with np.errstate(all="ignore"):
+        P, A = law.iso_stress_tangent(x)
+        k = [0, 4, 3]  # principal directions: loading r, lateral theta, thickness z
+        lp = x[..., k]
+        M = lp[..., :, None] * A[..., k, :][..., :, k] * lp[..., None, :]
+        M[..., [0, 1, 2], [0, 1, 2]] += lp * P[..., k]
+        N = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, -1.0]])  # d ln(lambda_k) / d eps_i
+        D = N.T @ M @ N
+        det = D[..., 0, 0] * D[..., 1, 1] - D[..., 0, 1] * D[..., 1, 0]
+        return (D[..., 0, 0] > 0) & (det > 0)
+
+
+def stable_range(stable: np.ndarray, lam: np.ndarray = STABILITY_STRETCHES) -> tuple[float, float] | None:
+    """The stretch interval around 1 on which every point of the grid is stable (None if
+    stretch 1 itself is not)."""
+    mid = int(np.argmin(np.abs(np.log(lam))))
+    if not stable[mid]:
+        return None
+    below = np.flatnonzero(~stable[:mid])
+    above = np.flatnonzero(~stable[mid:])
+    lo = below.max() + 1 if below.size else 0
+    hi = mid + above.min() - 1 if above.size else len(lam) - 1
+    return float(lam[lo]), float(lam[hi])
+
+
+@dataclass(frozen=True)
+class Family:
+    """A law as constants to fit: those it holds linearly (the stress is linear in them at
+    fixed other constants) and the others.  `make(linear, nonlinear)` gives the law with
+    kappa = 1 (W_iso does not depend on kappa)."""
+
+    model: str
+    linear: tuple[str, ...]
+    nonlinear: tuple[str, ...]
+    make: Callable[[np.ndarray, np.ndarray], Hyperelastic]
+    linear_sign: tuple[str, ...]  # "positive", "nonnegative" or "free", per linear constant
+    nonlinear_bounds: Callable[[Data], tuple[np.ndarray, np.ndarray]] = lambda data: (np.empty(0), np.empty(0))
+    nonlinear_starts: Callable[[Data], list[np.ndarray]] = lambda data: [np.empty(0)]
+
+    def law(self, p: np.ndarray) -> Hyperelastic:
+        """The law (kappa = 1) of the constants p = (linear, nonlinear)."""
+        return self.make(p[:len(self.linear)], p[len(self.linear):])
+
+    def table(self, p: np.ndarray) -> dict:
+        """The case-file constants (KEYS) of the law of p."""
+        law = self.law(p)
+        return {key: (list(v) if isinstance(v := getattr(law, key), tuple) else v) for key in KEYS[self.model]}
+
+
+def _max_I1(data: Data) -> float:
+    """The largest I1 of the data points (incompressible: I1 = sum of squared stretches)."""
+    return max(float(np.sum(kinematics(m, data.stretch[data.mode == i]) ** 2, axis=-1).max(initial=3.0))
+               for i, m in enumerate(MODES))
+
+
+def family(model: str, terms: int = 3) -> Family:
+    """The fitting description of a case-file model (terms: Ogden only)."""
+    positive = "positive"
+    if model == "neo-hooke":
+        return Family(model, ("C1",), (), lambda a, b: MooneyRivlin(a[0], 0.0, 1.0), (positive,))
+    if model == "mooney-rivlin":
+        return Family(model, ("C1", "C2"), (), lambda a, b: MooneyRivlin(a[0], a[1], 1.0),
+                      (positive, "nonnegative"))
+    if model == "yeoh":
+        return Family(model, ("C10", "C20", "C30"), (), lambda a, b: Yeoh(a[0], a[1], a[2], 1.0),
+                      (positive, "free", "free"))
+    if model == "ogden":
+        n = terms
+        return Family(model, tuple(f"mu_{i + 1}" for i in range(n)), tuple(f"alpha_{i + 1}" for i in range(n)),
+                      lambda a, b: Ogden(tuple(a), tuple(b), 1.0), ("free",) * n,
+                      lambda data: (np.full(n, -ALPHA_BOUND), np.full(n, ALPHA_BOUND)),
+                      lambda data: [np.array(s[:n]) for s in OGDEN_ALPHA_STARTS])
+    if model == "gent":
+        return Family(model, ("mu",), ("Jm",), lambda a, b: Gent(a[0], b[0], 1.0), (positive,),
+                      lambda data: (np.array([(_max_I1(data) - 3.0) * (1 + 1e-9)]), np.array([np.inf])),
+                      lambda data: [np.array([(_max_I1(data) - 3.0) * f]) for f in (1.05, 1.5, 3.0, 10.0, 100.0)])
+    if model == "arruda-boyce":
+        return Family(model, ("mu",), ("lambda_m",), lambda a, b: ArrudaBoyce(a[0], b[0], 1.0), (positive,),
+                      lambda data: (np.array([1.0 + 1e-9]), np.array([np.inf])),
+                      lambda data: [np.array([v]) for v in (1.5, 3.0, 6.0, 12.0, 50.0)])
+    raise ValueError(f"unknown model {model!r}")
+
+
+@dataclass
+class FitResult:
+    """The fitted law (kappa as asked), its constants, and how well and where it holds."""
+
+    model: str
+    terms: int | None
+    law: Hyperelastic
+    table: dict
+    rms: dict[str, float]
+    stable: dict[str, tuple[float, float] | None]
+    points: dict[str, int]
+
+
+def _residual(fam: Family, data: Data, p: np.ndarray) -> np.ndarray:
+    """Relative errors (n); non-finite model stresses (Gent beyond its limit) count as huge."""
+    r = (_nominal(fam.law(p), data.x) - data.stress) / np.abs(data.stress)
+    return np.nan_to_num(r, nan=1e6, posinf=1e6, neginf=-1e6)
+
+
+def _admissible(fam: Family, p: np.ndarray) -> bool:
+    table = fam.table(p) | {"model": fam.model, "kappa": 1.0}
+    try:
+        MaterialSpec.model_validate(table)
+    except ValueError:
+        return False
+    return True
+
+
+def fit(data: Data, model: str, terms: int = 3, kappa: float | None = None) -> FitResult | None:
+    """Least squares on the relative error; None when no admissible constants were found."""
+    fam = family(model, terms)
+    n = len(fam.linear)
+    scale = float(np.median(np.abs(data.stress)))
+    lower = {"positive": 1e-9 * scale, "nonnegative": 0.0, "free": -np.inf}
+    lin_lo = np.array([lower[s] for s in fam.linear_sign])
+    nl_lo, nl_hi = fam.nonlinear_bounds(data)
+    lo = np.concatenate([lin_lo, nl_lo])
+    hi = np.concatenate([np.full(n, np.inf), nl_hi])
+    w = 1.0 / np.abs(data.stress)
+    best = None
+    for b in fam.nonlinear_starts(data):
+        b = np.clip(b, nl_lo, nl_hi)
+        # the stress is linear in the first n constants: columns = stress of unit constants
+        basis = np.stack([_nominal(fam.law(np.concatenate([e, b])), data.x) for e in np.eye(n)], axis=1)
+        a = lsq_linear(basis * w[:, None], np.sign(data.stress), bounds=(lin_lo, np.full(n, np.inf))).x
+        p0 = np.clip(np.concatenate([a, b]), lo, hi)
+        sol = least_squares(lambda p: _residual(fam, data, p), p0, bounds=(lo, hi), x_scale="jac",
+                            xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=500)
+        if _admissible(fam, sol.x) and (best is None or sol.cost < best.cost):
+            best = sol
+    if best is None:
+        return None
+    p = best.x
+    if model == "ogden":  # terms in increasing alpha
+        order = np.argsort(p[n:])
+        p = np.concatenate([p[:n][order], p[n:][order]])
+    k = kappa if kappa is not None else 1000.0 * fam.law(p).shear_modulus
+    table = fam.table(p)
+    law = MaterialSpec.model_validate(table | {"model": model, "kappa": k}).build()
+    r = _residual(fam, data, p)
+    rms = {m: float(np.sqrt(np.mean(r[data.mode == i] ** 2))) for i, m in enumerate(MODES) if (data.mode == i).any()}
+    stable = {m: stable_range(drucker_stable(law, m, STABILITY_STRETCHES)) for m in MODES}
+    points = {m: data.count(m) for m in MODES if data.count(m)}
+    return FitResult(model, terms if model == "ogden" else None, law, table, rms, stable, points)
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, list):
+        return "[" + ", ".join(f"{x:.6g}" for x in v) + "]"
+    return f"{v:.6g}"
+
+
+def material_table(result: FitResult) -> str:
+    """The [material] table, ready to paste into a case file."""
+    lines = ["[material]", f'model = "{result.model}"']
+    lines += [f"{key} = {_toml_value(v)}" for key, v in result.table.items()]
+    lines.append(f"kappa = {result.law.kappa:.6g}")
+    return "\n".join(lines) + "\n"
+
+
+def combined_range(result: FitResult) -> tuple[float, float] | None:
+    """The stretch range stable in all three modes."""
+    ranges = list(result.stable.values())
+    if any(r is None for r in ranges):
+        return None
+    return max(r[0] for r in ranges), min(r[1] for r in ranges)
+
+
+def plot(result: FitResult, data: Data, mode: str, path: Path) -> None:
+    """Data as markers, the model as a line, for one mode."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    sel = data.mode == MODES.index(mode)
+    lam = data.stretch[sel]
+    grid = np.linspace(min(lam.min(), 1.0), lam.max() * 1.02, 300)
+    fig, ax = plt.subplots(figsize=(6.4, 4.6))
+    ax.plot(lam, data.stress[sel], "o", mfc="none", color="k", label="data")
+    ax.plot(grid, nominal_stress(result.law, mode, grid), "-", color="C3", label=f"{result.model} fit")
+    ax.axhline(0.0, color="0.8", lw=0.8)
+    ax.set_xlabel(f"stretch λ in the loading direction ({mode})")
+    ax.set_ylabel("nominal stress (units of the data)")
+    ax.set_title(f"{_name(result)}, {mode}: RMS relative error {100 * result.rms[mode]:.2f} %")
+    ax.legend(loc="upper left")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def _name(result: FitResult) -> str:
+    return f"{result.model} ({result.terms} terms)" if result.terms else result.model
+
+
+def _range_text(r: tuple[float, float] | None) -> str:
+    if r is None:
+        return "unstable at small strain"
+    if r == (float(STABILITY_STRETCHES[0]), float(STABILITY_STRETCHES[-1])):
+        return f"stable from {r[0]:.3g} to {r[1]:.3g} (the whole range checked)"
+    return f"stable from {r[0]:.3g} to {r[1]:.3g}"
+
+
+def run(paths: list[str], model: str, terms: int | None, out: str | None, kappa: float | None) -> int:
+    """The `axiform fit` command: exit 2 for bad data, 1 if nothing admissible, 0 otherwise."""
+    if terms is not None and model != "ogden":
+        print("axiform fit: --terms is for --model ogden", file=sys.stderr)
+        return 2
+    terms = 3 if terms is None else terms
+    if not 1 <= terms <= MAX_OGDEN_TERMS:
+        print(f"axiform fit: --terms must be 1 to {MAX_OGDEN_TERMS}, got {terms}", file=sys.stderr)
+        return 2
+    if kappa is not None and not (math.isfinite(kappa) and kappa > 0):
+        print(f"axiform fit: --kappa must be a finite number > 0, got {kappa}", file=sys.stderr)
+        return 2
+    try:
+        data = read_data(paths)
+    except FitDataError as exc:
+        print(f"axiform fit: {exc}", file=sys.stderr)
+        return 2
+    for note in data.notes:
+        print(f"axiform fit: {note}", file=sys.stderr)
+    result = fit(data, model, terms, kappa)
+    if result is None:
+        print(f"axiform fit: no admissible {model} constants found for these data", file=sys.stderr)
+        return 1
+    folder = Path(out) if out else Path("results") / f"fit-{model}"
+    folder.mkdir(parents=True, exist_ok=True)
+    counts = ", ".join(f"{m} {c}" for m, c in result.points.items())
+    table = material_table(result)
+    (folder / "material.toml").write_text(
+        f"# axiform fit --model {model}: {', '.join(map(str, paths))} ({counts} points)\n" + table)
+    both = combined_range(result)
+    summary = {
+        "model": model,
+        "terms": result.terms,
+        "parameters": result.table,
+        "kappa": result.law.kappa,
+        "shear_modulus": result.law.shear_modulus,
+        "points": result.points,
+        "rms_relative_error": result.rms,
+        "stable_range": list(both) if both else None,
+        "stable_range_by_mode": {m: (list(r) if r else None) for m, r in result.stable.items()},
+        "stability_checked": [float(STABILITY_STRETCHES[0]), float(STABILITY_STRETCHES[-1])],
+        "data": [str(p) for p in paths],
+    }
+    (folder / "fit.json").write_text(json.dumps(summary, indent=2) + "\n")
+    for mode in result.points:
+        plot(result, data, mode, folder / f"fit_{mode}.png")
+    print(f"{_name(result)} fitted to {counts} points; initial shear modulus {result.law.shear_modulus:.6g}\n")
+    print(table)
+    print(f"{'mode':<12} {'points':>6}  RMS relative error")
+    for mode, rms in result.rms.items():
+        print(f"{mode:<12} {result.points[mode]:>6}  {100 * rms:8.2f} %")
+    print("\nDrucker stability, stretch 0.1 to 10:")
+    for mode, r in result.stable.items():
+        print(f"  {mode:<12} {_range_text(r)}")
+    print(f"  {'all modes':<12} {_range_text(both)}")
+    print(f"\nwrote {folder / 'material.toml'}, fit.json, " + ", ".join(f"fit_{m}.png" for m in result.points))
+    return 0

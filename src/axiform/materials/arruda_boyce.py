@@ -1,0 +1,44 @@
+"""Arruda-Boyce (eight chain), Abaqus' five-term series:
+W_iso = mu sum_{i=1..5} c_i / lambda_m^(2i-2) (I1_bar^i - 3^i),
+c = (1/2, 1/20, 11/1050, 19/7000, 519/673750); lambda_m the locking stretch."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.polynomial import polynomial
+
+from .invariant import InvariantLaw
+
+SERIES = np.array([1.0 / 2.0, 1.0 / 20.0, 11.0 / 1050.0, 19.0 / 7000.0, 519.0 / 673750.0])
+
+
+@dataclass(frozen=True)
+class ArrudaBoyce(InvariantLaw):
+    """Arruda-Boyce plus kappa/2 (J - 1)^2; mu is Abaqus' mu (the initial shear modulus is
+    mu (1 + 3/(5 lm^2) + 99/(175 lm^4) + 513/(875 lm^6) + 42039/(67375 lm^8)))."""
+
+    mu: float
+    lambda_m: float
+    kappa: float
+
+
+    def coefficients(self) -> np.ndarray:
+        """a_i = mu c_i / lambda_m^(2i-2), i = 1..5, so that W_iso = sum a_i (I1_bar^i - 3^i)."""
+        return self.mu * SERIES / self.lambda_m ** (2.0 * np.arange(5))
+
+    @property
+    def shear_modulus(self) -> float:
+        """Initial shear modulus 2 dW/dI1_bar at I1_bar = 3."""
+        return 2.0 * float(polynomial.polyval(3.0, polynomial.polyder(np.r_[0.0, self.coefficients()])))
+
+    def psi(self, I1b: np.ndarray, I2b: np.ndarray | None) -> np.ndarray:
+        a = np.r_[0.0, self.coefficients()]
+        return polynomial.polyval(I1b, a) - polynomial.polyval(3.0, a)
+
+    def psi_derivatives(self, I1b: np.ndarray, I2b: np.ndarray | None, tangent: bool) -> tuple:
+        a1 = polynomial.polyder(np.r_[0.0, self.coefficients()])
+        W1 = polynomial.polyval(I1b, a1)
+        W11 = polynomial.polyval(I1b, polynomial.polyder(a1)) if tangent else None
+        return W1, None, W11, None, None
