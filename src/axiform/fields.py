@@ -1,5 +1,5 @@
 """Nodal fields for output: displacement, fibre rotation, J, Cauchy and von Mises stress,
-principal stretches, contact pressure.
+principal stretches, contact pressure, time of first contact.
 
 Quadrature-point values are averaged to the nodes (each element's mean, then the mean over
 the elements around a node): enough for pictures, not for error estimates.
@@ -51,4 +51,14 @@ def point_fields(model, u_full: np.ndarray) -> dict[str, np.ndarray]:
                 rep = pair.report()
                 pressure[rep["node"]] += rep["pressure"]
         out["contact_pressure"] = pressure
+        out["first_contact"] = first_contact(model)
     return out
+
+
+def first_contact(model) -> np.ndarray:
+    """Per node (n_nodes,): the time t (load factor) of the step in which it first touched a
+    mould (the earliest over the contact pairs), -1 where it never did."""
+    t = np.full(model.mesh.n_nodes, np.inf)
+    for pair in model.contacts:
+        np.fmin.at(t, pair.nodes, pair.first_contact)
+    return np.where(np.isfinite(t), t, -1.0)

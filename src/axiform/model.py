@@ -147,6 +147,7 @@ class Model:
         self._pressure_pos = [self.pattern.positions(p.dofs) for p in self.pressures]
         self._contact_dofs = [c.dofs(self.dpn) for c in self.contacts]
         self._contact_pos = [self.pattern.positions(d) for d in self._contact_dofs]
+        self._contact_edge_pos = [self.pattern.positions(c.edge_dofs(self.dpn)) for c in self.contacts]
         self.f_point = np.zeros(self.n_full)
         for d, v in self.point_loads:
             self.f_point[d] += v
@@ -206,6 +207,8 @@ class Model:
                 data -= lam * dfext
             for pos, Kc in zip(self._contact_pos, contact_data):
                 data = self.pattern.accumulate(pos, Kc, data)
+            for pos, pair in zip(self._contact_edge_pos, self.contacts):
+                data = self.pattern.accumulate(pos, -pair.coupling, data)  # through the current areas
             K, K_fp = self.pattern.blocks(data)
             if dm.np:
                 dr_dlam = dr_dlam + K_fp @ dm.prescribed_ref
