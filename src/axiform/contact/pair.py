@@ -110,24 +110,27 @@ class ContactPair:
         edges = slave_edges(mesh, np.asarray(slaves))
         if len(edges) == 0:
             raise ValueError("the slave nodes hold no boundary edge (select a face, not single nodes)")
-        area0 = np.bincount(edges.ravel(), ring_areas(mesh.points, edges).ravel(), mesh.n_nodes)
-        self.nodes = np.flatnonzero(area0 > 0)
-        if len(self.nodes) == 0:
-            raise ValueError("the slave face lies on the axis (no ring area)")
-        keep = (area0[edges] > 0).all(axis=1)
+        parts = ring_areas(mesh.points, edges)
+        self.nodes = np.unique(edges)
         local = np.full(mesh.n_nodes, -1)
         local[self.nodes] = np.arange(len(self.nodes))
-        self.edges = local[edges[keep]]  # (m, k) edges in slave numbering
+        self.edges = local[edges]  # (m, k) edges in slave numbering
+        n = len(self.nodes)
+        self.area0 = np.bincount(self.edges.ravel(), parts.ravel(), n)
+        # nodes on the axis have no ring area (the Q8 corner weight of an edge is 2 pi L r / 6)
+        self.on_axis = self.area0 <= 1e-12 * self.area0.max()
+        if self.on_axis.all():
+            raise ValueError("the slave face lies on the axis (no ring area)")
         self.mesh = mesh
         self.surface = surface
         self.X = mesh.points[self.nodes]
-        self.area0 = area0[self.nodes]
         if penalty is None:
             if modulus is None:
                 raise ValueError("give a penalty, or the material's modulus for the default one")
-            a = ring_areas(mesh.points, edges[keep])
-            h = np.bincount(self.edges.ravel(), (a * _edge_heights(mesh, edges[keep])[:, None]).ravel(),
-                            len(self.nodes)) / self.area0
+            height = _edge_heights(mesh, edges)[:, None]
+            weight = parts + 1e-300  # ring-area weighted mean of the heights of the node's cells
+            h = np.bincount(self.edges.ravel(), (weight * height).ravel(), n) / np.bincount(
+                self.edges.ravel(), weight.ravel(), n)
             self.kn0 = PENALTY_FACTOR * modulus / h  # per unit current area at the reference state
             self.thinning = 1.0  # the penalty grows as the element under the node thins
         else:
@@ -139,7 +142,6 @@ class ContactPair:
         self.depth = depth if depth is not None else 0.5 * mesh.size()
         self.smoothing = smoothing if smoothing is not None else 1e-3 * mesh.size()
         self.search = search
-        n = len(self.nodes)
         # history, updated only at converged steps
         self.x_prev = self.X.copy()  # surface-frame positions at the last converged step
         self.s_stick = np.full(n, np.nan)  # friction: surface coordinate where a node sticks
@@ -167,8 +169,8 @@ class ContactPair:
         parts, dparts = ring_areas(xa, self.edges, derivative=True)
         a = np.bincount(self.edges.ravel(), parts.ravel(), len(self.nodes))
         # f = w(a) t: w = a (a / a0)^thinning, the area times the thinning of the penalty
-        ratio = (a / self.area0) ** self.thinning
-        w, dw = a * ratio, (1.0 + self.thinning) * ratio
+        ratio = np.where(self.on_axis, 1.0, a / np.where(self.on_axis, 1.0, self.area0)) ** self.thinning
+        w, dw = a * ratio, np.where(self.on_axis, 1.0, (1.0 + self.thinning) * ratio)
         t, dt, status, proj, x = self._traction(xa - self.surface.offset(lam))
         f = w[:, None] * t
         K = w[:, None, None] * dt

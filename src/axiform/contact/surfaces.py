@@ -35,7 +35,7 @@ class Projection:
     kind: np.ndarray  # 0 none, 1 segment or circle, 2 cavity corner (vertex), 3 crossing
 
     @classmethod
-    def empty(cls, n: int) -> "Projection":
+    def empty(cls, n: int) -> Projection:
         z = np.zeros(n)
         return cls(np.zeros(n, bool), z.copy(), np.zeros((n, 2)), np.zeros((n, 2)), z.copy(), z.copy(),
                    np.ones(n), np.zeros((n, 2)), z.copy(), np.zeros(n, np.int8))
@@ -146,7 +146,7 @@ class Polyline(RigidSurface):
             self.lo[k], self.hi[k] = pts.min(axis=0), pts.max(axis=0)
 
     @classmethod
-    def from_profile(cls, profile, motion=(0.0, 0.0)) -> "Polyline":
+    def from_profile(cls, profile, motion=(0.0, 0.0)) -> Polyline:
         """The exact pieces of an axiform.profile.Profile (lines and arcs)."""
         from ..profile import Arc
 
@@ -155,7 +155,7 @@ class Polyline(RigidSurface):
         ccw = [p.ccw if isinstance(p, Arc) else True for p in profile.pieces]
         return cls(motion=motion, points=np.array(points, float), centers=centers, ccw=ccw)
 
-    def reversed(self) -> "Polyline":
+    def reversed(self) -> Polyline:
         """The same pieces walked the other way: the body on the other side."""
         centers = [None if not arc else tuple(c) for arc, c in zip(self.is_arc, self.c)][::-1]
         return Polyline(motion=self.motion, points=self.points[::-1].copy(), centers=centers,
