@@ -27,6 +27,7 @@ from pydantic import (
 )
 
 from .cavity import CavityError
+from .contact.dxf import DxfError, read_dxf
 from .contact.pair import ContactPair
 from .curves import PROPORTIONAL, Curve
 from .contact.surfaces import Circle, Polyline
@@ -286,17 +287,28 @@ class ProfileSurfaceSpec(Strict):
 
 class SurfaceSpec(Strict):
     """A rigid surface: a circle, a polyline (points in order: the body on their left), the
-    points of a CSV file (r, z per line), or a profile of lines and arcs."""
+    points of a CSV file (r, z per line), a profile of lines and arcs, or the lines and arcs
+    of a DXF drawing (on `layer`, ends joined within `tolerance`); `reverse` walks the
+    path the other way (the body on its other side)."""
 
     circle: CircleSpec | None = None
     polyline: Annotated[list[tuple[float, float]], Field(min_length=2)] | None = None
     file: str | None = None
     profile: ProfileSurfaceSpec | None = None
+    dxf: str | None = None
+    layer: str | None = None
+    tolerance: PositiveFloat | None = None
+    reverse: bool = False
 
     @model_validator(mode="after")
     def _one(self):
-        if sum(getattr(self, k) is not None for k in ("circle", "polyline", "file", "profile")) != 1:
-            raise ValueError("a surface is exactly one of circle, polyline, file, profile")
+        if sum(getattr(self, k) is not None for k in ("circle", "polyline", "file", "profile", "dxf")) != 1:
+            raise ValueError("a surface is exactly one of circle, polyline, file, profile, dxf")
+        for key in ("layer", "tolerance"):
+            if getattr(self, key) is not None and self.dxf is None:
+                raise ValueError(f"'{key}' belongs to a dxf surface")
+        if self.reverse and self.circle is not None:
+            raise ValueError("'reverse' does not apply to a circle (use inside = true)")
         return self
 
 
@@ -563,14 +575,19 @@ def _mesh(spec: MeshSpec, base: Path) -> Mesh:
         raise CaseError(f"mesh.file: cannot read {path} as a gmsh mesh ({' '.join(why.split())})") from None
 
 
-def default_penalty(material: Hyperelastic, mesh: Mesh) -> float:
-    """10 E / h: E the small-strain Young's modulus of the material, h the smallest element
-    edge; the penetration left is then about p h / (10 E) for a contact pressure p."""
+def youngs_modulus(material: Hyperelastic) -> float:
+    """The small-strain Young's modulus E = 9 kappa mu / (3 kappa + mu) of the material (for
+    the default contact penalty)."""
     mu, k = material.shear_modulus, material.kappa
-    return 10.0 * 9.0 * k * mu / (3.0 * k + mu) / mesh.size()
+    return 9.0 * k * mu / (3.0 * k + mu)
 
 
 def _surface(spec: SurfaceSpec, motion: tuple[float, float], base: Path, where: str):
+    surface = _path_surface(spec, motion, base, where)
+    return surface.reversed() if spec.reverse else surface
+
+
+def _path_surface(spec: SurfaceSpec, motion: tuple[float, float], base: Path, where: str):
     if spec.circle is not None:
         c = spec.circle
         return Circle(motion=motion, center=c.center, radius=c.radius, inside=c.inside)
@@ -585,6 +602,13 @@ def _surface(spec: SurfaceSpec, motion: tuple[float, float], base: Path, where: 
             return Polyline.from_profile(profile, motion)
         except (ProfileError, ValueError) as exc:
             raise CaseError(f"{where}.surface.profile: {exc}") from None
+    elif spec.dxf is not None:
+        path = Path(spec.dxf)
+        try:
+            return read_dxf(path if path.is_absolute() else base / path, spec.layer, tolerance=spec.tolerance,
+                            motion=motion)
+        except DxfError as exc:
+            raise CaseError(f"{where}.surface.dxf: {exc}") from None
     else:
         path = Path(spec.file)
         path = path if path.is_absolute() else base / path
@@ -623,10 +647,10 @@ def _contact(mesh: Mesh, model: Model, spec: ContactSpec, base: Path, where: str
     surface = _uncrossed(_surface(spec.surface, (spec.motion.ur, spec.motion.uz), base, where), where)
     surface.curve = spec.motion.build_curve()
     slaves = select_nodes(mesh, spec.slaves.model_dump(), f"{where}.slaves")
-    penalty = spec.penalty if spec.penalty is not None else default_penalty(model.material, mesh)
     try:
-        return ContactPair(mesh, surface, slaves, penalty, friction=spec.friction, sticky=spec.sticky,
-                           tangential_penalty=spec.tangential_penalty, depth=spec.depth, search=spec.search)
+        return ContactPair(mesh, surface, slaves, spec.penalty, friction=spec.friction, sticky=spec.sticky,
+                           tangential_penalty=spec.tangential_penalty, depth=spec.depth, search=spec.search,
+                           modulus=youngs_modulus(model.material))
     except ValueError as exc:
         raise CaseError(f"{where}.slaves: {exc}") from None
 

@@ -1,6 +1,6 @@
 """Nodal fields for output: displacement, fibre rotation, J, Cauchy and von Mises stress,
 pressure (-tr sigma / 3, volume-averaged over each element), principal stretches, contact
-pressure.
+pressure, time of first contact.
 
 Quadrature-point values are averaged to the nodes (each element's mean, then the mean over
 the elements around a node): enough for pictures, not for error estimates.
@@ -71,3 +71,4 @@ def point_fields(model, u_full: np.ndarray) -> dict[str, np.ndarray]:
         if when is not None:
             out["first_contact"] = np.nan_to_num(when, nan=-1.0)
     return out
+

@@ -210,6 +210,7 @@ class Model:
         span = float(np.ptp(self.mesh.points, axis=0).max())
         mu = float(getattr(self.material, "shear_modulus", 1.0))
         self._noise_floor = 16 * np.finfo(float).eps * 2 * np.pi * mu * span**2 * np.sqrt(dm.nf)
+        self._contact_edge_pos = [self.pattern.positions(c.edge_dofs(self.dpn)) for c in self.contacts]
         return self
 
     @property
@@ -325,6 +326,8 @@ class Model:
                 data = self.pattern.accumulate(pos, Kc, data)
             for pos, Hc in zip(self._cavity_pos, cav_data):
                 data = self.pattern.accumulate(pos, Hc, data)
+            for pos, pair in zip(self._contact_edge_pos, self.contacts):
+                data = self.pattern.accumulate(pos, -pair.coupling, data)  # through the current areas
             K, K_fp = self.pattern.blocks(data)
             if dm.np:
                 dr_dt = dr_dt + K_fp @ dpresc

@@ -170,14 +170,16 @@ class ResultsWriter:
         from .contact.pair import STATUS
 
         lines = [f"# step {step.number}, load_factor {float(step.lam)!r}",
-                 "pair,node,r,z,gap,pressure,status"]
+                 "pair,node,r,z,gap,pressure,status,first_contact"]
         totals = []
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
         for k, pair in enumerate(self.model.contacts):
             rep = pair.report()
             x = self.model.mesh.points[rep["node"]] + u[rep["node"]]
-            for node, (r, z), g, p, st in zip(rep["node"], x, rep["gap"], rep["pressure"], rep["status"]):
-                lines.append(f"{k},{node},{r:.10g},{z:.10g},{g:.6g},{p:.6g},{STATUS[int(st)]}")
+            for node, (r, z), g, p, st, t in zip(rep["node"], x, rep["gap"], rep["pressure"], rep["status"],
+                                                  rep["first_contact"]):
+                first = "" if np.isnan(t) else repr(float(t))
+                lines.append(f"{k},{node},{r:.10g},{z:.10g},{g:.6g},{p:.6g},{STATUS[int(st)]},{first}")
             totals.append({q: rep[q] for q in ("force_r", "force_z", "contact_area", "penetration")})
         write_atomic(self.out / "contact.csv", "\n".join(lines) + "\n")
         write_atomic(self.out / "surfaces.csv", mould_outlines(self.model.contacts, float(step.lam)))

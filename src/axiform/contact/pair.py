@@ -2,101 +2,202 @@
 law (eqs. 40-41), Coulomb friction with a tangential penalty and stick/slip (eqs. 42-45), or
 sticky contact (a node that touches stays where it touched: the parison freezing on the cold
 mould).  Forces are for the whole revolved body: the penalty is a pressure per unit gap,
-times the ring area of each node (the consistent area, integral of 2 pi r N_i ds).
+times the current ring area of each node (the consistent area, integral of 2 pi r N_i ds).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..elements import edge_shape, gauss_1d
 from ..mesh import Mesh
 from .surfaces import RigidSurface
 
 STATUS = {0: "open", 1: "stick", 2: "slip", 3: "sticky"}  # slip: |ft| > tanh(1) mu fn
+PENALTY_FACTOR = 10.0  # default penalty: PENALTY_FACTOR E / h, h the current element height
 
 
-def ring_areas(mesh: Mesh, nodes: np.ndarray) -> np.ndarray:
-    """Reference area of the revolved surface belonging to each slave node: over the boundary
-    edges (corner to corner) whose two ends are slaves, int 2 pi r N_i ds."""
+def slave_edges(mesh: Mesh, nodes: np.ndarray) -> np.ndarray:
+    """Boundary edges (m, edge_nodes) all of whose nodes (Q8: the mid-side node too) are among
+    `nodes`, ends first, as the owning cell runs."""
     is_slave = np.zeros(mesh.n_nodes, bool)
     is_slave[nodes] = True
-    e = mesh.boundary_edges[:, :2]
-    e = e[is_slave[e].all(axis=1)]
-    if len(e) == 0:
-        raise ValueError("the slave nodes hold no boundary edge (select a face, not single nodes)")
-    ra, rb = mesh.points[e[:, 0], 0], mesh.points[e[:, 1], 0]
-    L = np.linalg.norm(mesh.points[e[:, 1]] - mesh.points[e[:, 0]], axis=1)
-    area = np.zeros(mesh.n_nodes)
-    np.add.at(area, e[:, 0], 2 * np.pi * L * (2 * ra + rb) / 6)
-    np.add.at(area, e[:, 1], 2 * np.pi * L * (ra + 2 * rb) / 6)
-    return area[nodes]
+    e = mesh.boundary_edges
+    return e[is_slave[e].all(axis=1)]
+
+
+def ring_areas(x: np.ndarray, edges: np.ndarray, derivative: bool = False):
+    """The consistent ring areas of the edge nodes, a_i = int 2 pi r N_i ds over each edge
+    with the edge's own shape functions N_i (linear, or quadratic for Q8: Simpson's corner
+    weight 1/6 and mid-side weight 2/3 on a straight edge at constant r), in the
+    configuration x (n_nodes, 2) (reference or current).
+
+    Returns per edge and edge node the part a (m, k) and, if asked, its derivative
+    da[m, i, j, :] = d a_i / d x_j (m, k, k, 2) with respect to the positions of the edge's
+    nodes; a node's area is the sum of its parts over its edges."""
+    s, wq = gauss_1d(3)
+    N, dN = edge_shape(edges.shape[1], s)  # (p, k)
+    X = x[edges]  # (m, k, 2)
+    t = np.einsum("pk,mkd->mpd", dN, X)  # dx/ds (m, p, 2)
+    L = np.linalg.norm(t, axis=2)  # (m, p)
+    r = np.einsum("pk,mk->mp", N, X[..., 0])
+    a = 2 * np.pi * np.einsum("p,pi,mp->mi", wq, N, r * L)
+    if not derivative:
+        return a
+    m, k = edges.shape
+    da = np.zeros((m, k, k, 2))
+    # d(r L) / dx_j = N_j L e_r + r dN_j t / L
+    da[..., 0] = np.einsum("p,pi,pj,mp->mij", wq, N, N, L)
+    da += np.einsum("p,pi,pj,mpd->mijd", wq, N, dN, (r / L)[..., None] * t)
+    return a, 2 * np.pi * da
+
+
+def _edge_heights(mesh: Mesh, edges: np.ndarray) -> np.ndarray:
+    """Height of the cell under each boundary edge (m,): the cell's area in the (r, z) plane
+    over the edge's chord."""
+    local = mesh.element.edge_local_nodes()[:, :2]  # (4, 2) corner pairs of the cell edges
+    ends = np.sort(mesh.cells[:, local], axis=2).reshape(-1, 2)  # (4 e, 2)
+    n = mesh.n_nodes
+    keys = ends[:, 0] * n + ends[:, 1]
+    order = np.argsort(keys)
+    want = np.sort(edges[:, :2], axis=1)
+    cell = order[np.searchsorted(keys[order], want[:, 0] * n + want[:, 1])] // 4
+    c = mesh.points[mesh.cells[cell, :4]]  # corners, counter-clockwise
+    area = 0.5 * np.abs((c[..., 0] * np.roll(c[..., 1], -1, axis=1)
+                         - np.roll(c[..., 0], -1, axis=1) * c[..., 1]).sum(axis=1))
+    chord = np.linalg.norm(mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]], axis=1)
+    return area / chord
+
+
+def outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise outer products (n, 2, 2) of a and b (n, 2)."""
+    return a[:, :, None] * b[:, None, :]
 
 
 class ContactPair:
-    """Slave nodes (corner nodes on the boundary) against a rigid surface.
+    """Slave nodes of the body (every node of the boundary edges whose nodes are all
+    selected: corners and, for Q8, mid-side nodes) against a rigid surface.
 
-    penalty: normal stiffness per unit area (pressure per unit gap); tangential_penalty
-    defaults to the same.  friction: Coulomb coefficient mu (0: frictionless).  sticky: a node
-    that touches is tied to the point where it touched.  depth: how deep behind the surface a
-    node is still taken as touching it (nodes deeper were not in contact at the last
-    converged step and did not cross the surface since).  smoothing: the penalty law is
-    rounded over gaps in [-smoothing, smoothing] (fn = kn (d - g)^2 / 4d there, kn (-g)
-    below), so that the force has a continuous derivative and nodes grazing the surface
-    do not chatter in and out of contact from one Newton iteration to the next; default 1e-3
-    of the smallest element edge."""
+    Forces are lumped at the nodes: f_i = a_i t_i, with a_i the consistent ring area of node
+    i in the CURRENT configuration (`ring_areas`) and t_i the traction of the contact law
+    (pressure per unit gap times the gap, friction, sticky), so that the penalty acts per
+    unit of current area.  The derivative of a_i with respect to the positions of the nodes
+    of its edges is part of the tangent (`coupling`).
 
-    def __init__(self, mesh: Mesh, surface: RigidSurface, slaves: np.ndarray, penalty: float,
+    penalty: normal stiffness per unit current area (pressure per unit gap).  None (the
+    default) takes PENALTY_FACTOR * modulus / h with h the current height of the element
+    under the node, estimated at constant volume as h0 a0 / a (h0 the reference height, a0
+    and a the reference and current ring areas): a wall stretched and thinned keeps its
+    penetration p h / (PENALTY_FACTOR E) a fixed fraction of its current thickness for a
+    contact pressure p.  tangential_penalty defaults to the normal one (and follows the same
+    thinning when that is the default).  friction: Coulomb coefficient mu (0: frictionless).
+    sticky: a node that touches is tied to the point where it touched.  depth: how deep
+    behind the surface a node is still taken as touching it (nodes deeper were not in
+    contact at the last converged step and did not cross the surface since).  smoothing:
+    the penalty law is rounded over gaps in [-smoothing, smoothing] (fn = kn (d - g)^2 / 4d
+    there, kn (-g) below), so that the force has a continuous derivative and nodes grazing
+    the surface do not chatter in and out of contact from one Newton iteration to the next;
+    default 1e-3 of the smallest element edge.
+
+    History (updated at converged steps by `commit`): stick points, sticky nodes, and
+    `first_contact` (n,): the load factor (process time t) of the step in which each node
+    first touched (for sticky contact: froze), NaN where it never did."""
+
+    def __init__(self, mesh: Mesh, surface: RigidSurface, slaves: np.ndarray, penalty: float | None = None,
                  friction: float = 0.0, sticky: bool = False, tangential_penalty: float | None = None,
-                 depth: float | None = None, search: str = "buckets", smoothing: float | None = None):
-        corner = np.zeros(mesh.n_nodes, bool)
-        corner[mesh.corner_nodes] = True
-        on_boundary = np.zeros(mesh.n_nodes, bool)
-        on_boundary[np.unique(mesh.boundary_edges)] = True
-        slaves = np.asarray(slaves)
-        self.nodes = slaves[corner[slaves] & on_boundary[slaves]]
-        if len(self.nodes) == 0:
-            raise ValueError("no corner node on the boundary among the slave nodes")
+                 depth: float | None = None, search: str = "buckets", smoothing: float | None = None,
+                 modulus: float | None = None):
+        edges = slave_edges(mesh, np.asarray(slaves))
+        if len(edges) == 0:
+            raise ValueError("the slave nodes hold no boundary edge (select a face, not single nodes)")
+        parts = ring_areas(mesh.points, edges)
+        self.nodes = np.unique(edges)
+        local = np.full(mesh.n_nodes, -1)
+        local[self.nodes] = np.arange(len(self.nodes))
+        self.edges = local[edges]  # (m, k) edges in slave numbering
+        n = len(self.nodes)
+        self.area0 = np.bincount(self.edges.ravel(), parts.ravel(), n)
+        # nodes on the axis have no ring area (the Q8 corner weight of an edge is 2 pi L r / 6)
+        self.on_axis = self.area0 <= 1e-12 * self.area0.max()
+        if self.on_axis.all():
+            raise ValueError("the slave face lies on the axis (no ring area)")
         self.mesh = mesh
         self.surface = surface
         self.X = mesh.points[self.nodes]
-        self.area = ring_areas(mesh, self.nodes)
-        self.kn = penalty * self.area
-        self.kt = (penalty if tangential_penalty is None else tangential_penalty) * self.area
+        if penalty is None:
+            if modulus is None:
+                raise ValueError("give a penalty, or the material's modulus for the default one")
+            height = _edge_heights(mesh, edges)[:, None]
+            weight = parts + 1e-300  # ring-area weighted mean of the heights of the node's cells
+            h = np.bincount(self.edges.ravel(), (weight * height).ravel(), n) / np.bincount(
+                self.edges.ravel(), weight.ravel(), n)
+            self.kn0 = PENALTY_FACTOR * modulus / h  # per unit current area at the reference state
+            self.thinning = 1.0  # the penalty grows as the element under the node thins
+        else:
+            self.kn0 = np.full(len(self.nodes), float(penalty))
+            self.thinning = 0.0
+        self.kt0 = self.kn0 if tangential_penalty is None else np.full(len(self.nodes), float(tangential_penalty))
         self.mu = friction
         self.sticky = sticky
         self.depth = depth if depth is not None else 0.5 * mesh.size()
         self.smoothing = smoothing if smoothing is not None else 1e-3 * mesh.size()
         self.search = search
-        n = len(self.nodes)
         # history, updated only at converged steps
         self.x_prev = self.X.copy()  # surface-frame positions at the last converged step
         self.s_stick = np.full(n, np.nan)  # friction: surface coordinate where a node sticks
         self.stuck = np.zeros(n, bool)  # sticky: tied nodes, at stuck_point (surface frame)
         self.stuck_point = np.zeros((n, 2))
+        self.first_contact = np.full(n, np.nan)
+        self.coupling: np.ndarray | None = None
         self.last = None
 
     def dofs(self, dpn: int) -> np.ndarray:
         """Full dofs (ur, uz) of the slave nodes, (n, 2)."""
         return self.nodes[:, None] * dpn + np.arange(2)
 
+    def edge_dofs(self, dpn: int) -> np.ndarray:
+        """Full dofs (ur, uz) of the nodes of each slave edge, node by node (m, 2 k): the
+        blocks of `coupling`."""
+        return (self.nodes[self.edges][:, :, None] * dpn + np.arange(2)).reshape(len(self.edges), -1)
+
     def evaluate(self, u: np.ndarray, lam: float):
-        """Forces on the slave nodes (n, 2), their derivative (n, 2, 2) with respect to the
-        node positions, and the state of each node, at displacements u (n_nodes, 2)."""
-        x = self.X + u[self.nodes] - self.surface.offset(lam)
+        """Forces on the slave nodes f (n, 2), their derivative K (n, 2, 2) with respect to the
+        node positions relative to the surface, and the state of each node, at displacements
+        u (n_nodes, 2) and load factor lam.  Also sets `coupling` (m, 2k, 2k): the derivative
+        of the forces through the current ring areas, over the nodes of each slave edge."""
+        xa = self.X + u[self.nodes]
+        parts, dparts = ring_areas(xa, self.edges, derivative=True)
+        a = np.bincount(self.edges.ravel(), parts.ravel(), len(self.nodes))
+        # f = w(a) t: w = a (a / a0)^thinning, the area times the thinning of the penalty
+        ratio = np.where(self.on_axis, 1.0, a / np.where(self.on_axis, 1.0, self.area0)) ** self.thinning
+        w, dw = a * ratio, np.where(self.on_axis, 1.0, (1.0 + self.thinning) * ratio)
+        t, dt, status, proj, x = self._traction(xa - self.surface.offset(lam))
+        f = w[:, None] * t
+        K = w[:, None, None] * dt
+        e = self.edges
+        m, k = e.shape
+        C = np.einsum("mi,mid,mije->midje", dw[e], t[e], dparts)  # d f_i / d x_j through a_i
+        self.coupling = C.reshape(m, 2 * k, 2 * k)
+        self.last = (x, proj, f, status, a, lam)
+        return f, K, status
+
+    def _traction(self, x: np.ndarray):
+        """The contact law per unit of w (pressure per unit gap kn0, kt0): traction t (n, 2),
+        dt/dx (n, 2, 2), status, at positions x relative to the surface."""
         proj = self.surface.local(x, self.x_prev, self.depth, self.search)
         n = len(x)
         f = np.zeros((n, 2))
         K = np.zeros((n, 2, 2))  # d f / d x
         status = np.zeros(n, np.int8)
+        kn, kt = self.kn0, self.kt0
         d = self.smoothing
         g = proj.g
         contact = proj.active & (g < d) & ~self.stuck
         # normal law (eqs. 40-41): f = fn n, fn = -kn g, rounded over |g| < d
         band = contact & (g > -d)
-        fn = np.where(contact, np.where(band, self.kn * (d - g) ** 2 / (4 * d), -self.kn * g), 0.0)
-        dfn = np.where(contact, np.where(band, -self.kn * (d - g) / (2 * d), -self.kn), 0.0)  # dfn/dg
+        fn = np.where(contact, np.where(band, kn * (d - g) ** 2 / (4 * d), -kn * g), 0.0)
+        dfn = np.where(contact, np.where(band, -kn * (d - g) / (2 * d), -kn), 0.0)  # dfn/dg
         nv, tv = proj.n, proj.t
-        outer = lambda a, b: a[:, :, None] * b[:, None, :]  # noqa: E731
         f += fn[:, None] * nv
         K += dfn[:, None, None] * outer(nv, nv)
         K += (fn * proj.kappa)[:, None, None] * outer(tv, tv)  # fn dn/dx
@@ -114,12 +215,12 @@ class ContactPair:
             limit = self.mu * fn  # eq. 42
             rub = contact & (limit > 0)
             safe = np.where(rub, limit, 1.0)
-            z = np.where(rub, self.kt * slip / safe, 0.0)
+            z = np.where(rub, kt * slip / safe, 0.0)
             th = np.tanh(z)
             sech2 = 1.0 - th * th
             ft = np.where(rub, -limit * th, 0.0)
             f += ft[:, None] * tv
-            K -= (rub * self.kt * sech2 * proj.m)[:, None, None] * outer(tv, tv)  # dft/ds
+            K -= (rub * kt * sech2 * proj.m)[:, None, None] * outer(tv, tv)  # dft/ds
             K -= (rub * self.mu * (th - z * sech2) * dfn)[:, None, None] * outer(tv, nv)  # dft/dfn
             K -= (ft * proj.kappa)[:, None, None] * outer(nv, tv)  # ft dt/dx
             sliding = rub & (np.abs(z) > 1.0)
@@ -127,46 +228,49 @@ class ContactPair:
             self._slip_state = (contact, s0, z, limit)
         if self.sticky:
             tied = self.stuck
-            f[tied] -= self.kn[tied, None] * (x[tied] - self.stuck_point[tied])
-            K[tied] -= self.kn[tied, None, None] * np.eye(2)
+            f[tied] -= kn[tied, None] * (x[tied] - self.stuck_point[tied])
+            K[tied] -= kn[tied, None, None] * np.eye(2)
             status[tied] = 3
-        self.last = (x, proj, f, status)
-        return f, K, status
+        return f, K, status, proj, x
 
     def commit(self) -> None:
         """Accept the state of the last evaluation (a converged step): positions for the
-        crossing test, stick points, newly stuck nodes."""
-        x, proj, f, status = self.last
+        crossing test, stick points, newly stuck nodes, the time of first contact."""
+        x, proj, _, status, _, lam = self.last
         self.x_prev = x.copy()
         if self.mu > 0 and not self.sticky:
             # slip beyond z = 3 (tanh = 0.995) is plastic: the stick point follows the node, so
             # that a reversal of the slip finds the force at once
             contact, s0, z, limit = self._slip_state
             zc = np.clip(z, -3.0, 3.0)
-            s_new = np.where(z != zc, proj.s - zc * limit / np.maximum(self.kt, 1e-300), s0)
+            s_new = np.where(z != zc, proj.s - zc * limit / np.maximum(self.kt0, 1e-300), s0)
             self.s_stick = np.where(contact, s_new, np.nan)
         if self.sticky:
             new = (status == 1)
             self.stuck_point[new] = x[new] - proj.g[new, None] * proj.n[new]
             self.stuck |= new
+        self.first_contact[(status > 0) & np.isnan(self.first_contact)] = lam
 
     def report(self):
         """Per node of the last evaluation: current (r, z) in the global frame, gap, contact
-        pressure (normal force over the ring area), status; and the totals."""
-        x, proj, f, status = self.last
+        pressure (normal force over the current ring area), status; and the totals (the
+        contact area is that of the reference configuration)."""
+        _, proj, f, status, a, _ = self.last
         fn = np.einsum("ij,ij->i", f, proj.n)
         in_contact = status > 0
         gap = np.where(proj.active, proj.g, np.nan)
         return {
             "node": self.nodes,
-            "pressure": np.where(in_contact, fn / self.area, 0.0),
+            "pressure": np.where(in_contact, fn / a, 0.0),
             "gap": gap,
             "status": status,
             "force": f,
-            "area": self.area,
+            "area": self.area0,
+            "current_area": a,
+            "first_contact": self.first_contact,
             "force_r": float(f[:, 0].sum()),
             "force_z": float(f[:, 1].sum()),
-            "contact_area": float(self.area[in_contact].sum()),
+            "contact_area": float(self.area0[in_contact].sum()),
             "penetration": float(max(0.0, -np.nanmin(np.where(in_contact, gap, np.nan)))
                                  if (in_contact & proj.active).any() else 0.0),
         }

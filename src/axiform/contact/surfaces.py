@@ -36,7 +36,7 @@ class Projection:
     kind: np.ndarray  # 0 none, 1 segment or circle, 2 cavity corner (vertex), 3 crossing
 
     @classmethod
-    def empty(cls, n: int) -> "Projection":
+    def empty(cls, n: int) -> Projection:
         z = np.zeros(n)
         return cls(np.zeros(n, bool), z.copy(), np.zeros((n, 2)), np.zeros((n, 2)), z.copy(), z.copy(),
                    np.ones(n), np.zeros((n, 2)), z.copy(), np.zeros(n, np.int8))
@@ -73,7 +73,8 @@ class Circle(RigidSurface):
 
     def local(self, x: np.ndarray, x_prev: np.ndarray, depth: float, method: str = "buckets") -> Projection:
         """Closed form: the nearest point of the circle.  Nodes deeper than `depth` are
-        ignored unless they crossed the circle since the last converged step."""
+        ignored unless they crossed the circle since the last converged step or were less
+        than `depth` behind it there."""
         c = np.asarray(self.center, float)
         d = x - c
         rho = np.linalg.norm(d, axis=1)
@@ -90,7 +91,9 @@ class Circle(RigidSurface):
         phi_prev = np.arctan2(dp[:, 1], dp[:, 0])
         phi_prev = phi + (phi_prev - phi + np.pi) % (2 * np.pi) - np.pi  # no jump across +-pi
         crossed = (g_prev >= 0) & (g < 0)
-        active = (g > -depth) | crossed
+        # a node that was near the circle at the last converged step and is behind it now went
+        # deeper during the increment (a Newton iterate may overshoot): it is still touching
+        active = (g > -depth) | crossed | ((g_prev > -depth) & (g < 0))
         p = Projection.empty(len(x))
         p.active = active
         p.g, p.n, p.t, p.s = g, n, t, s
@@ -152,7 +155,7 @@ class Polyline(RigidSurface):
             self.lo[k], self.hi[k] = pts.min(axis=0), pts.max(axis=0)
 
     @classmethod
-    def from_profile(cls, profile, motion=(0.0, 0.0)) -> "Polyline":
+    def from_profile(cls, profile, motion=(0.0, 0.0)) -> Polyline:
         """The exact pieces of an axiform.profile.Profile (lines and arcs)."""
         from ..profile import Arc
 
@@ -160,6 +163,12 @@ class Polyline(RigidSurface):
         centers = [p.center if isinstance(p, Arc) else None for p in profile.pieces]
         ccw = [p.ccw if isinstance(p, Arc) else True for p in profile.pieces]
         return cls(motion=motion, points=np.array(points, float), centers=centers, ccw=ccw)
+
+    def reversed(self) -> Polyline:
+        """The same pieces walked the other way: the body on the other side."""
+        centers = [None if not arc else tuple(c) for arc, c in zip(self.is_arc, self.c)][::-1]
+        return Polyline(motion=self.motion, points=self.points[::-1].copy(), centers=centers,
+                        ccw=[bool(d < 0) for d in self.dir[::-1]])
 
     def _arc_points(self, k: int, n: int) -> np.ndarray:
         phi = self.phi0[k] + self.dir[k] * np.linspace(0, self.sweep[k], n)
@@ -214,7 +223,8 @@ class Polyline(RigidSurface):
         the nodes moved since the last converged step), then for each node:
         1. a piece its path crossed since the last converged step (front to back: paper
            Figure 6), the first one crossed along the path;
-        2. else the pieces it projects onto (0 <= xi <= 1, eq. 38) with a gap above -depth:
+        2. else the pieces it projects onto (0 <= xi <= 1, eq. 38) with a gap above -depth
+           (or any gap < 0, if it was in range with a gap above -depth at the last converged step):
            the one with the largest gap.  A node that entered a corner where the mould turns
            away from the body faces two pieces (Figure 8): it leaves by the nearer face;
         3. else a corner where the mould turns towards the body (a cavity corner), the node
@@ -239,7 +249,11 @@ class Polyline(RigidSurface):
             xc = x_prev[i[crossed]] + np.minimum(tau[crossed], 1.0)[:, None] * (x[i[crossed]] - x_prev[i[crossed]])
             xic = self._piece_local(k[crossed], xc)[0]
             crossed[crossed] = (xic >= -tol) & (xic <= 1 + tol)
-        inrange = (xi >= -tol) & (xi <= 1 + tol) & (g > -depth)
+        # in front of the piece or less than depth behind it; or behind it now and near it at the
+        # last converged step (it went deeper during the increment: a Newton iterate may overshoot
+        # the penalty; without this it would fall through the mould)
+        near0 = (xi0 >= -tol) & (xi0 <= 1 + tol) & (g0 > -depth)
+        inrange = (xi >= -tol) & (xi <= 1 + tol) & ((g > -depth) | (near0 & (g < 0)))
         # rank the pairs of each node: crossings first (earliest), then in-range (largest gap)
         score = np.where(crossed, 2.0 + (1.0 - np.minimum(tau, 1.0)), np.where(inrange, 1.0, -np.inf))
         gap_rank = np.where(crossed | ~inrange, 0.0, g)
