@@ -246,7 +246,7 @@ def test_toric_plate_case_with_sticky_contact(tmp_path):
     area = np.array([float(r["contact_area"]) for r in rows])
     assert area[0] == 0 and area[-1] > 0 and (np.diff(area) >= 0).all()  # sticky: never lets go
     text = (out / "contact.csv").read_text().splitlines()
-    assert text[1] == "pair,node,r,z,gap,pressure,status,first_contact" and any(",sticky," in line for line in text)
+    assert text[0] == "pair,node,r,z,gap,pressure,status,first_contact" and any(",sticky," in line for line in text)
     summary = json.loads((out / "summary.json").read_text())
     pen = summary["contact"][0]["penetration"]
     assert 0 <= pen < 0.01 * 0.5  # the default penalty leaves < 1 % of the thickness

@@ -145,7 +145,7 @@ def test_first_contact_time_in_the_order_the_nodes_touch(tmp_path, element):
     out = tmp_path / "out"
     assert main(["run", str(case), "--out", str(out), "-q"]) == 0
     lines = (out / "contact.csv").read_text().splitlines()
-    rows = list(csv.DictReader(lines[1:]))
+    rows = list(csv.DictReader(lines))
     assert list(rows[0]) == ["pair", "node", "r", "z", "gap", "pressure", "status", "first_contact"]
     r = np.array([float(row["r"]) for row in rows])
     first = np.array([float(row["first_contact"]) if row["first_contact"] else np.nan for row in rows])

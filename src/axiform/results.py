@@ -169,8 +169,7 @@ class ResultsWriter:
         """contact.csv: every slave node of every pair at this step; totals in the summary."""
         from .contact.pair import STATUS
 
-        lines = [f"# step {step.number}, load_factor {float(step.lam)!r}",
-                 "pair,node,r,z,gap,pressure,status,first_contact"]
+        lines = ["pair,node,r,z,gap,pressure,status,first_contact"]  # header first (DESIGN 10.12)
         totals = []
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
         for k, pair in enumerate(self.model.contacts):
