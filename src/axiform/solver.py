@@ -185,6 +185,7 @@ class _Load(_Path):
         k = model.knots()
         lo, hi = sorted((0.0, self.target))
         self.stops = np.append(k[(k > lo) & (k < hi)][:: 1 if self.target > 0 else -1], self.target)
+        self.previous = None  # the last converged increment (du, dlambda)
 
     def done(self):
         return abs(self.target - self.lam) <= 1e-12 * abs(self.target)
@@ -200,7 +201,18 @@ class _Load(_Path):
     def attempt(self, size):
         stop = self._next_stop()
         lam = stop if abs(stop - self.lam - size) <= 1e-12 * abs(self.target) else self.lam + size
-        return _newton_load(self.model, self.u_f, lam, self.opts, self.floor)
+        guess = None
+        if self.previous is not None:
+            # secant predictor: the last increment scaled to this step; Newton from the last
+            # converged state instead needs many iterations where the response is far from
+            # linear (a flat sheet under pressure stiffens as it stretches)
+            du, dlam = self.previous
+            guess = self.u_f + ((lam - self.lam) / dlam) * du
+        return _newton_load(self.model, self.u_f, lam, self.opts, self.floor, guess)
+
+    def accept(self, u_f, lam, size):
+        self.previous = (u_f - self.u_f, lam - self.lam)
+        super().accept(u_f, lam, size)
 
 
 class _Displacement(_Path):
@@ -212,6 +224,7 @@ class _Displacement(_Path):
         self.target = control.target
         self.nominal = control.target / control.steps
         self.reached = 0.0
+        self.previous = None  # the last converged increment (du, dlambda, d reached)
 
     def done(self):
         return abs(self.target - self.reached) <= 1e-12 * abs(self.target)
@@ -222,9 +235,15 @@ class _Displacement(_Path):
 
     def attempt(self, size):
         goal = self.target if abs(self.target - self.reached - size) <= 1e-12 * abs(self.target) else self.reached + size
-        return _newton_displacement(self.model, self.u_f, self.lam, self.c, goal, self.opts, self.floor)
+        guess = None
+        if self.previous is not None:  # secant predictor, as under load control
+            du, dlam, dprev = self.previous
+            ratio = (goal - self.reached) / dprev
+            guess = (self.u_f + ratio * du, self.lam + ratio * dlam)
+        return _newton_displacement(self.model, self.u_f, self.lam, self.c, goal, self.opts, self.floor, guess)
 
     def accept(self, u_f, lam, size):
+        self.previous = (u_f - self.u_f, lam - self.lam, size)
         super().accept(u_f, lam, size)
         self.reached += size
 
@@ -371,13 +390,22 @@ def _factorize(K):
     return checked
 
 
-def _newton_load(model, u_f, lam, opts, floor):
-    """Newton at fixed lambda from the last converged state.  With contact, a correction that
-    raises the residual is shortened (halved up to three times): the active set and the
-    stick/slip states change between iterations, and a full step can overshoot."""
-    u_f = u_f.copy()
+def _newton_load(model, u_f, lam, opts, floor, guess=None):
+    """Newton at fixed lambda from a predicted state `guess` (if it is admissible) or from the
+    last converged state u_f.  With contact, a correction that raises the residual is
+    shortened (halved up to three times): the active set and the stick/slip states change
+    between iterations, and a full step can overshoot."""
     residuals: list[float] = []
-    ev = _evaluate(model, u_f, lam)
+    ev = None
+    if guess is not None:
+        try:
+            ev = _evaluate(model, guess, lam)
+            u_f = guess.copy()
+        except StepFailed:  # an inverted element at the predicted state: start from u_f
+            ev = None
+    if ev is None:
+        u_f = u_f.copy()
+        ev = _evaluate(model, u_f, lam)
     for it in range(opts.max_iterations + 1):
         if _check(ev, lam, opts, floor, residuals):
             return u_f, lam, it, residuals, ev
@@ -396,13 +424,21 @@ def _newton_load(model, u_f, lam, opts, floor):
     raise StepFailed(f"no convergence in {opts.max_iterations} iterations")
 
 
-def _newton_displacement(model, u_f, lam, c, target, opts, floor):
+def _newton_displacement(model, u_f, lam, c, target, opts, floor, guess=None):
     """Newton with u_f[c] driven to target and lambda unknown (bordered system):
-    du = a + dlam b, K a = -R, K b = -dR/dlambda, dlam chosen so that u_c reaches target."""
+    du = a + dlam b, K a = -R, K b = -dR/dlambda, dlam chosen so that u_c reaches target.
+    Starts from a predicted (u, lambda) `guess` where it is admissible."""
     u_f = u_f.copy()
     residuals: list[float] = []
+    start = None
+    if guess is not None:
+        try:
+            start = _evaluate(model, guess[0], guess[1])
+            u_f, lam = guess[0].copy(), guess[1]
+        except StepFailed:  # inverted at the predicted state: start from the converged one
+            start = None
     for it in range(opts.max_iterations + 1):
-        ev = _evaluate(model, u_f, lam)
+        ev = start if (it == 0 and start is not None) else _evaluate(model, u_f, lam)
         if it > 0 and _check(ev, lam, opts, floor, residuals):
             return u_f, lam, it, residuals, ev
         if it == 0:

@@ -94,10 +94,11 @@ class ContactPair:
     sticky: a node that touches is tied to the point where it touched.  depth: how deep
     behind the surface a node is still taken as touching it (nodes deeper were not in
     contact at the last converged step and did not cross the surface since).  smoothing:
-    the penalty law is rounded over gaps in [-smoothing, smoothing] (fn = kn (d - g)^2 / 4d
-    there, kn (-g) below), so that the force has a continuous derivative and nodes grazing
-    the surface do not chatter in and out of contact from one Newton iteration to the next;
-    default 1e-3 of the smallest element edge.
+    the penalty law is rounded over gaps in [-smoothing, 0] (fn = kn g^2 / 2d there,
+    kn (-g - d/2) below, nothing for g >= 0), so that the force has a continuous derivative,
+    nodes grazing the surface do not chatter in and out of contact from one Newton iteration
+    to the next, and a node that touches a mould at rest (g = 0) feels no force; default 1e-3
+    of the smallest element edge.
 
     History (updated at converged steps by `commit`): stick points, sticky nodes, and
     `first_contact` (n,): the load factor (process time t) of the step in which each node
@@ -192,11 +193,12 @@ class ContactPair:
         kn, kt = self.kn0, self.kt0
         d = self.smoothing
         g = proj.g
-        contact = proj.active & (g < d) & ~self.stuck
-        # normal law (eqs. 40-41): f = fn n, fn = -kn g, rounded over |g| < d
+        contact = proj.active & (g < 0.0) & ~self.stuck
+        # normal law (eqs. 40-41): f = fn n, fn = -kn g, rounded over -d < g < 0 so that a node
+        # touching the surface (g = 0) feels no force and the force has a continuous slope
         band = contact & (g > -d)
-        fn = np.where(contact, np.where(band, kn * (d - g) ** 2 / (4 * d), -kn * g), 0.0)
-        dfn = np.where(contact, np.where(band, -kn * (d - g) / (2 * d), -kn), 0.0)  # dfn/dg
+        fn = np.where(contact, np.where(band, kn * g * g / (2 * d), -kn * (g + 0.5 * d)), 0.0)
+        dfn = np.where(contact, np.where(band, kn * g / d, -kn), 0.0)  # dfn/dg
         nv, tv = proj.n, proj.t
         f += fn[:, None] * nv
         K += dfn[:, None, None] * outer(nv, nv)

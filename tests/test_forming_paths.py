@@ -1,0 +1,54 @@
+"""Path following on forming processes with the default settings: a clamped sheet pressed by
+a pressure into a cup mould with sticky contact (the mould flush with the sheet's rim), and
+a case where only a tool moves until it touches, under load control and under arc length."""
+
+import numpy as np
+import pytest
+
+from axiform.case import build, parse
+from axiform.solver import solve
+
+SHEET = {
+    "title": "sheet into a cup",
+    "mesh": {"kind": "rectangle", "r": [0.0, 50.0], "z": [0.0, 1.0], "divisions": [25, 1], "element": "q4"},
+    "material": {"model": "neo-hooke", "C1": 0.1, "kappa": 200.0},
+    "fix": [{"at": {"r": 50.0}, "dofs": ["ur", "uz"]}, {"at": {"r": 0.0}, "dofs": ["ur"]}],
+    "pressure": [{"on": {"z": 1.0}, "value": 0.1}],
+    "contact": [{"surface": {"polyline": [[0.0, -40.0], [35.0, -40.0], [40.0, -35.0], [40.0, -5.0],
+                                          [45.0, 0.0], [55.0, 0.0]]},
+                 "slaves": {"z": 0.0}, "sticky": True}],
+    "monitor": [{"name": "w", "at": {"r": 0.0, "z": 0.0}, "dof": "uz"}],
+    "solver": {"control": "load", "steps": 20},
+}
+
+
+def test_sheet_vacuum_formed_into_a_cup_with_default_settings():
+    """Before the secant predictor of load steps this case took 809 steps and 9,616 Newton
+    iterations (102 s): Newton from the last state overshoots by orders of magnitude where a
+    flat sheet stiffens as it stretches.  Now 126 steps, 882 iterations (8.5 s).  The finer
+    50 x 2 sheet did not start at all while the rounded penalty law pushed the rim, flush with
+    the mould, away at g = 0.  The centre reaches the cup's bottom (-40)."""
+    built = build(parse(SHEET))
+    res = solve(built.model, built.control, built.options)
+    assert res.status == "finished", res.message
+    assert len(res.steps) < 150
+    w = built.monitors[0].value(res.last)
+    assert w == pytest.approx(-40.0, abs=0.05)
+
+
+def test_only_a_tool_moves_until_it_touches():
+    """A punch starts 5 above the sheet and moves down by 10: nothing responds to the load
+    factor until it touches (the first arc of an arc length was 0 and the run hung)."""
+    case = {k: v for k, v in SHEET.items() if k not in ("pressure", "contact")}
+    case["contact"] = [{"surface": {"circle": {"center": [0.0, 16.0], "radius": 10.0}},
+                        "slaves": {"z": 1.0}, "motion": {"uz": -10.0}}]
+    case["monitor"] = [{"name": "w", "at": {"r": 0.0, "z": 1.0}, "dof": "uz"}]
+    for control in ("load", "arc-length"):
+        case["solver"] = {"control": control, "steps": 20, "target": 1.0}
+        built = build(parse(case))
+        res = solve(built.model, built.control, built.options)
+        assert res.status == "finished", (control, res.message)
+        lam = np.array([s.lam for s in res.steps])
+        assert lam[-1] == pytest.approx(1.0) and (np.diff(lam) > 0).all()
+        # the punch bottom went from z = 6 to z = -4: the top face centre follows it
+        assert built.monitors[0].value(res.last) == pytest.approx(-5.0, abs=0.05)
