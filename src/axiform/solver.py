@@ -137,6 +137,7 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
             if abs(size) < opts.min_step * abs(nominal):
                 result.status = "stopped"
                 result.message = f"step {len(result.steps) + 1}: no convergence with the step cut below the minimum ({exc})"
+                result.message += path.diagnosis()
                 break
             continue
         path.accept(u_new, lam_new, trial)
@@ -170,6 +171,25 @@ class _Path:
 
     def clip(self, size: float) -> float:
         return size
+
+    def diagnosis(self) -> str:
+        """Why the path stopped, where the state tells (appended to the stop message)."""
+        return ""
+
+    def _stiffness_ratio(self) -> float | None:
+        """The current stiffness parameter: ||du/dlambda|| at the start over ||du/dlambda|| at
+        the last converged state (1 at the start, 0 at a limit point of the load); None when
+        nothing responds to the load at the start."""
+        try:
+            ev0 = _evaluate(self.model, np.zeros_like(self.u_f), 0.0)
+            t0 = _factorize(ev0.K)(ev0.dr_dlam)
+            ev = _evaluate(self.model, self.u_f, self.lam)
+            t = _factorize(ev.K)(ev.dr_dlam)
+        except StepFailed:
+            return None
+        n = self.model.dofmap.nf
+        n0, n1 = np.linalg.norm(t0[:n]), np.linalg.norm(t[:n])
+        return n0 / n1 if n0 > 0 and n1 > 0 else None
 
     def accept(self, u_f, lam, size):
         self.u_f, self.lam = u_f, lam
@@ -213,6 +233,14 @@ class _Load(_Path):
     def accept(self, u_f, lam, size):
         self.previous = (u_f - self.u_f, lam - self.lam)
         super().accept(u_f, lam, size)
+
+    def diagnosis(self):
+        ratio = self._stiffness_ratio() if self.lam != 0 else None
+        if ratio is not None and ratio < 0.05:
+            return (f"; this is a limit point of the load: the structure's stiffness against it has fallen to "
+                    f"{100 * ratio:.2g} % of its initial value, so it carries no more load; follow the path "
+                    "past it with control = \"arc-length\" or \"displacement\", or a cavity under volume control")
+        return ""
 
 
 class _Displacement(_Path):
