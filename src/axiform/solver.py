@@ -294,6 +294,10 @@ class _ArcLength(_Path):
             self.stop = int(model.dofmap.eq[control.stop_dof])
             if self.stop >= model.n_free:
                 raise ValueError("the stop dof is prescribed")
+        # with moving tools or load curves lambda is the process time: it may not decrease
+        # (a limit point of such a process is a snap, not a path to follow back)
+        self.timed = bool(model.knots().size) or any(
+            np.any(np.asarray(c.surface.motion, float) != 0) for c in model.contacts)
         self.load_step = abs(control.target / control.steps)
         if control.arc_length is not None:
             self.nominal = control.arc_length
@@ -318,6 +322,9 @@ class _ArcLength(_Path):
         u_new, lam_new, its, res, ev = self._arc_step(size)
         if self.previous is not None and np.dot(self.weight * (u_new - self.u_f), self.previous) < 0:
             raise StepFailed("the path turned back")
+        if self.timed and (lam_new - self.lam) * np.sign(self.control.target) < 0:
+            raise StepFailed("the load factor is the process time here (tools or curves follow it): it cannot "
+                             "run backwards")
         c = self.control
         if self._crossed(self.lam, lam_new, c.target):
             out = _newton_load(self.model, self.u_f, c.target, self.opts, self.floor)
