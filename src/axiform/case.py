@@ -398,6 +398,12 @@ class UnitsSpec(Strict):
     time: Unit | None = None
 
 
+class RestartSpec(Strict):
+    """Checkpoints for `axiform run --resume`: every k converged steps and at any stop (0: none)."""
+
+    every: Annotated[int, Field(ge=0)] = 10
+
+
 class Case(Strict):
     title: str = ""
     mesh: MeshSpec
@@ -410,6 +416,7 @@ class Case(Strict):
     cavity: list[CavitySpec] = []
     solver: SolverSpec = SolverSpec()
     output: OutputSpec = OutputSpec()
+    restart: RestartSpec = RestartSpec()
     units: UnitsSpec = UnitsSpec()
 
 

@@ -152,20 +152,49 @@ def _prepare(folder: Path) -> str | None:
     return None
 
 
-def run(case_path: str, out: str | None, quiet: bool = False, overrides: list[str] = ()) -> int:
-    """Read, check, solve and write a case; returns the exit code."""
+# the case tables a resumed run may not change (DESIGN 10.9): the model must be the same
+FROZEN_ON_RESUME = ("mesh", "material")
+
+
+def _resume_state(folder: Path, data: dict) -> dict:
+    """The checkpoint of a results folder to resume, after checking that the case's mesh and
+    material are the ones it was made with; CaseError (exit 2) otherwise."""
+    from .checkpoint import load as load_checkpoint
+
+    if not folder.is_dir():
+        raise CaseError(f"--resume: {folder} is not a results folder")
+    try:
+        state, meta = load_checkpoint(folder / "restart")
+    except ValueError as exc:
+        raise CaseError(f"--resume: {exc}") from None
+    for key in FROZEN_ON_RESUME:
+        if meta.get(key) != fingerprint(data.get(key, {})):
+            raise CaseError(f"{key}: differs from the run being resumed ([{key}] cannot change on --resume)")
+    return state
+
+
+def run(case_path: str, out: str | None, quiet: bool = False, overrides: list[str] = (),
+        resume: str | None = None) -> int:
+    """Read, check, solve and write a case (or resume a run in its folder); returns the exit code."""
     with Stops() as stops:
         try:
-            return _run(Path(case_path), out, quiet, list(overrides), stops)
+            return _run(Path(case_path), out, quiet, list(overrides), stops, resume)
         except Interrupted as exc:  # before the results folder was there
             _say(f"axiform: {exc} before the first step")
             return 128 + exc.signum
 
 
-def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], stops: Stops) -> int:
+def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], stops: Stops,
+         resume: str | None = None) -> int:
+    state = None
     try:
         data = read(case_file, overrides)
         case = parse(data)
+        if resume is not None:
+            if out is not None and Path(out).resolve() != Path(resume).resolve():
+                raise CaseError("--out: a resumed run writes in the folder it resumes (--resume)")
+            out = resume
+            state = _resume_state(Path(resume), data)
         built = build(case, case_file.parent)
     except CaseError as exc:
         return _invalid(case_file, exc)
@@ -177,6 +206,7 @@ def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], st
         out_dir = Path(out)
     else:
         out_dir, note = results_folder(case_file, digest)
+    restart_meta = {key: fingerprint(data.get(key, {})) for key in FROZEN_ON_RESUME}
     problem = _prepare(out_dir)
     if problem:
         _say(f"axiform: invalid output folder:\n--out: {problem}")
@@ -198,16 +228,28 @@ def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], st
 
     t0 = time.perf_counter()
     result = writer = None
+    if state is not None:
+        try:  # the checkpoint must fit this model and folder before anything is rewritten
+            model.restore(state["model"])
+            with stops.held():
+                writer = ResultsWriter(out_dir, model, built.monitors, case.title, every=o.every, vtu=o.vtu,
+                                       gid_files=o.gid, revolved=o.revolved, plots=o.plots,
+                                       thickness_every=o.thickness_every, labels=case_labels(case),
+                                       case={"file": str(case_file), "overrides": overrides, "sha256": digest},
+                                       restart_every=case.restart.every, restart_meta=restart_meta, resume=state)
+        except (ValueError, KeyError) as exc:
+            return _invalid(case_file, CaseError(f"--resume: {exc}"))
     try:
         with stops.held():
-            writer = ResultsWriter(out_dir, model, built.monitors, case.title, every=o.every, vtu=o.vtu,
+            writer = writer or ResultsWriter(out_dir, model, built.monitors, case.title, every=o.every, vtu=o.vtu,
                                    gid_files=o.gid, revolved=o.revolved, plots=o.plots,
                                    thickness_every=o.thickness_every, labels=case_labels(case),
-                                   case={"file": str(case_file), "overrides": overrides, "sha256": digest})
+                                   case={"file": str(case_file), "overrides": overrides, "sha256": digest},
+                                   restart_every=case.restart.every, restart_meta=restart_meta, resume=state)
         if not quiet:
             _say(f"axiform {__version__}: {case.title or case_file.name}: {model.mesh.n_cells} "
                  f"{model.mesh.element.name} elements, {model.n_free} free dofs -> {out_dir}{note}")
-        result = solve(model, control, built.options, on_step=on_step)
+        result = solve(model, control, built.options, on_step=on_step, resume=state)
         status, message = result.status, result.message
     except Interrupted as exc:
         if writer is None:
@@ -320,6 +362,9 @@ def main(argv: list[str] | None = None) -> int:
     p_run.add_argument("--out", help="results folder (default: results/<case name>, or results/<case name>-<n> "
                                      "when that one holds another case's results)")
     p_run.add_argument("-q", "--quiet", action="store_true", help="print only one line: the final status")
+    p_run.add_argument("--resume", metavar="DIR",
+                       help="continue the run in results folder DIR from its last checkpoint (restart/); "
+                            "[mesh] and [material] must be unchanged, a later target or more output may be set")
     p_check = sub.add_parser("check", help="validate a case file and build its model, without solving",
                              description="Validate a case file and build its model, without solving: exit 0 "
                                          "if valid, 2 with the key path and the reason if not.")
@@ -355,7 +400,7 @@ def main(argv: list[str] | None = None) -> int:
             if args.command == "plot":
                 return plot(args.folder, args.field, args.animate)
             if args.command == "run":
-                return run(args.case, args.out, args.quiet, args.set)
+                return run(args.case, args.out, args.quiet, args.set, args.resume)
             return check(args.case, args.set)
     except KeyboardInterrupt:
         _say("axiform: interrupted")

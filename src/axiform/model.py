@@ -237,6 +237,20 @@ class Model:
         it = iter(u_f[self.dofmap.nf:])
         return [float(next(it)) if c.unknown else c.target(t)[0] for c in self.cavities]
 
+    def state(self) -> dict:
+        """The history variables (contact and cavity state) after the last commit (restart)."""
+        return {"contacts": [pair.state() for pair in self.contacts],
+                "cavities": [{"pressure": c.pressure_now, "volume": c.volume_now} for c in self.cavities]}
+
+    def restore(self, state: dict) -> None:
+        """Put back the history variables of `state` (Model.state)."""
+        if len(state["contacts"]) != len(self.contacts) or len(state["cavities"]) != len(self.cavities):
+            raise ValueError("the saved state has other contact pairs or cavities than this model")
+        for pair, s in zip(self.contacts, state["contacts"]):
+            pair.restore(s)
+        for cav, s in zip(self.cavities, state["cavities"]):
+            cav.pressure_now, cav.volume_now = float(s["pressure"]), float(s["volume"])
+
     def commit(self) -> None:
         """A step converged at the last evaluated state: update the history variables
         (contact stick points, sticky nodes, positions for the crossing test, the cavities'

@@ -59,9 +59,13 @@ class ResultsWriter:
     def __init__(self, out: str | Path, model, monitors=(), title: str = "", every: int = 1,
                  vtu: bool = True, gid_files: bool = False, revolved: int = 0, plots: bool = True,
                  thickness_every: int | None = None, labels: dict | None = None,
-                 case: dict | None = None):
+                 case: dict | None = None, restart_every: int = 0, restart_meta: dict | None = None,
+                 resume: dict | None = None):
         """labels: units, load and monitor_quantities for summary.json (labels.case_labels);
-        case: where the case came from and its fingerprint."""
+        case: where the case came from and its fingerprint.  restart_every: write the step's
+        checkpoint to restart/ every k steps (and at the end of the run, whatever stopped it),
+        with restart_meta beside it.  resume: the checkpoint a resumed run starts from: the
+        folder's rows and files up to its step are kept, later ones dropped."""
         self.out = Path(out)
         self.out.mkdir(parents=True, exist_ok=True)
         self.model = model
@@ -97,18 +101,25 @@ class ResultsWriter:
         self.summary.update(labels or {})
         if case is not None:  # where the case came from and its fingerprint (the folder rule)
             self.summary["case"] = case
+        self.restart_every = restart_every
+        self.restart_meta = restart_meta or {}
+        self._checkpoint = None
+        header = ["step", "load_factor", "iterations"] + [m.name for m in self.monitors]
         self._history = io.StringIO()
         self._csv = csv.writer(self._history, lineterminator="\n")
-        self._csv.writerow(["step", "load_factor", "iterations"] + [m.name for m in self.monitors])
+        self._csv.writerow(header)
+        kept = self._resume(resume, header) if resume is not None else 0
         write_atomic(self.out / "history.csv", self._history.getvalue())
         for tmp in self.out.glob(".*.tmp"):
             tmp.unlink()
         if vtu:
             (self.out / "fields").mkdir(exist_ok=True)
-            for old in (self.out / "fields").glob("step_*.vtu"):
+        for old in [*(self.out / "fields").glob("step_*.vtu"), *(self.out / "fields").glob("surfaces_*.csv"),
+                    *(self.out / "thickness").glob("step_*.csv")]:
+            if int(old.stem.split("_")[-1]) > kept:
                 old.unlink()
-        for old in [*(self.out / "fields").glob("surfaces_*.csv"), *(self.out / "thickness").glob("step_*.csv")]:
-            old.unlink()
+        self._pvd = [(float(n), f"fields/{f.name}") for f in sorted((self.out / "fields").glob("step_*.vtu"))
+                     for n in [int(f.stem.split("_")[-1])]] if kept and vtu else []
         if thickness_every and model.mesh.fibres is not None:
             (self.out / "thickness").mkdir(exist_ok=True)
         for stale in ("thickness.csv", "contact.csv", "surfaces.csv", "fields.pvd", "revolved.vtu", "load_curve.png",
@@ -120,6 +131,26 @@ class ResultsWriter:
             with atomic(self.out / "axiform.post.res") as tmp:
                 gid.start_results(tmp)
         self._write_summary()
+
+    def _resume(self, checkpoint: dict, header: list[str]) -> int:
+        """Keep history.csv's rows up to the checkpoint's step; returns that step."""
+        step = int(checkpoint["step"])
+        try:
+            with open(self.out / "history.csv", newline="") as fh:
+                rows = list(csv.reader(fh))
+        except OSError as exc:
+            raise ValueError(f"{self.out}: no history.csv to resume ({exc})") from None
+        if not rows or rows[0] != header:
+            raise ValueError(f"{self.out}/history.csv has other columns than this case's monitors")
+        kept = [r for r in rows[1:] if r and int(r[0]) <= step]
+        if len(kept) != step:
+            raise ValueError(f"{self.out}/history.csv holds {len(kept)} rows up to step {step}")
+        for r in kept:
+            self._csv.writerow(r)
+        self.steps = self._last_written = step
+        self.newton_iterations = int(checkpoint["newton_iterations"])
+        self.summary.update(steps=step, newton_iterations=self.newton_iterations, load_factor=float(kept[-1][1]))
+        return step
 
     def _write_summary(self):
         self.summary["wall_time_s"] = round(time.perf_counter() - self.t0, 4)
@@ -162,6 +193,9 @@ class ResultsWriter:
         if self.thickness_every and step.number % self.thickness_every == 0:
             self._write_thickness_step(step)
         self._last_step = step
+        self._checkpoint = step.checkpoint
+        if self.restart_every and step.checkpoint is not None and step.number % self.restart_every == 0:
+            self.save_checkpoint()
         self._write_summary()
         return values
 
@@ -246,6 +280,10 @@ class ResultsWriter:
         if message:
             self.summary["message"] = message
         self._write_summary()
+        if self.restart_every:
+            self.save_checkpoint()
+        if not hasattr(self, "_last_step"):  # a resumed run that added no step
+            return
         if self.steps and self._last_written != self.steps:
             self._write_fields(self._last_step)
         if self.steps and self.thickness_every and self.steps % self.thickness_every:
@@ -257,6 +295,14 @@ class ResultsWriter:
             from .plots import plot_folder
 
             plot_folder(self.out)
+
+
+    def save_checkpoint(self) -> None:
+        """restart/checkpoint.npz: the state after the last recorded step (if it has one)."""
+        if self._checkpoint is not None:
+            from .checkpoint import save
+
+            save(self.out / "restart", self._checkpoint, {**self.restart_meta, "step": self._checkpoint["step"]})
 
 
 def mould_outlines(pairs, lam: float) -> str:

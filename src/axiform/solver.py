@@ -79,6 +79,7 @@ class Step:
     u_f: np.ndarray
     u: np.ndarray
     evaluation: Evaluation
+    checkpoint: dict | None = None  # the whole state after this step, to resume from (restart)
 
 
 @dataclass
@@ -112,9 +113,12 @@ def _force_floor(model: Model) -> float:
 
 def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthControl,
           options: NewtonOptions | None = None,
-          on_step: Callable[[Step], None] | None = None) -> SolveResult:
+          on_step: Callable[[Step], None] | None = None, resume: dict | None = None) -> SolveResult:
     """Run the load stepping to the end or until the step would fall below the minimum.
-    Every converged step is handed to on_step as it comes."""
+    Every converged step is handed to on_step as it comes, with its `checkpoint`: the whole
+    state after it (path, step size, counts, contact and cavity history).  `resume`: such a
+    checkpoint to continue from; the steps then go on with the same numbers and sizes as in an
+    uninterrupted run."""
     opts = options or NewtonOptions()
     if model.dofmap is None:
         model.finalize()
@@ -128,6 +132,13 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
     result = SolveResult("finished")
     nominal = path.nominal
     size = nominal
+    first = 1
+    if resume is not None:
+        path.restore(resume["path"])
+        model.restore(resume["model"])
+        size = float(resume["size"])
+        first = int(resume["step"]) + 1
+        result.newton_iterations = int(resume["newton_iterations"])
     while not path.done():
         trial = path.clip(size)  # shortened to land on a knot or the end; size is kept
         try:
@@ -136,19 +147,22 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
             size = trial / 2.0
             if abs(size) < opts.min_step * abs(nominal):
                 result.status = "stopped"
-                result.message = f"step {len(result.steps) + 1}: no convergence with the step cut below the minimum ({exc})"
+                result.message = f"step {first + len(result.steps)}: no convergence with the step cut below the minimum ({exc})"
                 result.message += path.diagnosis()
                 break
             continue
         path.accept(u_new, lam_new, trial)
         model.commit()
         result.newton_iterations += its
-        step = Step(len(result.steps) + 1, lam_new, its, res, u_new, model.expand(u_new, lam_new), ev)
+        if its <= opts.easy_iterations:
+            size = min(size * opts.growth, nominal, key=abs)
+        number = first + len(result.steps)
+        checkpoint = {"path": path.state(), "model": model.state(), "size": size, "step": number,
+                      "newton_iterations": result.newton_iterations}
+        step = Step(number, lam_new, its, res, u_new, model.expand(u_new, lam_new), ev, checkpoint)
         result.steps.append(step)
         if on_step:
             on_step(step)
-        if its <= opts.easy_iterations:
-            size = min(size * opts.growth, nominal, key=abs)
         if len(result.steps) >= path.max_steps and not path.done():
             result.status = "stopped"
             result.message = f"the end was not reached in {path.max_steps} steps"
@@ -171,6 +185,21 @@ class _Path:
 
     def clip(self, size: float) -> float:
         return size
+
+    _state_keys = ("u_f", "lam")
+
+    def state(self) -> dict:
+        """What the path needs to go on from its last converged step (restart)."""
+        out = {}
+        for key in self._state_keys:
+            v = getattr(self, key)
+            out[key] = v.copy() if isinstance(v, np.ndarray) else v
+        return out
+
+    def restore(self, state: dict) -> None:
+        for key in self._state_keys:
+            v = state[key]
+            setattr(self, key, v.copy() if isinstance(v, np.ndarray) else v)
 
     def diagnosis(self) -> str:
         """Why the path stopped, where the state tells (appended to the stop message)."""
@@ -197,6 +226,8 @@ class _Path:
 
 class _Load(_Path):
     """lambda = t from 0 to the target; every knot of every curve is a step's end."""
+
+    _state_keys = ("u_f", "lam", "previous")
 
     def __init__(self, model, control: LoadControl, opts):
         super().__init__(model, opts)
@@ -244,6 +275,8 @@ class _Load(_Path):
 
 
 class _Displacement(_Path):
+    _state_keys = ("u_f", "lam", "previous", "reached")
+
     def __init__(self, model, control: DisplacementControl, opts):
         super().__init__(model, opts)
         self.c = int(model.dofmap.eq[control.dof])
@@ -277,6 +310,8 @@ class _Displacement(_Path):
 
 
 class _ArcLength(_Path):
+    _state_keys = ("u_f", "lam", "previous", "finished")
+
     def __init__(self, model, control: ArcLengthControl, opts):
         super().__init__(model, opts)
         self.control = control

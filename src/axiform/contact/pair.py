@@ -253,6 +253,19 @@ class ContactPair:
             self.stuck |= new
         self.first_contact[(status > 0) & np.isnan(self.first_contact)] = lam
 
+    _history = ("x_prev", "s_stick", "stuck", "stuck_point", "first_contact")
+
+    def state(self) -> dict[str, np.ndarray]:
+        """Copies of the history variables updated at commit (restart)."""
+        return {k: getattr(self, k).copy() for k in self._history}
+
+    def restore(self, state: dict[str, np.ndarray]) -> None:
+        for k in self._history:
+            v = np.asarray(state[k])
+            if v.shape != getattr(self, k).shape:
+                raise ValueError(f"contact state '{k}' has shape {v.shape}, not {getattr(self, k).shape}")
+            setattr(self, k, v.astype(getattr(self, k).dtype, copy=True))
+
     def report(self):
         """Per node of the last evaluation: current (r, z) in the global frame, gap, contact
         pressure (normal force over the current ring area), status; and the totals (the

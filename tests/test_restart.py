@@ -1,0 +1,142 @@
+"""Restart: a run stopped after some step and resumed from that step's checkpoint gives the
+same steps as an uninterrupted run (load control with sticky contact, displacement control,
+arc length; through the Python API and through `axiform run --resume`), and a resume that
+would change the model is refused."""
+
+import csv
+import json
+import os
+import signal
+
+import numpy as np
+import pytest
+
+import axiform.cli as cli
+from axiform.case import build, parse
+from axiform.checkpoint import load as load_checkpoint
+from axiform.checkpoint import save as save_checkpoint
+from axiform.solver import solve
+
+PUNCH = {
+    "title": "punch on a disc, sticky",
+    "mesh": {"kind": "rectangle", "r": [0.0, 10.0], "z": [0.0, 2.0], "divisions": [10, 2], "element": "q4"},
+    "material": {"model": "neo-hooke", "C1": 0.5, "kappa": 50.0},
+    "fix": [{"at": {"z": 0.0}, "dofs": ["uz"]}, {"at": {"r": 0.0}, "dofs": ["ur"]}],
+    "contact": [{"surface": {"circle": {"center": [0.0, 7.0], "radius": 5.0}}, "slaves": {"z": 2.0},
+                 "sticky": True, "motion": {"uz": -0.8}}],
+    "monitor": [{"name": "w", "at": {"r": 0.0, "z": 2.0}, "dof": "uz"},
+                {"name": "force", "contact": 0, "quantity": "force-z"}],
+    "solver": {"control": "load", "steps": 8},
+    "output": {"vtu": False, "plots": False},
+}
+PLATE = {
+    "title": "plate",
+    "mesh": {"kind": "rectangle", "r": [0.0, 7.5], "z": [0.0, 0.5], "divisions": [10, 2], "element": "sfr"},
+    "material": {"model": "mooney-rivlin", "C1": 80.0, "C2": 20.0, "kappa": 1e4},
+    "fix": [{"at": {"r": 7.5}, "dofs": ["ur", "uz", "rot"]}, {"at": {"r": 0.0}, "dofs": ["ur"]}],
+    "pressure": [{"on": {"z": 0.0}, "value": 1.0}],
+    "monitor": [{"name": "w", "at": {"r": 0.0, "z": 0.5}, "dof": "uz"}],
+    "solver": {"control": "displacement", "dof": {"at": {"r": 0.0, "z": 0.5}, "dof": "uz"}, "target": 6.0,
+               "steps": 10},
+    "output": {"vtu": False, "plots": False},
+}
+ARC = {**PLATE, "solver": {"control": "arc-length", "target": 100.0, "steps": 20,
+                           "stop": {"at": {"r": 0.0, "z": 0.5}, "dof": "uz", "value": 8.0}}}
+
+
+class Stop(Exception):
+    pass
+
+
+@pytest.mark.parametrize("case", [PUNCH, PLATE, ARC], ids=["load-sticky", "displacement", "arc-length"])
+def test_resumed_steps_equal_the_uninterrupted_run(case, tmp_path):
+    full = solve(*_model(case))
+    assert full.status == "finished" and len(full.steps) > 6
+    k = len(full.steps) // 2
+    kept = []
+
+    def stop_after_k(step):
+        kept.append(step)
+        if step.number == k:
+            raise Stop
+
+    with pytest.raises(Stop):
+        solve(*_model(case), on_step=stop_after_k)
+    # through the file format, as a resumed run reads it
+    save_checkpoint(tmp_path, kept[-1].checkpoint, {})
+    state, _ = load_checkpoint(tmp_path)
+    rest = solve(*_model(case), resume=state)
+    assert rest.status == "finished"
+    assert [s.number for s in rest.steps] == [s.number for s in full.steps[k:]]
+    for a, b in zip(rest.steps, full.steps[k:]):
+        assert a.lam == pytest.approx(b.lam, rel=1e-12, abs=1e-14)
+        assert a.iterations == b.iterations
+        np.testing.assert_allclose(a.u, b.u, rtol=1e-10, atol=1e-12 * np.abs(b.u).max())
+
+
+def _model(case):
+    built = build(parse(case))
+    return built.model, built.control, built.options
+
+
+def _toml(value) -> str:
+    """A value as TOML (inline tables and arrays)."""
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{k} = {_toml(v)}" for k, v in value.items()) + " }"
+    if isinstance(value, list):
+        return "[" + ", ".join(_toml(v) for v in value) + "]"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value)
+    return repr(value)
+
+
+def _write(tmp_path, case):
+    path = tmp_path / "case.toml"
+    path.write_text("\n".join(f"{k} = {_toml(v)}" for k, v in case.items()) + "\n")
+    return path
+
+
+def _rows(folder):
+    with open(folder / "history.csv", newline="") as fh:
+        return [[float(v) for v in r] for r in list(csv.reader(fh))[1:]]
+
+
+def test_axiform_run_resume_gives_the_same_history(tmp_path, monkeypatch):
+    """A run interrupted (SIGTERM) after step 5 keeps a checkpoint; `--resume` continues it in
+    the same folder and history.csv equals that of an uninterrupted run."""
+    case = dict(PUNCH, restart={"every": 2})
+    path = _write(tmp_path, case)
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "full"), "-q"]) == 0
+    real_solve = cli.solve
+
+    def interrupted(model, control, options, on_step=None, resume=None):
+        def step(s):
+            on_step(s)
+            if s.number == 5:
+                os.kill(os.getpid(), signal.SIGTERM)
+        return real_solve(model, control, options, on_step=step, resume=resume)
+
+    monkeypatch.setattr(cli, "solve", interrupted)
+    out = tmp_path / "cut"
+    assert cli.main(["run", str(path), "--out", str(out), "-q"]) == 128 + signal.SIGTERM
+    monkeypatch.setattr(cli, "solve", real_solve)
+    assert len(_rows(out)) == 5
+    assert cli.main(["run", str(path), "--resume", str(out), "-q"]) == 0
+    full, resumed = _rows(tmp_path / "full"), _rows(out)
+    assert len(full) == len(resumed)
+    np.testing.assert_allclose(resumed, full, rtol=1e-10, atol=1e-12)
+
+
+def test_resume_refuses_another_model(tmp_path, capsys):
+    path = _write(tmp_path, PUNCH)
+    out = tmp_path / "run"
+    assert cli.main(["run", str(path), "--out", str(out), "-q"]) == 0
+    assert cli.main(["run", str(path), "--resume", str(out), "--set", "material.C1=0.6", "-q"]) == 2
+    assert "material: differs from the run being resumed" in capsys.readouterr().err
+    assert cli.main(["run", str(path), "--resume", str(tmp_path / "nowhere"), "-q"]) == 2
+    # a later target is allowed: the run goes on from its last step
+    assert cli.main(["run", str(path), "--resume", str(out), "--set", "solver.target=1.5", "-q"]) == 0
+    rows = _rows(out)
+    assert rows[-1][1] == pytest.approx(1.5) and [r[0] for r in rows] == list(range(1, len(rows) + 1))
