@@ -74,22 +74,26 @@ def test_arc_length_lands_on_the_target_load():
     assert all(np.diff([s.lam for s in res.steps]) > 0)
 
 
-@pytest.mark.parametrize("element", ["q4", "q8"])
-def test_arc_length_carries_the_papers_plate_past_its_pressure_maximum(element):
-    """The clamped plate (2 x 20, mixed) under arc length with the default settings, stopped
-    at a mid-thickness centre deflection of 21 in: the pressure rises to its maximum (measured
-    42.43 psi Q4, 41.32 psi Q8) and falls after it while the deflection grows at every step
-    (before, the path turned back at the maximum)."""
+@pytest.mark.parametrize("element, formulation, steps", [("q4", "mixed", 20), ("q4", "mixed", 80),
+                                                         ("q8", "mixed", 80), ("q8", "mixed", 400),
+                                                         ("sfr", "displacement", 80)])
+def test_arc_length_carries_the_papers_plate_past_its_pressure_maximum(element, formulation, steps):
+    """The clamped plate (2 x 20) under arc length with the default settings, stopped at a
+    mid-thickness centre deflection of 21 in: the pressure rises to its maximum (measured
+    42.43 psi Q4, 41.32 psi Q8, 42.04 psi SFR) and falls after it while the deflection grows at
+    every step (before, the path turned back at the maximum).  The mixed SFR is left out: its
+    path wanders near the maximum (the centre goes back by up to 0.8 in over a few steps while
+    the fibre rotations, up to 6.5 rad, carry the arc), a known limitation."""
     from axiform import rectangle, select_edges, select_nodes
 
     mesh = rectangle((0.0, 7.5), (0.0, 0.5), (20, 2), element)
-    model = Model(mesh, MooneyRivlin(80.0, 20.0, 1e4))
+    model = Model(mesh, MooneyRivlin(80.0, 20.0, 1e4), formulation=formulation)
     model.fix(select_nodes(mesh, {"r": 7.5}), ["ur", "uz", "rot"])
     model.fix(select_nodes(mesh, {"r": 0.0}), ["ur"])
     model.pressure(select_edges(mesh, {"z": 0.0}), 1.0)
     model.finalize()
     w = int(model.dof(select_nodes(mesh, {"r": 0.0, "z": 0.25})[0], "uz"))
-    res = solve(model, ArcLengthControl(target=100.0, steps=80, stop_dof=w, stop_value=21.0))
+    res = solve(model, ArcLengthControl(target=100.0, steps=steps, stop_dof=w, stop_value=21.0))
     assert res.status == "finished", res.message
     deflection = np.array([s.u[w] for s in res.steps])
     p = np.array([s.lam for s in res.steps])
