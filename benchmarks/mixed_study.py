@@ -49,9 +49,9 @@ def sphere(element, kappa, formulation, space):
     return float(res.last.u[model.dof(select_nodes(mesh, {"set": "inner", "z": 0.0}), "ur")][0])
 
 
-def plate(element, divisions, kappa, formulation, w=6.0):
+def plate(element, divisions, kappa, formulation, w=6.0, space=None):
     mesh = rectangle((0.0, 7.5), (0.0, 0.5), divisions, element)
-    model = Model(mesh, MooneyRivlin(80.0, 20.0, kappa), formulation=formulation)
+    model = Model(mesh, MooneyRivlin(80.0, 20.0, kappa), formulation=formulation, pressure_space=space)
     model.fix(select_nodes(mesh, {"r": 7.5}), ["ur", "uz", "rot"])
     model.fix(select_nodes(mesh, {"r": 0.0}), ["ur"])
     model.pressure(select_edges(mesh, {"z": 0.0}), 1.0)
@@ -73,6 +73,17 @@ def evaluate_cost(element, formulation, n=100):
     return best
 
 
+def zero_modes(element, divisions, formulation, space):
+    mesh = rectangle((1.0, 2.0), (0.0, 1.0), divisions, element)
+    model = Model(mesh, MooneyRivlin(0.4, 0.1, 1e3), formulation=formulation, pressure_space=space).finalize()
+    _, Ke = model.solid.evaluate(np.zeros(model.n_full))
+    K = np.zeros((model.n_full, model.n_full))
+    for dofs, k in zip(model.solid.dofs, Ke):
+        K[np.ix_(dofs, dofs)] += k
+    w = np.linalg.eigvalsh(0.5 * (K + K.T))
+    return int((np.abs(w) < 1e-8 * np.abs(w).max()).sum())
+
+
 def main():
     lines = ["# Mixed (u–p–J̄) against displacement elements", "",
              "Regenerate: `.venv/bin/python benchmarks/mixed_study.py` (about a minute).", "",
@@ -87,21 +98,31 @@ def main():
         print(lines[-1], flush=True)
     lines += ["", "## 2. Paper's plate: pressure at w = 6 in (mid-thickness centre) against mixed Q8 16 × 160", "",
               "| kappa/mu | mesh | " + " | ".join(f"{e} {f}" for e in ("q4", "q8", "sfr")
-                                                for f in ("displacement", "mixed")) + " |",
-              "|---|---|" + "---|" * 6]
+                                                for f in ("displacement", "mixed")) + " | sfr mixed p1 |",
+              "|---|---|" + "---|" * 7]
     for km in (50.0, 1e3):
         ref = plate("q8", (160, 16), km * 200.0, "mixed")
         for div in ((20, 2), (80, 8)):
             vals = [plate(e, div, km * 200.0, f) / ref - 1 for e in ("q4", "q8", "sfr") for f in ("displacement", "mixed")]
+            vals.append(plate("sfr", div, km * 200.0, "mixed", space="p1") / ref - 1)
             lines.append(f"| {km:g} | {div[1]}x{div[0]} | " + " | ".join(f"{100 * v:+.2f} %" for v in vals) + " |")
             print(lines[-1], flush=True)
-        lines.append(f"| {km:g} | reference | p = {ref:.4f} psi |" + " |" * 5)
+        lines.append(f"| {km:g} | reference | p = {ref:.4f} psi |" + " |" * 6)
     lines += ["", "## 3. One residual + tangent evaluation, 100 × 100 elements (best of 5, this machine)", "",
               "| element | displacement (s) | mixed (s) | mixed / displacement |", "|---|---|---|---|"]
     for e in ("q4", "q8", "sfr"):
         d, m = evaluate_cost(e, "displacement"), evaluate_cost(e, "mixed")
         lines.append(f"| {e} | {d:.3f} | {m:.3f} | {m / d:.2f} |")
         print(lines[-1], flush=True)
+    lines += ["", "## 4. Zero-energy modes of the assembled tangent at u = 0 (eigenvalues below 1e-8 of the largest)",
+              "", "kappa/mu = 1e3.  Rigid axial translation: 1; SFR adds the uniform fibre rotation (and, on one",
+              "element, one more mode, DESIGN 3).  A pressure space that added spurious modes would show here.", "",
+              "| element | mesh | displacement | mixed p0 | mixed p1 |", "|---|---|---|---|---|"]
+    for e in ("q4", "q8", "sfr"):
+        for div in ((1, 1), (2, 2), (4, 1)):
+            lines.append(f"| {e} | {div[1]}x{div[0]} | " + " | ".join(str(zero_modes(e, div, f, sp)) for f, sp in
+                                                                      (("displacement", None), ("mixed", "p0"),
+                                                                       ("mixed", "p1"))) + " |")
     OUT.write_text("\n".join(lines) + "\n")
     print("wrote", OUT)
 

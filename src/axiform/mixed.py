@@ -89,11 +89,6 @@ class MixedAssembly(SolidAssembly):
         self.Minv = np.linalg.inv(M)  # (e, np, np)
         self.NpdV = NpdV
 
-    def pressure(self, u_full: np.ndarray) -> np.ndarray:
-        """The element pressures p = kappa (J_bar - 1) at the quadrature points (e, q)."""
-        x = self.gradient(u_full)
-        return self._pressure(x, slice(None))[0]
-
     def _pressure(self, x: np.ndarray, sl: slice):
         J, dJ = volumetric_derivatives(x)
         h = np.einsum("eqi,eq->ei", self.NpdV[sl], J)
