@@ -58,7 +58,9 @@ def test_thick_sphere_displacement_elements_lock():
 
 def test_sfr_pressure_space_p0_not_p1():
     """Why SFR ships P0: with P1 (three pressure modes on 2x2 Gauss points) it still locks
-    (measured -21.7 % at kappa/mu = 1e3, -97.7 % at 1e4), with P0 it is within 0.4 %."""
+    (measured at kappa/mu = 1e3 between -21.7 % and -79.3 % depending on the load steps: the
+    converged state itself depends on the path, a sign of a badly conditioned element), with
+    P0 it is within 0.4 % whatever the steps."""
     exact = exact_bore(1e3)
     assert abs(sphere_bore("sfr", 1e3, "mixed", "p0") / exact - 1) < 5e-3
     assert sphere_bore("sfr", 1e3, "mixed", "p1") / exact - 1 < -0.1
