@@ -16,7 +16,8 @@ Methods:
   design) comes with each solve;
 - "fixed-point": the plain rule, each t_k scaled by target / achieved at its station s_k.
 Both stop at the first design whose final wall is within `tolerance` (max relative
-deviation) of the target, or after max_iter iterations.
+deviation) of the target, or after max_iter iterations.  Knots whose interpolation reaches
+no station of the target keep their values.
 """
 
 from __future__ import annotations
@@ -281,6 +282,11 @@ def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], met
     mesh = design.built.model.mesh
     objective = Objective(mesh.fibre_s, *target, float(design.initial.mean()), smoothness)
     lo, hi = design.bounds()
+    # the knots whose interpolation reaches a station of the target: the others keep their values
+    k = design.knots
+    left, right = np.concatenate([[-np.inf], k[:-1]]), np.concatenate([k[1:], [np.inf]])
+    s_in = mesh.fibre_s[objective.inside]
+    active = ((s_in[None, :] > left[:, None]) & (s_in[None, :] < right[:, None])).any(axis=1)
     solves = 0
     rows: list[tuple[int, float, float, int]] = []
 
@@ -325,6 +331,7 @@ def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], met
             t = current.thickness
             ratio = np.interp(design.knots, t["s"][objective.inside],
                               objective.target[objective.inside] / t["thickness"][objective.inside])
+            ratio[~active] = 1.0
             current, _ = forward(np.clip(current.design * ratio, lo, hi), False)
             if not current.finished:
                 message = f"the forward solve of iteration {len(rows)} stopped: {current.message}"
@@ -337,10 +344,16 @@ def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], met
         cache: dict[bytes, tuple[Iterate, Any]] = {x0.tobytes(): (initial, first)}
         state = {"best": initial, "fail": None}
 
+        def full(x):
+            out = x0.copy()
+            out[active] = x
+            return out
+
         def evaluate(x):
-            key = np.asarray(x, float).tobytes()
+            x = full(np.asarray(x, float))
+            key = x.tobytes()
             if key not in cache:
-                cache[key] = forward(np.asarray(x, float), True)
+                cache[key] = forward(x, True)
                 it = cache[key][0]
                 if it.finished and it.objective < state["best"].objective:
                     state["best"] = it
@@ -362,13 +375,14 @@ def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], met
                 record(it)  # the optimizer asks the Jacobian at each accepted iterate
             if len(rows) > max_iter:
                 raise StopIteration
-            return rj[1]
+            return rj[1][:, active]
 
         from scipy.optimize import least_squares
 
         if initial.deviation > tolerance:
             try:
-                out = least_squares(fun, x0, jac=jac, bounds=(lo, hi), method="trf", x_scale=x0,
+                a = active
+                out = least_squares(fun, x0[a], jac=jac, bounds=(lo[a], hi[a]), method="trf", x_scale=x0[a],
                                     max_nfev=4 * max_iter + 4)
                 converged = out.status > 0
                 message = f"the optimizer converged to a best fit: {out.message}" if converged else out.message
