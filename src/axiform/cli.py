@@ -1,5 +1,6 @@
 """`axiform run CASE.toml [--out DIR]`, `axiform check CASE.toml`, `axiform plot DIR`,
-`axiform fit DATA.csv --model MODEL` (fit.py).
+`axiform fit DATA.csv --model MODEL` (fit.py), `axiform optimize CASE.toml --target T.csv
+--out DIR` (optimize.py).
 
 Exit codes: 0 finished, 1 stopped (converged steps kept), 2 invalid case (refused before any
 work), 3 failed (an unexpected error), 130 / 143 interrupted by SIGINT / SIGTERM.
@@ -390,6 +391,24 @@ def main(argv: list[str] | None = None) -> int:
     p_fit.add_argument("--terms", type=int, help="Ogden: number of terms, 1 to 6 (default 3)")
     p_fit.add_argument("--out", help="output folder (default: results/fit-<model>)")
     p_fit.add_argument("--kappa", type=float, help="bulk modulus written (default: 1000 x the initial shear modulus)")
+    p_opt = sub.add_parser("optimize", help="program a parison / preform: the thickness table that gives a target "
+                                            "final wall",
+                           description="Find the mesh.thickness table of a layered case whose final wall meets "
+                                       "a target thickness (DESIGN 10.10); writes optimized.toml, optimize.csv, "
+                                       "optimize.json, optimize.png and final/ (the results of the optimized case).")
+    p_opt.add_argument("case", help="the case file (TOML): a layered mesh with a thickness table, load control")
+    p_opt.add_argument("--target", required=True, help="CSV with the header s,thickness: the wanted final thickness "
+                                                       "against the reference arc length s")
+    p_opt.add_argument("--out", required=True, help="output folder")
+    p_opt.add_argument("--max-iter", type=int, default=20, help="most iterations (default 20)")
+    p_opt.add_argument("--method", choices=["gradient", "fixed-point"], default="gradient",
+                       help="gradient: least squares with direct-differentiation gradients (default); "
+                            "fixed-point: scale each station by target / achieved")
+    p_opt.add_argument("--tolerance", type=float, default=0.01,
+                       help="stop when the max relative deviation from the target is below this (default 0.01)")
+    p_opt.add_argument("--smoothness", type=float, default=1e-4,
+                       help="weight of the smoothness term on the design (default 1e-4)")
+    p_opt.add_argument("-q", "--quiet", action="store_true", help="print only one line: the final status")
     args = parser.parse_args(argv)
     try:
         with np.errstate(all="ignore"):  # overflow and NaN are caught by the guards, not printed
@@ -397,6 +416,11 @@ def main(argv: list[str] | None = None) -> int:
                 from .fit import run as fit
 
                 return fit(args.data, args.model, args.terms, args.out, args.kappa)
+            if args.command == "optimize":
+                from .optimize import run as optimize
+
+                return optimize(args.case, args.target, args.out, args.max_iter, args.method, args.tolerance,
+                                args.smoothness, args.quiet)
             if args.command == "plot":
                 return plot(args.folder, args.field, args.animate)
             if args.command == "run":

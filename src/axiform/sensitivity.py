@@ -1,0 +1,176 @@
+"""Sensitivities of every converged state to design variables s, by direct differentiation
+along the load path (load control).
+
+At each converged step n the residual R_n(u_n; s, h_{n-1}) = 0 holds, h_{n-1} the history
+committed at the step before (contact stick points, sticky nodes and where they froze,
+positions for the crossing test), and h_n = H(u_n; s, h_{n-1}).  Differentiating,
+
+    K_n du_n/ds = -( dR_n/ds |_u  +  dR_n/dh dh_{n-1}/ds )
+
+with K_n = dR/du the (bordered) tangent at the converged state, evaluated with the history
+h_{n-1} it converged with.  Cavities under volume or gas control are part of it: their
+pressures are unknowns of u and their constraints rows of R.
+
+The right-hand side is semi-analytic: central differences of the residual with respect to
+each s_k at fixed u, two residual assemblies per variable and step (the well-known
+semi-analytic method of shape sensitivity).  The model is rebuilt for s +- h e_k by a
+user-supplied function (`build`), so every way the reference geometry enters the residual
+counts: G and dV, pressure and cavity edges, V0 of a cavity under volume control, contact
+ring areas, default penalties and reference positions.  The history is carried the same way:
+each of these "shadow" models commits its history at the perturbed state u_n +- h du_n/ds_k,
+so that its history is h_n(s +- h e_k) to first order and the difference of the shadows'
+residuals at the next step holds dR/dh dh/ds.  The linear solves reuse one factorization of
+K_n per step for all variables.
+
+Cost per converged step: one tangent evaluation and one factorization of K_n, 2 m residual
+evaluations for m variables (4 m with contact: the shadows' history), one back-substitution
+with m right-hand sides.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from .linsolve import factorize
+from .model import Model
+from .solver import LoadControl, NewtonOptions, SolveResult, Step, solve
+from .thickness import thickness_table
+
+RELATIVE_STEP = 1e-6  # the difference step of the semi-analytic residual, relative to |s_k|
+
+
+class DesignError(ValueError):
+    """The models built for perturbed designs cannot be compared with the base model (other
+    supports, dofs or contact nodes: a selector that matches other nodes)."""
+
+
+@dataclass
+class Sensitivity:
+    """A forward solve with the derivatives of its converged states.
+
+    solve: the forward solve (status, steps, ...); model: the base model at its last state.
+    design: the design s (m,); dx_ds: the derivative of the reference node positions
+    (n_nodes, 2, m).  du_ds: per converged step, dU/ds of the full nodal dofs (n_full, m),
+    node by node as model.dofmap numbers them (every step, or only the last with
+    keep_steps=False); dp_ds: per step, the derivative of the unknown cavity pressures
+    (cavities under volume or gas control, in model order) (c, m).  thickness: the
+    thickness table of the last step (thickness.thickness_table, layered and rectangle
+    meshes; None otherwise) and dthickness_ds its derivative (stations, m)."""
+
+    solve: SolveResult
+    model: Model
+    design: np.ndarray
+    dx_ds: np.ndarray
+    du_ds: list[np.ndarray] = field(default_factory=list)
+    dp_ds: list[np.ndarray] = field(default_factory=list)
+    thickness: dict[str, np.ndarray] | None = None
+    dthickness_ds: np.ndarray | None = None
+
+    @property
+    def status(self) -> str:
+        return self.solve.status
+
+    def dx_final_ds(self) -> np.ndarray:
+        """Derivative of the current node positions x = X + u at the last step (n_nodes, 2, m)."""
+        du = self.du_ds[-1].reshape(self.model.mesh.n_nodes, self.model.dpn, -1)[:, :2]
+        return self.dx_ds + du
+
+
+def _same_numbering(base: Model, other: Model, k: int) -> None:
+    if (other.mesh.n_nodes != base.mesh.n_nodes or other.n_free != base.n_free
+            or not np.array_equal(other.dofmap.eq, base.dofmap.eq)
+            or len(other.contacts) != len(base.contacts)
+            or any(not np.array_equal(a.nodes, b.nodes) for a, b in zip(base.contacts, other.contacts))
+            or len(other.cavities) != len(base.cavities)):
+        raise DesignError(f"the model built for a perturbed design variable {k} has other dofs, supports or "
+                          "contact nodes than the base model: select nodes by named sets (start, end, inner, "
+                          "outer, ...) or by coordinates that do not move with the design")
+
+
+def sensitivity(build: Callable[[np.ndarray], Model], design: np.ndarray, control: LoadControl,
+                options: NewtonOptions | None = None, keep_steps: bool = True,
+                on_step: Callable[[Step, np.ndarray], None] | None = None,
+                relative_step: float = RELATIVE_STEP) -> Sensitivity:
+    """Solve the model build(design) under load control and differentiate every converged
+    state with respect to the design variables (module docstring).
+
+    build: design s (m,) -> an unsolved Model (finalized or not) with the same mesh topology,
+    supports and loads for every s, only the reference geometry (or constants) changed.
+    on_step(step, du_ds): called after each converged step with dU/ds (n_full, m).
+    Returns a Sensitivity; its dthickness_ds is d(final thickness)/ds (stations, m)."""
+    if not isinstance(control, LoadControl):
+        raise ValueError("sensitivities follow the load path under load control (LoadControl)")
+    s = np.asarray(design, float).ravel()
+    m = s.size
+    h = relative_step * np.where(s != 0, np.abs(s), 1.0)
+
+    def built(x):
+        model = build(x)
+        return model.finalize() if model.dofmap is None else model
+
+    model = built(s)
+    lagging = built(s)  # the base model one commit behind: the tangent K_n with the history h_{n-1}
+    shadows = []
+    for k in range(m):
+        e = np.zeros(m)
+        e[k] = h[k]
+        pair = (built(s + e), built(s - e))
+        for shadow in pair:
+            _same_numbering(model, shadow, k)
+        shadows.append(pair)
+    dx_ds = np.stack([(p.mesh.points - q.mesh.points) / (2 * hk) for (p, q), hk in zip(shadows, h)], axis=-1)
+    history = bool(model.contacts)
+    dm = model.dofmap
+    out = Sensitivity(SolveResult("running"), model, s, dx_ds)
+
+    def differentiate(step: Step) -> None:
+        u_f, lam = step.u_f, step.lam
+        ev = lagging.evaluate(u_f, lam)
+        lagging.commit()
+        dR = np.empty((model.n_free, m))
+        for k, (plus, minus) in enumerate(shadows):
+            dR[:, k] = (plus.evaluate(u_f, lam, tangent=False).r - minus.evaluate(u_f, lam, tangent=False).r) / (2 * h[k])
+        du_f = -np.asarray(factorize(ev.K)(dR)).reshape(model.n_free, m)
+        if history:
+            for k, (plus, minus) in enumerate(shadows):
+                for shadow, sign in ((plus, 1.0), (minus, -1.0)):
+                    shadow.evaluate(u_f + sign * h[k] * du_f[:, k], lam, tangent=False)
+                    shadow.commit()
+        du = np.concatenate([du_f[: dm.nf], np.zeros((dm.np, m))])[dm.eq]  # (n_full, m)
+        if not keep_steps:
+            out.du_ds.clear()
+            out.dp_ds.clear()
+        out.du_ds.append(du)
+        out.dp_ds.append(du_f[dm.nf:])
+        if on_step is not None:
+            on_step(step, du)
+
+    out.solve = solve(model, control, options, on_step=differentiate)
+    last = out.solve.last
+    if last is not None:
+        u2 = last.u.reshape(-1, model.dpn)[:, :2]
+        out.thickness = thickness_table(model.mesh, u2, model.contacts)
+        if out.thickness is not None:
+            out.dthickness_ds = thickness_derivative(model, u2, out.dx_final_ds())
+    return out
+
+
+def thickness_derivative(model: Model, u: np.ndarray, dx: np.ndarray) -> np.ndarray:
+    """d thickness / ds (stations, m) of the wall at the nodal displacements u (n_nodes, 2),
+    the current positions moving by dx (n_nodes, 2, m) per unit of each design variable:
+    central differences of the measured thickness along each dx (the thickness is a smooth
+    function of the node positions), moving no node by more than 1e-6 of the smallest
+    element edge."""
+    mesh = model.mesh
+    m = dx.shape[-1]
+    out = np.empty((len(mesh.fibres), m))
+    for k in range(m):
+        v = dx[..., k]
+        eps = 1e-6 * mesh.size() / max(float(np.abs(v).max()), 1e-300)
+        plus = thickness_table(mesh, u + eps * v)["thickness"]
+        minus = thickness_table(mesh, u - eps * v)["thickness"]
+        out[:, k] = (plus - minus) / (2 * eps)
+    return out

@@ -1,0 +1,116 @@
+"""Sensitivities by direct differentiation along the load path (axiform.sensitivity) against
+central differences of whole forward solves: a free tube blown by a cavity under volume
+control, and tubes blown against a conical mould with sticky contact and with Coulomb
+friction (nodes touch at different steps, so the history counts), in the mixed and the
+displacement formulations.  Relative error <= 1e-5 where the path keeps its contact set."""
+
+import copy
+
+import numpy as np
+import pytest
+
+from axiform.case import build, parse
+from axiform.sensitivity import DesignError, sensitivity
+from axiform.solver import ArcLengthControl, NewtonOptions, solve
+from axiform.thickness import thickness_table
+
+TUBE = {
+    "title": "tube",
+    "mesh": {"kind": "layered", "element": "q4", "start": [10.0, 0.0],
+             "profile": [{"line": {"to": [10.0, 12.0], "divisions": 6}}],
+             "thickness": [[0.0, 1.0], [6.0, 1.2], [12.0, 0.9]], "layers": 1},
+    "material": {"model": "neo-hooke", "C1": 0.1, "kappa": 100.0},
+    "fix": [{"at": {"set": "start"}, "dofs": ["uz"]}, {"at": {"set": "end"}, "dofs": ["uz"]}],
+    "cavity": [{"name": "gas", "boundary": {"set": "inner"}, "control": "volume", "volume": 6000.0}],
+    "solver": {"steps": 6},
+}
+MOULD = {"surface": {"polyline": [[11.5, -3.0], [14.0, 15.0]]}, "slaves": {"set": "outer"}}
+
+
+def tube(formulation="mixed", element="q4", contact=None, volume=6000.0):
+    tree = copy.deepcopy(TUBE)
+    tree["mesh"].update(formulation=formulation, element=element)
+    tree["cavity"][0]["volume"] = volume
+    if contact is not None:
+        tree["contact"] = [dict(MOULD, **contact)]
+    return tree
+
+
+def builder(tree):
+    def model(x):
+        t = copy.deepcopy(tree)
+        t["mesh"]["thickness"] = [[row[0], float(v)] for row, v in zip(tree["mesh"]["thickness"], x)]
+        return build(parse(t)).model
+    return model
+
+
+def forward(model, control, options, lams):
+    result = solve(model, control, options)
+    assert [s.lam for s in result.steps] == pytest.approx(lams, abs=1e-12)  # the same path
+    u = result.last.u.reshape(-1, model.dpn)[:, :2]
+    table = thickness_table(model.mesh, u)
+    return table["thickness"], model.cavities[0].pressure_now, [p.report()["status"] for p in model.contacts]
+
+
+def check_against_forward_differences(tree, rel=1e-5):
+    built = build(parse(tree))
+    x0 = np.array([row[1] for row in tree["mesh"]["thickness"]])
+    make = builder(tree)
+    sens = sensitivity(make, x0, built.control, built.options)
+    assert sens.status == "finished"
+    lams = [s.lam for s in sens.solve.steps]
+    assert len(sens.du_ds) == len(lams)
+    for k in range(len(x0)):
+        h = 1e-4 * x0[k]
+        e = np.zeros_like(x0)
+        e[k] = h
+        tp, pp, cp = forward(make(x0 + e), built.control, built.options, lams)
+        tm, pm, cm = forward(make(x0 - e), built.control, built.options, lams)
+        for a, b in zip(cp, cm):  # the contact set does not change between the two
+            assert np.array_equal(a, b)
+        fd = (tp - tm) / (2 * h)
+        err = np.abs(sens.dthickness_ds[:, k] - fd).max() / np.abs(fd).max()
+        assert err <= rel, (k, err)
+        dp = (pp - pm) / (2 * h)  # the cavity pressure, an unknown of the bordered system
+        assert sens.dp_ds[-1][0, k] == pytest.approx(dp, rel=rel, abs=rel * abs(pp) / x0[k])
+    return sens
+
+
+@pytest.mark.parametrize("formulation", ["mixed", "displacement"])
+def test_free_tube_under_volume_control(formulation):
+    sens = check_against_forward_differences(tube(formulation))
+    # the design moves the nodes across the wall linearly: dX/ds at the knots is +-1/2 of the normal
+    assert np.abs(sens.dx_ds).max() == pytest.approx(0.5, rel=1e-6)
+
+
+def test_sticky_mould_with_nodes_freezing_at_different_steps_mixed():
+    sens = check_against_forward_differences(tube("mixed", contact={"sticky": True}, volume=7000.0))
+    first = sens.model.contacts[0].first_contact
+    assert np.unique(first[~np.isnan(first)]).size >= 3  # the wall froze on the mould over several steps
+    assert (sens.model.contacts[0].report()["status"] == 3).sum() >= 6
+
+
+def test_coulomb_friction_on_the_mould():
+    sens = check_against_forward_differences(tube("displacement", contact={"friction": 0.3}, volume=6000.0))
+    pair = sens.model.contacts[0]
+    assert (pair.report()["status"] > 0).sum() >= 6
+    assert np.unique(pair.first_contact[~np.isnan(pair.first_contact)]).size >= 3
+
+
+def test_design_changing_the_supports_is_refused():
+    """A model whose supports depend on the design (here: one more fixed node above s0 = 1)
+    cannot be differentiated: DesignError says why."""
+    tree = tube()
+    built = build(parse(tree))
+    plain = builder(tree)
+
+    def make(x):
+        model = plain(x)
+        if x[0] > 1.0:
+            model.fix([0], ["ur"])
+        return model
+
+    with pytest.raises(DesignError, match="named sets"):
+        sensitivity(make, np.array([1.0, 1.2, 0.9]), built.control, built.options)
+    with pytest.raises(ValueError, match="load control"):
+        sensitivity(plain, np.array([1.0, 1.2, 0.9]), ArcLengthControl(), NewtonOptions())
