@@ -84,7 +84,9 @@ def test_free_tube_under_volume_control(formulation):
 
 
 def test_sticky_mould_with_nodes_freezing_at_different_steps_mixed():
-    sens = check_against_forward_differences(tube("mixed", contact={"sticky": True}, volume=7000.0))
+    tree = tube("mixed", contact={"sticky": True}, volume=7000.0)
+    tree["solver"]["steps"] = 12  # 6 steps need 13-20 Newton iterations each, at the limit of 20
+    sens = check_against_forward_differences(tree)
     first = sens.model.contacts[0].first_contact
     assert np.unique(first[~np.isnan(first)]).size >= 3  # the wall froze on the mould over several steps
     assert (sens.model.contacts[0].report()["status"] == 3).sum() >= 6

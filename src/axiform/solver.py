@@ -461,21 +461,22 @@ def _factorize(K):
 
 
 def _newton_load(model, u_f, lam, opts, floor, guess=None):
-    """Newton at fixed lambda from a predicted state `guess` (if it is admissible) or from the
-    last converged state u_f.  With contact, a correction that raises the residual is
-    shortened (halved up to three times): the active set and the stick/slip states change
-    between iterations, and a full step can overshoot."""
-    residuals: list[float] = []
-    ev = None
+    """Newton at fixed lambda from a predicted state `guess`, and if that fails (or the guess
+    is not admissible) from the last converged state u_f."""
     if guess is not None:
         try:
-            ev = _evaluate(model, guess, lam)
-            u_f = guess.copy()
-        except StepFailed:  # an inverted element at the predicted state: start from u_f
-            ev = None
-    if ev is None:
-        u_f = u_f.copy()
-        ev = _evaluate(model, u_f, lam)
+            return _newton_load_from(model, guess.copy(), lam, opts, floor)
+        except StepFailed:
+            pass
+    return _newton_load_from(model, u_f.copy(), lam, opts, floor)
+
+
+def _newton_load_from(model, u_f, lam, opts, floor):
+    """Newton at fixed lambda from u_f.  With contact, a correction that raises the residual
+    is shortened (halved up to three times): the active set and the stick/slip states change
+    between iterations, and a full step can overshoot."""
+    residuals: list[float] = []
+    ev = _evaluate(model, u_f, lam)
     for it in range(opts.max_iterations + 1):
         if _check(ev, lam, opts, floor, residuals):
             return u_f, lam, it, residuals, ev
@@ -497,18 +498,19 @@ def _newton_load(model, u_f, lam, opts, floor, guess=None):
 def _newton_displacement(model, u_f, lam, c, target, opts, floor, guess=None):
     """Newton with u_f[c] driven to target and lambda unknown (bordered system):
     du = a + dlam b, K a = -R, K b = -dR/dlambda, dlam chosen so that u_c reaches target.
-    Starts from a predicted (u, lambda) `guess` where it is admissible."""
-    u_f = u_f.copy()
-    residuals: list[float] = []
-    start = None
+    Starts from a predicted (u, lambda) `guess`, and if that fails from the converged state."""
     if guess is not None:
         try:
-            start = _evaluate(model, guess[0], guess[1])
-            u_f, lam = guess[0].copy(), guess[1]
-        except StepFailed:  # inverted at the predicted state: start from the converged one
-            start = None
+            return _newton_displacement_from(model, guess[0].copy(), guess[1], c, target, opts, floor)
+        except StepFailed:
+            pass
+    return _newton_displacement_from(model, u_f.copy(), lam, c, target, opts, floor)
+
+
+def _newton_displacement_from(model, u_f, lam, c, target, opts, floor):
+    residuals: list[float] = []
     for it in range(opts.max_iterations + 1):
-        ev = start if (it == 0 and start is not None) else _evaluate(model, u_f, lam)
+        ev = _evaluate(model, u_f, lam)
         if it > 0 and _check(ev, lam, opts, floor, residuals):
             return u_f, lam, it, residuals, ev
         if it == 0:
