@@ -474,7 +474,9 @@ def _newton_load(model, u_f, lam, opts, floor, guess=None):
 def _newton_load_from(model, u_f, lam, opts, floor):
     """Newton at fixed lambda from u_f.  With contact, a correction that raises the residual
     is shortened (halved up to three times): the active set and the stick/slip states change
-    between iterations, and a full step can overshoot."""
+    between iterations, and a full step can overshoot.  If no shortened step lowers the
+    residual either, the full step is taken: creeping by eighths of Newton steps stalled
+    sticky and frictional steps for 15 iterations at a residual that did not fall."""
     residuals: list[float] = []
     ev = _evaluate(model, u_f, lam)
     for it in range(opts.max_iterations + 1):
@@ -484,13 +486,15 @@ def _newton_load_from(model, u_f, lam, opts, floor):
             break
         du = -_factorize(ev.K)(ev.r)
         trial = _evaluate(model, u_f + du, lam)
-        if model.contacts:
-            norm = ev.force_norm
+        if model.contacts and trial.force_norm > ev.force_norm:
+            full = (du, trial)
             for _ in range(3):
-                if trial.force_norm <= norm:
-                    break
-                du *= 0.5
+                du = 0.5 * du
                 trial = _evaluate(model, u_f + du, lam)
+                if trial.force_norm <= ev.force_norm:
+                    break
+            else:
+                du, trial = full
         u_f, ev = u_f + du, trial
     raise StepFailed(f"no convergence in {opts.max_iterations} iterations")
 
