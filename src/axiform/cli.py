@@ -207,7 +207,7 @@ def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], st
         if not quiet:
             _say(f"axiform {__version__}: {case.title or case_file.name}: {model.mesh.n_cells} "
                  f"{model.mesh.element.name} elements, {model.n_free} free dofs -> {out_dir}{note}")
-        result = solve(model, control, built.options, on_step=on_step)
+        result = solve(model, control, built.options, on_step=on_step, keep=1)
         status, message = result.status, result.message
     except Interrupted as exc:
         if writer is None:
