@@ -222,12 +222,19 @@ def _factorize_superlu(K: sp.csr_matrix) -> Solve:
 
 
 def _factorize_dense(K: sp.spmatrix) -> Solve:
-    from scipy.linalg import lu_factor, lu_solve
+    """LAPACK getrf / getrs, called directly (scipy.linalg.lu_solve's wrapper keeps a few
+    objects per call)."""
+    from scipy.linalg.lapack import dgetrf, dgetrs
 
-    lu, piv = lu_factor(K.toarray(), check_finite=False, overwrite_a=True)
-    if not np.all(np.diagonal(lu)):
+    lu, piv, info = dgetrf(K.toarray(), overwrite_a=True)
+    if info > 0:
         raise SingularTangentError("the tangent is singular (a zero pivot)")
-    return lambda b: _check(lu_solve((lu, piv), b, check_finite=False))
+
+    def solve(b: np.ndarray) -> np.ndarray:
+        x, info = dgetrs(lu, piv, np.asarray(b, dtype=float))
+        return _check(x)
+
+    return solve
 
 
 def factorize(K: sp.spmatrix) -> Solve:
