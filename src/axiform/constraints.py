@@ -11,6 +11,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from .graphs import connected_components
+
 
 class DofMap:
     """Map full dofs to equations.  fixed: {full dof: reference value}; ties: groups of full
@@ -21,8 +23,6 @@ class DofMap:
         if len(ties):
             pairs = np.vstack([np.column_stack([g[:-1], g[1:]]) for g in map(np.asarray, ties) if len(g) > 1])
             graph = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n_full, n_full))
-            from scipy.sparse.csgraph import connected_components  # imported when needed (0.15 s)
-
             _, label = connected_components(graph, directed=False)
             first = np.full(label.max() + 1, n_full)
             np.minimum.at(first, label, np.arange(n_full))

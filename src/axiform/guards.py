@@ -14,6 +14,8 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
+from .graphs import connected_components
+
 
 def key_path(parts: list[str | int]) -> str:
     """('contact', 0, 'surface', 'polyline', 2, 1) -> 'contact[0].surface.polyline[2][1]'."""
@@ -106,8 +108,6 @@ def bodies(n_nodes: int, cells: np.ndarray) -> np.ndarray:
     """The connected body (0, 1, ...) each node belongs to, (n_nodes,), through shared cells."""
     rows = np.repeat(cells[:, 0], cells.shape[1])
     graph = sp.coo_matrix((np.ones(rows.size), (rows, cells.ravel())), shape=(n_nodes, n_nodes))
-    from scipy.sparse.csgraph import connected_components  # imported when needed (0.15 s)
-
     return connected_components(graph, directed=False)[1]
 
 

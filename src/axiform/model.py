@@ -17,6 +17,7 @@ from .assembly import SolidAssembly
 from .constraints import DofMap, SparsePattern
 from .cavity import Cavity
 from .curves import PROPORTIONAL, Curve
+from .graphs import connected_components
 from .loads import FollowerPressure
 from .mixed import MixedAssembly
 from .mesh import Mesh
@@ -181,8 +182,6 @@ class Model:
         rows = np.repeat(cells[:, 0], cells.shape[1])
         graph = sp.coo_matrix((np.ones(rows.size), (rows, cells.ravel())),
                               shape=(self.mesh.n_nodes, self.mesh.n_nodes))
-        from scipy.sparse.csgraph import connected_components  # imported when needed (0.15 s)
-
         _, body = connected_components(graph, directed=False)
         held = {body[d // self.dpn] for d in fixed if d % self.dpn == 2}
         for b in np.unique(body[cells[:, 0]]):

@@ -230,8 +230,9 @@ def _text(value: Any) -> str:
 
 
 def plot_sweep(path: Path, sweep: Sweep, rows: list[dict | None]) -> bool:
-    """sweep.png: the report monitor against the first varied key, one line for each
-    combination of the other keys; cases that did not finish are left out (and counted)."""
+    """sweep.png: the report monitor against the first key that takes several values, one
+    line for each combination of the other such keys; cases that did not finish are left out
+    (and counted)."""
     if sweep.report is None or not sweep.keys:
         return False
     import matplotlib
@@ -239,23 +240,25 @@ def plot_sweep(path: Path, sweep: Sweep, rows: list[dict | None]) -> bool:
     matplotlib.use("Agg")
     from matplotlib.figure import Figure
 
-    first, others = sweep.keys[0], sweep.keys[1:]
-    groups: dict[tuple, list[tuple[Any, float]]] = {}
+    # keys that take one value in every case say nothing on the picture
+    varied = [k for k in sweep.keys if len({_text(c.get(k)) for c in sweep.cases}) > 1] or sweep.keys[:1]
+    first, others = varied[0], varied[1:]
+    xs = list(dict.fromkeys(_text(case.get(first)) for case in sweep.cases))  # values as text: lists too
+    values = {_text(case.get(first)): case.get(first) for case in sweep.cases}
+    numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values.values())
+    groups: dict[str, list[tuple[float, float]]] = {}
     for case, row in zip(sweep.cases, rows):
         if row and row.get("status") == "finished" and sweep.report in row.get("monitors", {}):
-            label = tuple(case.get(k) for k in others)
-            groups.setdefault(label, []).append((case.get(first), row["monitors"][sweep.report]))
-    xs = list(dict.fromkeys(case.get(first) for case in sweep.cases))
-    numeric = all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in xs)
+            label = ", ".join(f"{k} = {_text(case.get(k))}" for k in others)
+            x = _text(case.get(first))
+            groups.setdefault(label, []).append((values[x] if numeric else xs.index(x), row["monitors"][sweep.report]))
     fig = Figure(figsize=(6.4, 4.4), layout="constrained")
     ax = fig.add_subplot()
     for label, points in groups.items():
-        points.sort(key=lambda p: p[0] if numeric else xs.index(p[0]))
-        x = [p[0] if numeric else xs.index(p[0]) for p in points]
-        name = ", ".join(f"{k} = {_text(v)}" for k, v in zip(others, label)) if others else None
-        ax.plot(x, [p[1] for p in points], marker="o", label=name)
+        points.sort()
+        ax.plot([p[0] for p in points], [p[1] for p in points], marker="o", label=label or None)
     if not numeric:
-        ax.set_xticks(range(len(xs)), [_text(x) for x in xs])
+        ax.set_xticks(range(len(xs)), xs)
     finished = sum(1 for r in rows if r and r.get("status") == "finished")
     ax.set_xlabel(first)
     ax.set_ylabel(sweep.report)
@@ -335,7 +338,10 @@ def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: 
             if cluster is not None:
                 cluster.close()
     progress.close()
-    plot_sweep(root / "sweep.png", sweep, rows)
+    try:
+        plot_sweep(root / "sweep.png", sweep, rows)
+    except Exception as exc:  # noqa: BLE001 - the cases and sweep.csv stand; say why the picture does not
+        print(f"axiform sweep: sweep.png not written ({type(exc).__name__}: {exc})", file=say)
     bad = [f"{k + 1:04d}" for k, r in enumerate(rows) if r.get("status") != "finished"]
     print(f"axiform sweep: {n - len(bad)} of {n} cases finished" + (f"; not finished: {', '.join(bad)}" if bad else "")
           + f" -> {root / 'sweep.csv'}", file=say)
