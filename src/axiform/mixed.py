@@ -145,8 +145,9 @@ class MixedAssembly(SolidAssembly):
             if tangent:
                 AG = np.matmul(A, self.G[sl]).reshape(m, q * 5, nd)
                 np.matmul(GdV_T, AG, out=Ke[sl])
-                # B = int N_p dJ^T G dV (m, np, nd); K += kappa B^T M^-1 B
-                dJG = np.matmul(dJ.T.reshape(m, q, 1, 5), self.G[sl]).reshape(m, q, nd)
-                B = np.matmul(self._NpdV_T[sl], dJG)
-                Ke[sl] += kappa * np.matmul(B.transpose(0, 2, 1), np.matmul(self.Minv[sl], B))
+                # B = int N_p dJ^T G dV (m, np, nd) as one product with the stacked G (m, 5q, nd);
+                # K += kappa B^T M^-1 B
+                W = self._NpdV_T[sl][:, :, :, None] * dJ.T.reshape(m, 1, q, 5)  # (m, np, q, 5)
+                B = np.matmul(W.reshape(m, -1, q * 5), self._G2[sl])
+                Ke[sl] += np.matmul(B.transpose(0, 2, 1), kappa * np.matmul(self.Minv[sl], B))
         return fe, Ke
