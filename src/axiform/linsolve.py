@@ -1,7 +1,7 @@
 """LU of the (non-symmetric) tangent K: one factorization, several right-hand sides; the
 ordering and symbolic analysis done once per sparsity pattern.
 
-The solver is chosen by the size n of K (benchmarks/README.md § 2 measured each):
+The solver is chosen by the size n of K (benchmarks/README.md § 3.2 measured each):
 
 - n <= DENSE_MAX: dense LAPACK LU (getrf / getrs), where the sparse solvers' fixed costs
   exceed the whole dense work;
