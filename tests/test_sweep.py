@@ -154,3 +154,12 @@ def test_full_factorial_order_and_values(sweep_dir):
 @pytest.mark.parametrize("value", [1.5, -2, True, "q8", [40, 4], {"r": 7.5, "z": 0.0}, [[0.0, 0.0], [1.0, 2.0]], 1e-300])
 def test_toml_value_round_trip(value):
     assert tomllib.loads(f"v = {toml_value(value)}")["v"] == value
+
+
+def test_bad_workers_and_out(sweep_dir, capsys):
+    args = ["sweep", str(sweep_dir / "sweep.toml")]
+    assert main(args + ["--out", str(sweep_dir / "w0"), "--workers", "0"]) == 2
+    assert "--workers" in capsys.readouterr().err
+    (sweep_dir / "a_file").write_text("")
+    assert main(args + ["--out", str(sweep_dir / "a_file")]) == 2
+    assert "--out" in capsys.readouterr().err
