@@ -199,6 +199,9 @@ def section_process(trees: dict[str, Path], repeat: int, tmp: Path) -> str:
         jobs[f"axiform run, no VTU, no plots ({name})"] = (
             run + ["--set", "output.vtu=false", "--set", "output.plots=false", "--out", str(tmp / f"plain-{name}")],
             env_for(src))
+        jobs[f"axiform run, no VTU, no plots, MKL's default threads ({name})"] = (
+            run + ["--set", "output.vtu=false", "--set", "output.plots=false", "--out", str(tmp / f"threads-{name}")],
+            env_for(src, threads_one=False))
         jobs[f"import axiform.cli ({name})"] = ([py, "-c", "import axiform.cli"], env_for(src))
     jobs["python -c pass"] = ([py, "-c", "pass"], env_for(SRC))
     # the peers' 44 pressures: where axiform's load curve reaches w = 8 k / 44 (as benchmarks/peers.py)

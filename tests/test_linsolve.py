@@ -108,3 +108,17 @@ def test_threads_keep_their_own(monkeypatch):
     for t in threads:
         t.join()
     assert len(errors) == 60 and max(errors) <= 1e-10
+
+
+def test_threads_by_size(monkeypatch):
+    """Below PARALLEL_MIN unknowns PARDISO runs on one thread, above on MKL's own setting; the
+    same answer either way."""
+    _backend(monkeypatch, "pardiso")
+    K, B = _tangent("q4", (7, 6))
+    x1 = ls.factorize(K)(B)
+    assert ls._STATE.pardiso.threads == 1
+    monkeypatch.setattr(ls, "PARALLEL_MIN", 0)
+    ls._STATE.pardiso.release()
+    x0 = ls.factorize(K)(B)
+    assert ls._STATE.pardiso.threads == 0
+    assert np.abs(x1 - x0).max() <= 1e-12 * np.abs(x0).max()

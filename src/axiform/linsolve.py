@@ -37,6 +37,7 @@ import numpy as np
 import scipy.sparse as sp
 
 DENSE_MAX = 150  # largest n factorized as a dense matrix
+PARALLEL_MIN = 2000  # smallest n that PARDISO factorizes with MKL's threads (smaller: one thread)
 
 Solve = Callable[[np.ndarray], np.ndarray]
 
@@ -68,11 +69,17 @@ def _mkl() -> ctypes.CDLL | None:
     import ctypes.util
 
     candidates += [ctypes.util.find_library("mkl_rt"), ctypes.util.find_library("mkl_rt.1")]
+    # MKL's OpenMP threads otherwise spin 200 ms after each factorization, on the core that
+    # the evaluation between two factorizations needs (on a loaded machine the plate's solve
+    # took twice as long); read when the runtime starts, so set before the library loads
+    os.environ.setdefault("KMP_BLOCKTIME", "0")
     _MKL = None
     for path in filter(None, candidates):
         try:
             lib = ctypes.CDLL(path)
             lib.pardiso.restype = None
+            lib.MKL_Set_Num_Threads_Local.restype = ctypes.c_int
+            lib.MKL_Set_Num_Threads_Local.argtypes = [ctypes.c_int]
             _MKL = lib
             break
         except (OSError, AttributeError):
@@ -90,7 +97,9 @@ _f64p = ctypes.POINTER(ctypes.c_double)
 
 class _Pardiso:
     """One PARDISO handle (real non-symmetric, zero-based CSR): analyse() once per pattern,
-    factor() per matrix, solve() per right-hand side block."""
+    factor() per matrix, solve() per right-hand side block.  Below PARALLEL_MIN unknowns
+    every phase runs on one thread (MKL's threads gain nothing there: benchmarks/README.md
+    § 3.2); the number of threads is chosen at the analysis and kept for its phases."""
 
     def __init__(self, lib: ctypes.CDLL):
         self.lib = lib
@@ -104,10 +113,20 @@ class _Pardiso:
         self.iparm[12] = 1  # weighted matching, for non-symmetric matrices
         self.iparm[34] = 1  # zero-based indices
         self.n = 0
+        self.threads = 0  # 0: MKL's own setting
         self.indptr = self.indices = None
         self.token: object | None = None
 
     def _call(self, phase: int, data, b=None, x=None, nrhs: int = 1) -> int:
+        if self.threads:
+            before = self.lib.MKL_Set_Num_Threads_Local(self.threads)  # this thread only
+            try:
+                return self._pardiso(phase, data, b, x, nrhs)
+            finally:
+                self.lib.MKL_Set_Num_Threads_Local(before)
+        return self._pardiso(phase, data, b, x, nrhs)
+
+    def _pardiso(self, phase: int, data, b, x, nrhs: int) -> int:
         error = ctypes.c_int32(0)
         one = ctypes.c_int32(1)
         dummy = np.zeros(1)
@@ -132,6 +151,7 @@ class _Pardiso:
         """Phase 11: ordering and symbolic factorization of K's pattern."""
         self.release()
         self.n = K.shape[0]
+        self.threads = 1 if self.n < PARALLEL_MIN else 0
         self._src_indptr, self._src_indices = K.indptr, K.indices
         self.indptr = np.ascontiguousarray(K.indptr, dtype=np.int32)
         self.indices = np.ascontiguousarray(K.indices, dtype=np.int32)
