@@ -149,7 +149,7 @@ def test_curves_are_applied_exactly_at_their_knots():
     uz_dofs = model.dof(bottom, "uz")
     ur_side = model.dof(side, "ur")
     for s in res.steps:
-        reaction = s.evaluation.r_full[uz_dofs].sum()
+        reaction = s.r_full[uz_dofs].sum()
         assert reaction == pytest.approx(-0.01 * len(top) * f(s.lam), rel=1e-7, abs=1e-12)
         assert np.allclose(s.u[ur_side], 0.05 * g(s.lam), rtol=0, atol=1e-15)
 

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import axiform.cli as cli
+import axiform.solver as solver
 from axiform.case import build, parse
 from axiform.checkpoint import load as load_checkpoint
 from axiform.checkpoint import save as save_checkpoint
@@ -109,19 +110,19 @@ def test_axiform_run_resume_gives_the_same_history(tmp_path, monkeypatch):
     case = dict(PUNCH, restart={"every": 2})
     path = _write(tmp_path, case)
     assert cli.main(["run", str(path), "--out", str(tmp_path / "full"), "-q"]) == 0
-    real_solve = cli.solve
+    real_solve = solver.solve
 
-    def interrupted(model, control, options, on_step=None, resume=None):
+    def interrupted(model, control, options, on_step=None, keep=None, resume=None):
         def step(s):
             on_step(s)
             if s.number == 5:
                 os.kill(os.getpid(), signal.SIGTERM)
-        return real_solve(model, control, options, on_step=step, resume=resume)
+        return real_solve(model, control, options, on_step=step, keep=keep, resume=resume)
 
-    monkeypatch.setattr(cli, "solve", interrupted)
+    monkeypatch.setattr(solver, "solve", interrupted)  # axiform run imports it when it runs
     out = tmp_path / "cut"
     assert cli.main(["run", str(path), "--out", str(out), "-q"]) == 128 + signal.SIGTERM
-    monkeypatch.setattr(cli, "solve", real_solve)
+    monkeypatch.setattr(solver, "solve", real_solve)
     assert len(_rows(out)) == 5
     assert cli.main(["run", str(path), "--resume", str(out), "-q"]) == 0
     full, resumed = _rows(tmp_path / "full"), _rows(out)

@@ -1,12 +1,21 @@
-"""axiform: large-strain axisymmetric finite elements for forming hollow plastic bodies."""
+"""axiform: large-strain axisymmetric finite elements for forming hollow plastic bodies.
 
-from .elements import ELEMENTS, Q4, Q8, SFR
-from .materials import ArrudaBoyce, Gent, MooneyRivlin, NeoHooke, Ogden, Yeoh
-from .mesh import Mesh, read_gmsh, rectangle
-from .model import Model
-from .selectors import select_edges, select_nodes
-from .sensitivity import Sensitivity, sensitivity
-from .solver import DisplacementControl, LoadControl, NewtonOptions, solve
+The names below are imported on first use (PEP 562), so that `import axiform.cli` does not
+load NumPy, SciPy and the element code before a command needs them.
+"""
+
+from importlib import import_module
+
+_WHERE = {
+    "ELEMENTS": "elements", "Q4": "elements", "Q8": "elements", "SFR": "elements",
+    "ArrudaBoyce": "materials", "Gent": "materials", "MooneyRivlin": "materials", "NeoHooke": "materials",
+    "Ogden": "materials", "Yeoh": "materials",
+    "Mesh": "mesh", "read_gmsh": "mesh", "rectangle": "mesh",
+    "Model": "model",
+    "select_edges": "selectors", "select_nodes": "selectors",
+    "Sensitivity": "sensitivity", "sensitivity": "sensitivity",
+    "DisplacementControl": "solver", "LoadControl": "solver", "NewtonOptions": "solver", "solve": "solver",
+}
 
 __all__ = [
     "ELEMENTS", "Q4", "Q8", "SFR", "MooneyRivlin", "NeoHooke", "Mesh", "read_gmsh", "rectangle",
@@ -14,3 +23,15 @@ __all__ = [
     "NewtonOptions", "solve", "Yeoh", "Ogden", "Gent", "ArrudaBoyce", "sensitivity", "Sensitivity",
 ]
 __version__ = "0.1.0"
+
+
+def __getattr__(name: str):
+    if name in _WHERE:
+        value = getattr(import_module(f".{_WHERE[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'axiform' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(list(globals()) + __all__)

@@ -544,7 +544,7 @@ class Monitor:
         if self.pair is not None:
             return float(self.pair.report()[_CONTACT_QUANTITY[self.quantity]])
         if self.reaction:
-            return float(step.evaluation.r_full[self.dofs].sum())
+            return float(step.r_full[self.dofs].sum())
         return float(step.u[self.dofs].sum())
 
 

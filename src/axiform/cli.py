@@ -1,9 +1,12 @@
 """`axiform run CASE.toml [--out DIR]`, `axiform check CASE.toml`, `axiform plot DIR`,
 `axiform fit DATA.csv --model MODEL` (fit.py), `axiform optimize CASE.toml --target T.csv
---out DIR` (optimize.py).
+--out DIR` (optimize.py), `axiform sweep SWEEP.toml --out DIR` (sweep.py).
 
 Exit codes: 0 finished, 1 stopped (converged steps kept), 2 invalid case (refused before any
 work), 3 failed (an unexpected error), 130 / 143 interrupted by SIGINT / SIGTERM.
+
+The modules behind the commands (NumPy, SciPy, pydantic, matplotlib, meshio, Dask) are
+imported by the command that needs them: `import axiform.cli` itself stays light.
 """
 
 from __future__ import annotations
@@ -20,14 +23,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Self
 
-import numpy as np
-
 from . import __version__
-from .case import CaseError, build, fingerprint, parse, read
-from .case_material import KEYS
-from .labels import case_labels
-from .results import NonFiniteResult, ResultsWriter
-from .solver import StepFailed, solve
 
 EXIT = {"finished": 0, "stopped": 1, "failed": 3}
 
@@ -112,7 +108,7 @@ def _say(*lines: str) -> None:
     print(*lines, sep="\n", file=sys.stderr)
 
 
-def _invalid(case_file: Path, exc: CaseError) -> int:
+def _invalid(case_file: Path, exc: Exception) -> int:
     _say(f"axiform: invalid case {case_file}:", str(exc))
     return 2
 
@@ -160,6 +156,7 @@ FROZEN_ON_RESUME = ("mesh", "material")
 def _resume_state(folder: Path, data: dict) -> dict:
     """The checkpoint of a results folder to resume, after checking that the case's mesh and
     material are the ones it was made with; CaseError (exit 2) otherwise."""
+    from .case import CaseError, fingerprint
     from .checkpoint import load as load_checkpoint
 
     if not folder.is_dir():
@@ -187,6 +184,11 @@ def run(case_path: str, out: str | None, quiet: bool = False, overrides: list[st
 
 def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], stops: Stops,
          resume: str | None = None) -> int:
+    from .case import CaseError, build, fingerprint, parse, read
+    from .labels import case_labels
+    from .results import NonFiniteResult, ResultsWriter
+    from .solver import StepFailed, solve
+
     state = None
     try:
         data = read(case_file, overrides)
@@ -250,7 +252,7 @@ def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], st
         if not quiet:
             _say(f"axiform {__version__}: {case.title or case_file.name}: {model.mesh.n_cells} "
                  f"{model.mesh.element.name} elements, {model.n_free} free dofs -> {out_dir}{note}")
-        result = solve(model, control, built.options, on_step=on_step, resume=state)
+        result = solve(model, control, built.options, on_step=on_step, keep=1, resume=state)
         status, message = result.status, result.message
     except Interrupted as exc:
         if writer is None:
@@ -296,6 +298,8 @@ def _failed(exc: Exception, what: str) -> int:
 
 def check(case_path: str, overrides: list[str] = ()) -> int:
     """Validate a case and build its model, without solving; returns the exit code."""
+    from .case import CaseError, build, parse, read
+
     case_file = Path(case_path)
     try:
         built = build(parse(read(case_file, overrides)), case_file.parent)
@@ -387,7 +391,8 @@ def main(argv: list[str] | None = None) -> int:
                              "per written step")
     p_fit = sub.add_parser("fit", help="fit a hyperelastic law to uniaxial / equibiaxial / planar test data")
     p_fit.add_argument("data", nargs="+", help="CSV files with the header mode,stretch,stress")
-    p_fit.add_argument("--model", required=True, choices=list(KEYS), help="the law")
+    p_fit.add_argument("--model", required=True, help="the law: neo-hooke, mooney-rivlin, yeoh, ogden, gent, "
+                                                      "arruda-boyce")
     p_fit.add_argument("--terms", type=int, help="Ogden: number of terms, 1 to 6 (default 3)")
     p_fit.add_argument("--out", help="output folder (default: results/fit-<model>)")
     p_fit.add_argument("--kappa", type=float, help="bulk modulus written (default: 1000 x the initial shear modulus)")
@@ -409,7 +414,26 @@ def main(argv: list[str] | None = None) -> int:
     p_opt.add_argument("--smoothness", type=float, default=1e-4,
                        help="weight of the smoothness term on the design (default 1e-4)")
     p_opt.add_argument("-q", "--quiet", action="store_true", help="print only one line: the final status")
+    p_sweep = sub.add_parser("sweep", help="run variants of a case on a Dask cluster: sweep.csv, sweep.png",
+                             description="Run the cases of a sweep file ([vary]: full factorial, or [[cases]]) "
+                                         "on a Dask cluster, each in OUT/cases/NNNN/; OUT/sweep.csv, OUT/sweep.png. "
+                                         "Exit 0 when every case finished, 1 when some did not, 2 for an invalid "
+                                         "sweep file.")
+    p_sweep.add_argument("sweep", help="the sweep file (TOML): case, [vary] or [[cases]], [report]")
+    p_sweep.add_argument("--out", required=True, help="the sweep folder: cases/NNNN/, sweep.csv, sweep.png")
+    p_sweep.add_argument("--scheduler", help="address of a running Dask scheduler (default: a LocalCluster)")
+    p_sweep.add_argument("--workers", type=int, help="worker processes of the LocalCluster (default: the cores)")
     args = parser.parse_args(argv)
+    if args.command == "fit":
+        from .case_material import KEYS
+
+        if args.model not in KEYS:
+            p_fit.error(f"argument --model: invalid choice: {args.model!r} (choose from {', '.join(KEYS)})")
+    import numpy as np
+
+    from .malloc import keep_freed_memory
+
+    keep_freed_memory()  # the same temporaries are allocated on every Newton iteration
     try:
         with np.errstate(all="ignore"):  # overflow and NaN are caught by the guards, not printed
             if args.command == "fit":
@@ -421,6 +445,10 @@ def main(argv: list[str] | None = None) -> int:
 
                 return optimize(args.case, args.target, args.out, args.max_iter, args.method, args.tolerance,
                                 args.smoothness, args.quiet)
+            if args.command == "sweep":
+                from .sweep import run_sweep
+
+                return run_sweep(args.sweep, args.out, args.scheduler, args.workers)
             if args.command == "plot":
                 return plot(args.folder, args.field, args.animate)
             if args.command == "run":

@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
+
+from .graphs import connected_components
 
 
 class DofMap:
@@ -60,7 +61,11 @@ class DofMap:
 
 class SparsePattern:
     """The CSR pattern of the extended system, built once from the dof connectivity of
-    every term (element dofs, edge dofs ...); values are refilled each iteration."""
+    every term (element dofs, edge dofs ...); values are refilled each iteration.
+
+    The data array holds the K_ff block first (free rows and columns, in CSR order), then
+    K_fp (free rows, prescribed columns), then the prescribed rows: K_ff's values are a
+    view of its head, with no copy."""
 
     def __init__(self, dofmap: DofMap, blocks: list[np.ndarray]):
         self.dofmap = dofmap
@@ -71,15 +76,16 @@ class SparsePattern:
         np.not_equal(keys[1:], keys[:-1], out=distinct[1:])
         self.keys = keys[distinct]
         rows, cols = self.keys // n, self.keys % n
-        self.indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=n))])
-        self.indices = cols
         nf = dofmap.nf
         ff = (rows < nf) & (cols < nf)
         fp = (rows < nf) & (cols >= nf)
-        self._ff = np.flatnonzero(ff)
-        self._fp = np.flatnonzero(fp)
+        order = np.concatenate([np.flatnonzero(ff), np.flatnonzero(fp), np.flatnonzero(~(ff | fp))])
+        self._slot = np.empty(order.size, dtype=np.int64)  # sorted key -> place in the data array
+        self._slot[order] = np.arange(order.size)
+        self.n_ff, self.n_fp = int(ff.sum()), int(fp.sum())
         self._ff_csr = self._sub(rows[ff], cols[ff], nf, nf)
         self._fp_csr = self._sub(rows[fp], cols[fp] - nf, nf, dofmap.np)
+        self._fp_rows, self._fp_cols = rows[fp], cols[fp] - nf
 
     def _keys(self, dofs: np.ndarray) -> np.ndarray:
         eq = self.dofmap.eq[dofs]  # (m, k)
@@ -92,17 +98,30 @@ class SparsePattern:
 
     def positions(self, dofs: np.ndarray) -> np.ndarray:
         """Positions in the data array of each entry (m, k, k) of blocks on these dofs."""
-        return np.searchsorted(self.keys, self._keys(dofs)).ravel()
+        return self._slot[np.searchsorted(self.keys, self._keys(dofs)).ravel()]
 
     def accumulate(self, positions: np.ndarray, values: np.ndarray, data: np.ndarray | None = None):
         """Add values (matching positions) into a data array of the pattern."""
         add = np.bincount(positions, weights=values.ravel(), minlength=len(self.keys))
-        return add if data is None else data + add
+        if data is None:
+            return add
+        data += add
+        return data
+
+    def free_block(self, data: np.ndarray) -> sp.csr_matrix:
+        """K_ff (free rows and columns) as a CSR matrix on a view of data."""
+        i, p, s = self._ff_csr
+        K = sp.csr_matrix((data[: self.n_ff], i, p), shape=s)
+        K.has_sorted_indices = True  # the keys are sorted: spares a scan of every row
+        return K
+
+    def fp_product(self, data: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """K_fp v (nf,) for v (np,) on the prescribed equations."""
+        w = data[self.n_ff: self.n_ff + self.n_fp] * v[self._fp_cols]
+        return np.bincount(self._fp_rows, weights=w, minlength=self.dofmap.nf)
 
     def blocks(self, data: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """K_ff and K_fp (free rows; free and prescribed columns) as CSR matrices."""
-        i, p, s = self._ff_csr
-        K_ff = sp.csr_matrix((data[self._ff], i, p), shape=s)
         i, p, s = self._fp_csr
-        K_fp = sp.csr_matrix((data[self._fp], i, p), shape=s)
-        return K_ff, K_fp
+        K_fp = sp.csr_matrix((data[self.n_ff: self.n_ff + self.n_fp], i, p), shape=s)
+        return self.free_block(data), K_fp

@@ -13,7 +13,8 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
+
+from .graphs import connected_components
 
 
 def key_path(parts: list[str | int]) -> str:

@@ -1,32 +1,45 @@
-"""Sparse LU of the (non-symmetric) tangent: one factorization, several right-hand sides.
+"""LU of the (non-symmetric) tangent K: one factorization, several right-hand sides; the
+ordering and symbolic analysis done once per sparsity pattern.
 
-MKL PARDISO through pypardiso where it is installed (x86-64), otherwise SciPy's SuperLU.
-benchmarks/newton_iteration.py measured both on these tangents (one core): PARDISO
-factorizes and solves 2 to 4 times faster than the best SuperLU ordering at 1e5 to 3e5 dofs
-(Q4 and SFR): a Newton iteration at 1e5 dofs takes 0.73 s (Q4) and 1.03 s (SFR) on one
-core with it, 0.55 and 0.75 s with two (benchmarks/README.md).
+The solver is chosen by the size n of K (benchmarks/README.md § 3.2 measured each):
 
-SuperLU's column ordering: minimum degree on K^T K, which bounds the fill whatever rows
-partial pivoting picks.  Minimum degree on K^T + K (used before) assumes diagonal pivots:
-with partial pivoting the fill depends on the values of K, and on some tangents it grew 3x
-(Q4) to 12x (SFR), the factorization 10x (Q4) to 100x (SFR) slower (benchmarks/README.md).
+- n <= DENSE_MAX: dense LAPACK LU (getrf / getrs), where the sparse solvers' fixed costs
+  exceed the whole dense work;
+- larger: MKL PARDISO (matrix type 11, real non-symmetric) called through ctypes, phase 11
+  (METIS ordering, symbolic factorization) once for each sparsity pattern, then phase 22
+  (numerical factorization) for each K and phase 33 for each solve.  pypardiso, which
+  installs MKL, redoes phase 11 on every factorization, and its import scans site-packages
+  (0.1 to 0.5 s): only the library it brings is used here, found when first needed;
+- without MKL (not x86-64): SciPy's SuperLU with the column ordering minimum degree on
+  K^T K (MMD_ATA), computed once per pattern and then given as the natural order of the
+  permuted K.  A column ordering bounds the fill whatever rows partial pivoting picks;
+  minimum degree on K^T + K assumes diagonal pivots and on some tangents the fill grew 3x
+  (Q4) to 12x (SFR) (benchmarks/README.md).
 
-Only the latest factorization can be used: PARDISO keeps one in a shared solver object (a
-new one costs 0.1 s to find the MKL library), and factorize() replaces it.
+PARDISO does not fail on a zero pivot: it replaces pivots below 1e-13 |K| and counts them
+(iparm[13]).  Such a K is singular: it goes to SuperLU, which raises on an exact zero pivot
+or answers (b in the range of K: an unloaded rigid mode, harmless), as dense LU does.
+
+Only the latest factorization of each thread can be used: factorize() replaces it, and a
+solve function of an earlier one raises.  Each thread keeps its own solver state.
 """
 
 from __future__ import annotations
 
+import ctypes
+import glob
+import os
+import sys
+import threading
+from typing import Callable
+
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
-try:  # optional: MKL PARDISO (pip install pypardiso; x86-64 Linux / Windows)
-    import pypardiso as _pypardiso
-except ImportError:  # pragma: no cover - depends on the platform
-    _pypardiso = None
+DENSE_MAX = 150  # largest n factorized as a dense matrix
+PARALLEL_MIN = 2000  # smallest n that PARDISO factorizes with MKL's threads (smaller: one thread)
 
-_PARDISO = None  # one solver object: making one looks for libmkl_rt, about 0.1 s
+Solve = Callable[[np.ndarray], np.ndarray]
 
 
 class SingularTangentError(RuntimeError):
@@ -39,48 +52,223 @@ def _check(x: np.ndarray) -> np.ndarray:
     return x
 
 
-def _factorize_pardiso(K: sp.csr_matrix):
-    global _PARDISO
-    if _PARDISO is None:
-        _PARDISO = _pypardiso.PyPardisoSolver(mtype=11)  # real, non-symmetric
-    s = _PARDISO
-    K = sp.csr_matrix(K, copy=True)
-    K.sort_indices()
-    s._axiform_token = None  # earlier solve functions are no longer valid
-    try:
-        s.factorize(K)
-    except (_pypardiso.pardiso_wrapper.PyPardisoError, ValueError) as exc:  # ValueError: an empty row
-        raise SingularTangentError(str(exc)) from exc
+# ---- MKL PARDISO ------------------------------------------------------------------------
+_MKL: ctypes.CDLL | None | bool = False  # False: not looked for yet; None: not found
+
+
+def _mkl() -> ctypes.CDLL | None:
+    """MKL's runtime library (libmkl_rt), looked for once: $PYPARDISO_MKL_RT, the library
+    folder of this Python's prefix (where the mkl wheel installs it), the linker's path."""
+    global _MKL
+    if _MKL is not False:
+        return _MKL
+    candidates = [os.environ.get("PYPARDISO_MKL_RT")]
+    for prefix in dict.fromkeys((sys.prefix, sys.base_prefix)):
+        candidates += sorted(glob.glob(os.path.join(prefix, "lib", "libmkl_rt.so*")), key=len)
+        candidates += sorted(glob.glob(os.path.join(prefix, "Library", "bin", "mkl_rt*.dll")), key=len)
+    import ctypes.util
+
+    candidates += [ctypes.util.find_library("mkl_rt"), ctypes.util.find_library("mkl_rt.1")]
+    # MKL's OpenMP threads otherwise spin 200 ms after each factorization, on the core that
+    # the evaluation between two factorizations needs (on a loaded machine the plate's solve
+    # took twice as long); read when the runtime starts, so set before the library loads
+    os.environ.setdefault("KMP_BLOCKTIME", "0")
+    _MKL = None
+    for path in filter(None, candidates):
+        try:
+            lib = ctypes.CDLL(path)
+            lib.pardiso.restype = None
+            lib.MKL_Set_Num_Threads_Local.restype = ctypes.c_int
+            lib.MKL_Set_Num_Threads_Local.argtypes = [ctypes.c_int]
+            _MKL = lib
+            break
+        except (OSError, AttributeError):
+            continue
+    return _MKL
+
+
+def _address(a: np.ndarray) -> tuple[int, int]:
+    return a.__array_interface__["data"][0], a.size
+
+
+_i32p = ctypes.POINTER(ctypes.c_int32)
+_f64p = ctypes.POINTER(ctypes.c_double)
+
+
+class _Pardiso:
+    """One PARDISO handle (real non-symmetric, zero-based CSR): analyse() once per pattern,
+    factor() per matrix, solve() per right-hand side block.  Below PARALLEL_MIN unknowns
+    every phase runs on one thread (MKL's threads gain nothing there: benchmarks/README.md
+    § 3.2); the number of threads is chosen at the analysis and kept for its phases."""
+
+    def __init__(self, lib: ctypes.CDLL):
+        self.lib = lib
+        self.pt = np.zeros(64, dtype=np.int64)
+        self.iparm = np.zeros(64, dtype=np.int32)
+        self.iparm[0] = 1  # the values below, not the defaults
+        self.iparm[1] = 2  # nested dissection (METIS)
+        self.iparm[7] = 0  # iterative refinement only where pivots were perturbed
+        self.iparm[9] = 13  # pivots below 1e-13 |K| are perturbed (and counted: iparm[13])
+        self.iparm[10] = 1  # scaling and
+        self.iparm[12] = 1  # weighted matching, for non-symmetric matrices
+        self.iparm[34] = 1  # zero-based indices
+        self.n = 0
+        self.threads = 0  # 0: MKL's own setting
+        self.indptr = self.indices = None
+        self.token: object | None = None
+
+    def _call(self, phase: int, data, b=None, x=None, nrhs: int = 1) -> int:
+        if self.threads:
+            before = self.lib.MKL_Set_Num_Threads_Local(self.threads)  # this thread only
+            try:
+                return self._pardiso(phase, data, b, x, nrhs)
+            finally:
+                self.lib.MKL_Set_Num_Threads_Local(before)
+        return self._pardiso(phase, data, b, x, nrhs)
+
+    def _pardiso(self, phase: int, data, b, x, nrhs: int) -> int:
+        error = ctypes.c_int32(0)
+        one = ctypes.c_int32(1)
+        dummy = np.zeros(1)
+        self.lib.pardiso(
+            self.pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)), ctypes.byref(one), ctypes.byref(one),
+            ctypes.byref(ctypes.c_int32(11)), ctypes.byref(ctypes.c_int32(phase)), ctypes.byref(ctypes.c_int32(self.n)),
+            data.ctypes.data_as(_f64p), self.indptr.ctypes.data_as(_i32p), self.indices.ctypes.data_as(_i32p),
+            None, ctypes.byref(ctypes.c_int32(nrhs)), self.iparm.ctypes.data_as(_i32p),
+            ctypes.byref(ctypes.c_int32(0)),
+            (dummy if b is None else b).ctypes.data_as(_f64p), (dummy if x is None else x).ctypes.data_as(_f64p),
+            ctypes.byref(error))
+        return error.value
+
+    def same_pattern(self, K: sp.csr_matrix) -> bool:
+        if self.indptr is None or K.shape[0] != self.n:
+            return False
+        if _address(K.indices) == _address(self._src_indices) and _address(K.indptr) == _address(self._src_indptr):
+            return True  # the arrays of the analysed matrix (kept alive here), not a copy
+        return np.array_equal(K.indptr, self.indptr) and np.array_equal(K.indices, self.indices)
+
+    def analyse(self, K: sp.csr_matrix) -> None:
+        """Phase 11: ordering and symbolic factorization of K's pattern."""
+        self.release()
+        self.n = K.shape[0]
+        self.threads = 1 if self.n < PARALLEL_MIN else 0
+        self._src_indptr, self._src_indices = K.indptr, K.indices
+        self.indptr = np.ascontiguousarray(K.indptr, dtype=np.int32)
+        self.indices = np.ascontiguousarray(K.indices, dtype=np.int32)
+        error = self._call(11, np.ascontiguousarray(K.data, dtype=float))
+        if error:
+            self.indptr = None
+            raise SingularTangentError(f"PARDISO analysis failed (error {error})")
+
+    def factor(self, data: np.ndarray) -> None:
+        """Phase 22: numerical factorization of the values data (in the analysed pattern)."""
+        self.token = None
+        error = self._call(22, data)
+        if error:
+            raise SingularTangentError(f"PARDISO factorization failed (error {error})")
+
+    def solve(self, data: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """Phase 33: K^-1 b for b (n,) or (n, k)."""
+        bf = np.asfortranarray(b, dtype=float)
+        x = np.empty_like(bf)
+        error = self._call(33, data, bf, x, 1 if b.ndim == 1 else b.shape[1])
+        if error:
+            raise SingularTangentError(f"PARDISO solve failed (error {error})")
+        return np.ascontiguousarray(x)
+
+    def release(self) -> None:
+        """Phase -1: free PARDISO's memory of this handle."""
+        if self.indptr is not None:
+            self._call(-1, np.zeros(1))
+            self.indptr = None
+        self.token = None
+
+
+# ---- per-thread state --------------------------------------------------------------------
+class _State(threading.local):
+    pardiso: _Pardiso | None = None
+    superlu_pattern: tuple | None = None  # (indptr, indices, perm_c) of the last SuperLU ordering
+
+
+_STATE = _State()
+
+
+def _factorize_pardiso(K: sp.csr_matrix, lib: ctypes.CDLL) -> Solve:
+    s = _STATE.pardiso
+    if s is None:
+        s = _STATE.pardiso = _Pardiso(lib)
+    if not s.same_pattern(K):
+        s.analyse(K)
+    data = np.ascontiguousarray(K.data, dtype=float)
+    s.factor(data)
     if s.iparm[13] > 0:
-        # PARDISO does not fail on a zero pivot: it replaces pivots below 1e-13 |K| and
-        # counts them.  K is singular: let SuperLU raise (an exact zero pivot) or answer, as
-        # it did before (b in the range of K: an unloaded rigid mode, harmless)
         return _factorize_superlu(K)
-    token = object()
-    s._axiform_token = token
+    token = s.token = object()
 
     def solve(b: np.ndarray) -> np.ndarray:
-        if getattr(s, "_axiform_token", None) is not token:
+        if s.token is not token:
             raise RuntimeError("this factorization was replaced by a later factorize() call")
-        try:
-            x = s.solve(K, np.asarray(b, dtype=float))
-        except _pypardiso.pardiso_wrapper.PyPardisoError as exc:
-            raise SingularTangentError(str(exc)) from exc
+        return _check(s.solve(data, np.asarray(b, dtype=float)))
+
+    return solve
+
+
+def _factorize_superlu(K: sp.csr_matrix) -> Solve:
+    """SuperLU with the MMD_ATA column ordering of the last matrix of the same pattern."""
+    from scipy.sparse.linalg import splu
+
+    A = K.tocsc()
+    A.sort_indices()
+    held = _STATE.superlu_pattern
+    try:
+        if held is not None and np.array_equal(held[0], A.indptr) and np.array_equal(held[1], A.indices):
+            order = held[2]  # the columns in the order of the first factorization
+            lu = splu(A[:, order], permc_spec="NATURAL")
+
+            def solve(b: np.ndarray) -> np.ndarray:
+                y = lu.solve(b)
+                x = np.empty_like(y)
+                x[order] = y
+                return _check(x)
+
+            return solve
+        lu = splu(A, permc_spec="MMD_ATA")
+    except RuntimeError as exc:  # "Factor is exactly singular"
+        raise SingularTangentError(str(exc)) from exc
+    order = np.empty_like(lu.perm_c)
+    order[lu.perm_c] = np.arange(lu.perm_c.size)
+    _STATE.superlu_pattern = (A.indptr.copy(), A.indices.copy(), order)
+    return lambda b: _check(lu.solve(b))
+
+
+def _factorize_dense(K: sp.spmatrix) -> Solve:
+    """LAPACK getrf / getrs, called directly (scipy.linalg.lu_solve's wrapper keeps a few
+    objects per call)."""
+    from scipy.linalg.lapack import dgetrf, dgetrs
+
+    lu, piv, info = dgetrf(K.toarray(), overwrite_a=True)
+    if info > 0:
+        raise SingularTangentError("the tangent is singular (a zero pivot)")
+
+    def solve(b: np.ndarray) -> np.ndarray:
+        x, info = dgetrs(lu, piv, np.asarray(b, dtype=float))
         return _check(x)
 
     return solve
 
 
-def _factorize_superlu(K: sp.csr_matrix):
-    try:
-        lu = splu(K.tocsc(), permc_spec="MMD_ATA")
-    except RuntimeError as exc:  # "Factor is exactly singular"
-        raise SingularTangentError(str(exc)) from exc
-    return lambda b: _check(lu.solve(b))
-
-
-def factorize(K: sp.csr_matrix):
-    """A function b -> K^-1 b for one or several right-hand sides."""
-    if _pypardiso is not None:
-        return _factorize_pardiso(K)
+def factorize(K: sp.spmatrix) -> Solve:
+    """A function b -> K^-1 b for b (n,) or several right-hand sides (n, k)."""
+    n = K.shape[0]
+    if n <= DENSE_MAX:
+        return _factorize_dense(K)
+    if K.format != "csr":
+        K = K.tocsr()
+    if not K.has_sorted_indices:
+        K = K.sorted_indices()
+    if np.any(np.diff(K.indptr) == 0):
+        raise SingularTangentError("the tangent has an empty row")
+    lib = _mkl()
+    if lib is not None:
+        return _factorize_pardiso(K, lib)
     return _factorize_superlu(K)

@@ -29,6 +29,7 @@ import numpy as np
 
 from .assembly import SolidAssembly
 from .materials import deformation_gradient
+from .materials.kinematics import from_rows, to_rows
 
 PRESSURE_SPACES = ("p0", "p1")
 
@@ -47,26 +48,32 @@ def pressure_basis(space: str, Xq: np.ndarray, dV: np.ndarray) -> np.ndarray:
     return np.concatenate([np.ones((e, q, 1)), d], axis=2)
 
 
-def volumetric_derivatives(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """J = det F and dJ = dJ/dF (..., 5) for x = (F_rR, F_rZ, F_zR, F_zZ, F_tT)."""
-    a, b, c, d, f = (x[..., i] for i in range(5))
+def volumetric_rows(xt: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """J = det F (n,) and dJ = dJ/dF (5, n) at x rows xt (5, n) = (F_rR, F_rZ, F_zR, F_zZ, F_tT)."""
+    a, b, c, d, f = xt
     j2 = a * d - b * c
-    dJ = np.stack([f * d, -f * c, -f * b, f * a, j2], axis=-1)
+    dJ = np.empty_like(xt)
+    dJ[0], dJ[1], dJ[2], dJ[3], dJ[4] = f * d, -f * c, -f * b, f * a, j2
     return f * j2, dJ
 
 
-def add_pressure_hessian(A: np.ndarray, x: np.ndarray, p: np.ndarray) -> None:
-    """A += p d2J/dF2 in place (..., 5, 5): J = f (a d - b c) is quadratic in each pair."""
-    a, b, c, d, f = (x[..., i] for i in range(5))
+def add_pressure_hessian(A: np.ndarray, xt: np.ndarray, p: np.ndarray) -> None:
+    """A += p d2J/dF2 in place on rows A (5, 5, n), xt (5, n), p (n,): J = f (a d - b c) is
+    quadratic in each pair."""
+    a, b, c, d, f = xt
     pf = p * f
-    A[..., 0, 3] += pf
-    A[..., 3, 0] += pf
-    A[..., 1, 2] -= pf
-    A[..., 2, 1] -= pf
-    for i, v in ((0, d), (1, -c), (2, -b), (3, a)):
+    A[0, 3] += pf
+    A[3, 0] += pf
+    A[1, 2] -= pf
+    A[2, 1] -= pf
+    for i, v in ((0, d), (3, a)):
         pv = p * v
-        A[..., 4, i] += pv
-        A[..., i, 4] += pv
+        A[4, i] += pv
+        A[i, 4] += pv
+    for i, v in ((1, c), (2, b)):
+        pv = p * v
+        A[4, i] -= pv
+        A[i, 4] -= pv
 
 
 class MixedAssembly(SolidAssembly):
@@ -88,25 +95,31 @@ class MixedAssembly(SolidAssembly):
         M = np.einsum("eqi,eqj->eij", NpdV, self.Np)
         self.Minv = np.linalg.inv(M)  # (e, np, np)
         self.NpdV = NpdV
+        self._NpdV_T = np.ascontiguousarray(NpdV.transpose(0, 2, 1))  # (e, np, q)
 
-    def _pressure(self, x: np.ndarray, sl: slice):
-        J, dJ = volumetric_derivatives(x)
-        h = np.einsum("eqi,eq->ei", self.NpdV[sl], J)
-        Jhat = np.einsum("eij,ej->ei", self.Minv[sl], h)
-        Jbar = np.einsum("eqi,ei->eq", self.Np[sl], Jhat)
-        return self.material.kappa * (Jbar - 1.0), dJ
+    def _pressure(self, xt: np.ndarray, sl: slice) -> tuple[np.ndarray, np.ndarray]:
+        """p = kappa (J_bar - 1) (n,) and dJ (5, n) at the rows xt (5, n) of the elements sl."""
+        J, dJ = volumetric_rows(xt)
+        m, q = self.Np[sl].shape[:2]
+        h = np.matmul(self._NpdV_T[sl], J.reshape(m, q, 1))  # int N_p J dV (m, np, 1)
+        Jbar = np.matmul(self.Np[sl], np.matmul(self.Minv[sl], h))  # (m, q, 1)
+        return self.material.kappa * (Jbar.reshape(-1) - 1.0), dJ
 
     def stress(self, x: np.ndarray, sl: slice = slice(None)) -> np.ndarray:
         """P = P_iso + p dJ/dF (e, q, 5) with the element pressure p."""
-        p, dJ = self._pressure(x, sl)
-        P_iso, _ = self.material.iso_stress_tangent(x)
-        return P_iso + p[..., None] * dJ
+        xt, shape = to_rows(x)
+        p, dJ = self._pressure(xt, sl)
+        P = self.material._rows(xt, 0.0, False)[0]
+        P += p * dJ
+        return from_rows(P, None, shape)[0]
 
-    def evaluate(self, u_full: np.ndarray, tangent: bool = True):
-        """Element internal forces fe (e, nd) and, if asked, element tangents Ke (e, nd, nd)."""
+    def evaluate(self, u_full: np.ndarray, tangent: bool = True, out: tuple | None = None):
+        """Element internal forces fe (e, nd) and, if asked, element tangents Ke (e, nd, nd),
+        written into out = (fe, Ke) when given (from `buffers`) and returned.  The law's
+        isochoric part (`_rows` with kappa = 0) and the pressure terms are computed on the
+        contiguous component rows (5, n), then brought to (m, q, 5, 5) once."""
         e, q, _, nd = self.G.shape
-        fe = np.empty((e, nd))
-        Ke = np.empty((e, nd, nd)) if tangent else None
+        fe, Ke = out if out is not None else self.buffers(tangent)
         kappa = self.material.kappa
         for start in range(0, e, self.chunk):
             sl = slice(start, min(start + self.chunk, e))
@@ -114,17 +127,21 @@ class MixedAssembly(SolidAssembly):
             ue = u_full[self.dofs[sl]]
             x = deformation_gradient(np.matmul(self._G2[sl], ue[:, :, None]).reshape(m, q, 5))
             self.check_inverted(x, start)
-            p, dJ = self._pressure(x, sl)
-            P, A = self.material.iso_stress_tangent(x)
-            P += p[..., None] * dJ
+            xt, shape = to_rows(x)
+            p, dJ = self._pressure(xt, sl)
+            P, A = self.material._rows(xt, 0.0, tangent)
+            P += p * dJ
+            if tangent:
+                add_pressure_hessian(A, xt, p)
+            P, A = from_rows(P, A, shape)
             GdV_T = self._GdV[sl].transpose(0, 2, 1)
             np.matmul(GdV_T, P.reshape(m, q * 5, 1), out=fe[sl, :, None])
             if tangent:
-                add_pressure_hessian(A, x, p)
                 AG = np.matmul(A, self.G[sl]).reshape(m, q * 5, nd)
                 np.matmul(GdV_T, AG, out=Ke[sl])
-                # B = int N_p dJ^T G dV (m, np, nd); K += kappa B^T M^-1 B
-                dJG = np.matmul(dJ[:, :, None, :], self.G[sl])[:, :, 0, :]  # (m, q, nd)
-                B = np.einsum("eqi,eqn->ein", self.NpdV[sl], dJG)
-                Ke[sl] += kappa * np.matmul(B.transpose(0, 2, 1), np.matmul(self.Minv[sl], B))
+                # B = int N_p dJ^T G dV (m, np, nd) as one product with the stacked G (m, 5q, nd);
+                # K += kappa B^T M^-1 B
+                W = self._NpdV_T[sl][:, :, :, None] * dJ.T.reshape(m, 1, q, 5)  # (m, np, q, 5)
+                B = np.matmul(W.reshape(m, -1, q * 5), self._G2[sl])
+                Ke[sl] += np.matmul(B.transpose(0, 2, 1), kappa * np.matmul(self.Minv[sl], B))
         return fe, Ke

@@ -7,16 +7,17 @@ of the follower pressure, so it is not symmetric.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Iterable, Sequence
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from .assembly import SolidAssembly
 from .constraints import DofMap, SparsePattern
 from .cavity import Cavity
 from .curves import PROPORTIONAL, Curve
+from .graphs import connected_components
 from .loads import FollowerPressure
 from .mixed import MixedAssembly
 from .mesh import Mesh
@@ -35,8 +36,7 @@ class Evaluation:
     applied external load at t (full vector), and the
     norm of the assembled magnitudes of the element forces (the scale against which the
     residual is small: it does not cancel where large stresses balance), and the round-off
-    level of the residual, eps ||K||_inf ||u||: the residual of u rounded to double precision,
-    below which no Newton iteration can go (thin walls with a large kappa reach it)."""
+    level of the residual `noise` (computed when asked)."""
 
     r: np.ndarray
     dr_dlam: np.ndarray
@@ -44,14 +44,26 @@ class Evaluation:
     r_full: np.ndarray
     f_ext_full: np.ndarray
     force_scale: float
-    noise: float = 0.0
+    noise_floor: float = 0.0  # the model's own round-off floor (Model.finalize)
     nf: int | None = None  # force equations first in r; the rest are cavity constraints
     constraint_error: float = 0.0  # max |C| of the cavity constraints, relative to V0 (or p V0)
+    u_norm: float = 0.0  # ||u|| of the state (all dofs)
 
     @property
     def force_norm(self) -> float:
         """||R|| over the force equations (the constraints are measured apart)."""
         return float(np.linalg.norm(self.r[: self.nf]))
+
+    @cached_property
+    def noise(self) -> float:
+        """The round-off level of the residual, eps ||K||_inf ||u||: the residual of u rounded
+        to double precision, below which no Newton iteration can go (thin walls with a large
+        kappa reach it); at least noise_floor."""
+        K = self.K
+        if K is None or not K.nnz:
+            return self.noise_floor
+        rows = np.add.reduceat(np.abs(K.data), K.indptr[:-1][np.diff(K.indptr) > 0])
+        return max(self.noise_floor, float(np.finfo(float).eps * rows.max() * self.u_norm))
 
 
 @dataclass
@@ -190,6 +202,7 @@ class Model:
         self.pattern = SparsePattern(self.dofmap, [self.solid.dofs] + [p.dofs for p in self.pressures]
                                      + [c.dofs for c in self.cavities])
         self._solid_pos = self.pattern.positions(self.solid.dofs)
+        self._buffers = [None, None]  # the solid's (fe, Ke) held between evaluations, without / with K
         self._pressure_pos = [self.pattern.positions(p.dofs) for p in self.pressures]
         self._cavity_pos = [self.pattern.positions(c.dofs) for c in self.cavities]
         self._contact_dofs = [c.dofs(self.dpn) for c in self.contacts]
@@ -293,7 +306,10 @@ class Model:
         nf = dm.nf
         presc, dpresc = self.prescribed(t)
         u = dm.expand(u_f, presc)
-        fe, Ke = self.solid.evaluate(u, tangent)
+        k = 1 if tangent else 0
+        if self._buffers[k] is None:
+            self._buffers[k] = self.solid.buffers(tangent)
+        fe, Ke = self.solid.evaluate(u, tangent, self._buffers[k])  # consumed below, refilled next call
         f_int = np.bincount(self.solid.dofs.ravel(), weights=fe.ravel(), minlength=self.n_full)
         f_abs = np.bincount(self.solid.dofs.ravel(), weights=np.abs(fe).ravel(), minlength=self.n_full)
         f_ext, df_ext, dfext = self.external_load(u, t, tangent)
@@ -342,9 +358,9 @@ class Model:
                 data = self.pattern.accumulate(pos, Hc, data)
             for pos, pair in zip(self._contact_edge_pos, self.contacts):
                 data = self.pattern.accumulate(pos, -pair.coupling, data)  # through the current areas
-            K, K_fp = self.pattern.blocks(data)
-            if dm.np:
-                dr_dt = dr_dt + K_fp @ dpresc
+            K = self.pattern.free_block(data)
+            if dm.np and dpresc.any():
+                dr_dt = dr_dt + self.pattern.fp_product(data, dpresc)
         r = r_eq[:nf]
         if constraints:
             # bordered system [[K, -G], [dC/du, dC/dp]] for the unknown cavity pressures
@@ -363,8 +379,5 @@ class Model:
         else:
             constraint_error = 0.0
         scale = float(np.linalg.norm(f_abs) + np.linalg.norm(f_ext))
-        noise = self._noise_floor
-        if K is not None and K.nnz:
-            row_sums = np.add.reduceat(np.abs(K.data), K.indptr[:-1][np.diff(K.indptr) > 0])
-            noise = max(noise, float(np.finfo(float).eps * row_sums.max() * np.linalg.norm(u)))
-        return Evaluation(r, dr_dt, K, r_full, f_ext, scale, noise, nf, constraint_error)
+        return Evaluation(r, dr_dt, K, r_full, f_ext, scale, self._noise_floor, nf, constraint_error,
+                          float(np.linalg.norm(u)))

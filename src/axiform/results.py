@@ -220,8 +220,6 @@ class ResultsWriter:
 
     def _write_fields(self, step):
         """Field output of one step: VTU (+ .pvd), GiD results, thickness.csv."""
-        import meshio
-
         mesh = self.model.mesh
         self._last_written = step.number
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
@@ -242,6 +240,8 @@ class ResultsWriter:
                 gid.append_results(tmp, step.number, data)
         if not self.vtu:
             return
+        import meshio  # here: 0.1 s to import, for VTU files only
+
         cell_type = "quad8" if mesh.element.nodes == 8 else "quad"
         pts = np.column_stack([mesh.points, np.zeros(mesh.n_nodes)])
         name = f"step_{step.number:04d}.vtu"

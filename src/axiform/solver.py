@@ -70,7 +70,11 @@ class NewtonOptions:
 
 @dataclass
 class Step:
-    """A converged step: number, load factor, Newton iterations and the residual norms."""
+    """A converged step: number, load factor lambda, Newton iterations, the residual norms,
+    the unknowns u_f (n_free,), the displacements u (n_full,) and the residual at every dof
+    r_full (n_full,): the reactions at the supported dofs.  What the results need, and no
+    more: neither the tangent nor the Evaluation is kept, so that memory does not grow with
+    the steps by more than these vectors."""
 
     number: int
     lam: float
@@ -78,17 +82,21 @@ class Step:
     residuals: list[float]
     u_f: np.ndarray
     u: np.ndarray
-    evaluation: Evaluation
+    r_full: np.ndarray  # the residual, reactions at the supports (full vector)
     checkpoint: dict | None = None  # the whole state after this step, to resume from (restart)
 
 
 @dataclass
 class SolveResult:
-    status: str  # "finished" | "stopped"
+    """status "finished" | "stopped"; steps: the converged steps kept (all, or the latest
+    `keep` of them); n_steps: how many converged."""
+
+    status: str
     steps: list[Step] = field(default_factory=list)
     newton_iterations: int = 0
     message: str = ""
     wall_time_s: float = 0.0
+    n_steps: int = 0
 
     @property
     def last(self) -> Step | None:
@@ -113,12 +121,14 @@ def _force_floor(model: Model) -> float:
 
 def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthControl,
           options: NewtonOptions | None = None,
-          on_step: Callable[[Step], None] | None = None, resume: dict | None = None) -> SolveResult:
+          on_step: Callable[[Step], None] | None = None, keep: int | None = None,
+          resume: dict | None = None) -> SolveResult:
     """Run the load stepping to the end or until the step would fall below the minimum.
     Every converged step is handed to on_step as it comes, with its `checkpoint`: the whole
-    state after it (path, step size, counts, contact and cavity history).  `resume`: such a
-    checkpoint to continue from; the steps then go on with the same numbers and sizes as in an
-    uninterrupted run."""
+    state after it (path, step size, counts, contact and cavity history).  The result keeps
+    all steps, or only the latest `keep` (memory flat in the number of steps: a writer that
+    takes each step as it comes needs keep=1).  `resume`: a checkpoint to continue from; the
+    steps then go on with the same numbers and sizes as in an uninterrupted run."""
     opts = options or NewtonOptions()
     if model.dofmap is None:
         model.finalize()
@@ -147,7 +157,7 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
             size = trial / 2.0
             if abs(size) < opts.min_step * abs(nominal):
                 result.status = "stopped"
-                result.message = f"step {first + len(result.steps)}: no convergence with the step cut below the minimum ({exc})"
+                result.message = f"step {first + result.n_steps}: no convergence with the step cut below the minimum ({exc})"
                 result.message += path.diagnosis()
                 break
             continue
@@ -156,14 +166,18 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
         result.newton_iterations += its
         if its <= opts.easy_iterations:
             size = min(size * opts.growth, nominal, key=abs)
-        number = first + len(result.steps)
+        result.n_steps += 1
+        number = first + result.n_steps - 1
         checkpoint = {"path": path.state(), "model": model.state(), "size": size, "step": number,
                       "newton_iterations": result.newton_iterations}
-        step = Step(number, lam_new, its, res, u_new, model.expand(u_new, lam_new), ev, checkpoint)
+        step = Step(number, lam_new, its, res, u_new, model.expand(u_new, lam_new), ev.r_full, checkpoint)
+        del ev  # the tangent goes now, not at the next step
         result.steps.append(step)
+        if keep is not None and len(result.steps) > keep:
+            del result.steps[0]
         if on_step:
             on_step(step)
-        if len(result.steps) >= path.max_steps and not path.done():
+        if first - 1 + result.n_steps >= path.max_steps and not path.done():
             result.status = "stopped"
             result.message = f"the end was not reached in {path.max_steps} steps"
             break
@@ -427,7 +441,8 @@ def _check(ev: Evaluation, lam: float, opts: NewtonOptions, floor: float, residu
     ref = _reference_force(ev, lam, floor)
     if norm > 1e10 * ref:
         raise StepFailed("Newton diverges")
-    return norm <= max(opts.tolerance * ref, ev.noise) and ev.constraint_error <= opts.tolerance
+    # the round-off level (a row sum over K) is computed only where the tolerance is not met
+    return (norm <= opts.tolerance * ref or norm <= ev.noise) and ev.constraint_error <= opts.tolerance
 
 
 def _evaluate(model: Model, u_f, lam) -> Evaluation:

@@ -14,8 +14,6 @@ from pathlib import Path
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial import cKDTree
 
 from .surfaces import Polyline
 
@@ -168,6 +166,9 @@ def _extent_points(entity):
 
 def _chain(pieces: list[Piece], tol: float, reverse: bool, motion) -> Polyline:
     """Join the pieces end to end into one path (see read_dxf)."""
+    from scipy.sparse.csgraph import connected_components  # imported when needed (0.3 s with cKDTree)
+    from scipy.spatial import cKDTree
+
     n = len(pieces)
     ends = np.array([[p.a, p.b] for p in pieces]).reshape(-1, 2)  # end 2k: start of k, 2k+1: its end
     pairs = np.array(sorted(cKDTree(ends).query_pairs(tol)), dtype=np.int64).reshape(-1, 2)

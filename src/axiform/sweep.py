@@ -1,0 +1,349 @@
+"""`axiform sweep SWEEP.toml --out DIR [--scheduler ADDRESS] [--workers N]`: many variants
+of one case on a Dask cluster (DESIGN § 10.8).
+
+    case = "plate.toml"                 # relative to SWEEP.toml
+    [vary]                              # full factorial over the listed values of case keys
+    "material.C1" = [60.0, 80.0, 100.0]
+    "solver.target" = [6.0, 8.0]
+    # or, instead of [vary]: [[cases]] tables of { key = value } overrides, one case each
+    [report]
+    monitor = "w_center"                # plotted against the varied keys (default: the first monitor)
+
+Case k (k = 1, 2, ...; the last key of [vary] varies fastest) runs in DIR/cases/NNNN/
+(NNNN = k, four digits) through the same code as `axiform run CASE --set KEY=VALUE ... --out
+DIR/cases/NNNN`: a normal results folder.  DIR/sweep.csv has one row per case (case, the
+varied keys, status, exit_code, steps, wall_time_s, message, the last value of every
+monitor), rewritten as cases finish; DIR/sweep.png plots the report monitor against the
+varied keys.  A case that fails or stops keeps its row; a second run of the same command
+skips the cases whose summary.json says "finished" for the same case text (resume).
+
+Dask distributed runs the cases: a LocalCluster of N single-threaded worker processes
+(default: the cores), or the scheduler at --scheduler (its workers need axiform and the
+folders, by a shared file system).  Exit 0 when every case finished, 1 when some did not,
+2 for an invalid sweep file (refused before any work).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import itertools
+import json
+import math
+import os
+import sys
+import time
+import tomllib
+from contextlib import redirect_stderr
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .case import CaseError, fingerprint, parse, read
+
+SWEEP_KEYS = ("case", "vary", "cases", "report")
+FIXED_COLUMNS = ("status", "exit_code", "steps", "wall_time_s", "message")
+# one math library thread per worker: the workers already fill the cores
+WORKER_ENV = {v: "1" for v in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")}
+
+
+def toml_value(value: Any) -> str:
+    """A value (as tomllib reads it) written back as TOML text, for KEY=VALUE overrides."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return repr(value) if math.isfinite(value) else {math.inf: "inf", -math.inf: "-inf"}.get(value, "nan")
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, list):
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{json.dumps(k)} = {toml_value(v)}" for k, v in value.items()) + " }"
+    raise TypeError(f"not a TOML value: {value!r}")
+
+
+@dataclass
+class Sweep:
+    """A validated sweep: the base case file, the varied keys, one dict of overrides per case,
+    the monitor to report and the monitors of the case."""
+
+    case_file: Path
+    keys: list[str]
+    cases: list[dict[str, Any]]
+    report: str | None
+    monitors: list[str] = field(default_factory=list)
+
+    def overrides(self, k: int) -> list[str]:
+        """The --set KEY=VALUE strings of case k (0-based)."""
+        return [f"{key}={toml_value(v)}" for key, v in self.cases[k].items()]
+
+
+def load_sweep(path: str | Path) -> Sweep:
+    """Read and check a sweep file; CaseError names the key and the reason.  Every case is
+    read and validated (not built) here, before any work."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise CaseError(f"{path}: no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise CaseError(f"{path}: cannot read it ({exc})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise CaseError(f"{path}: not valid TOML ({exc})") from None
+    unknown = [k for k in data if k not in SWEEP_KEYS]
+    if unknown:
+        raise CaseError(f"{unknown[0]}: not a key of a sweep file (expected {', '.join(SWEEP_KEYS)})")
+    if not isinstance(data.get("case"), str) or not data["case"].strip():
+        raise CaseError("case: the case file (a string, relative to the sweep file) is required")
+    case_file = (path.parent / data["case"]).resolve()
+    if not case_file.is_file():
+        raise CaseError(f"case: no such file {case_file}")
+    if ("vary" in data) == ("cases" in data):
+        raise CaseError("vary / cases: give exactly one of [vary] (a full factorial) and [[cases]]")
+    if "vary" in data:
+        vary = data["vary"]
+        if not isinstance(vary, dict) or not vary:
+            raise CaseError("vary: a table of case keys, each with a list of values")
+        for key, values in vary.items():
+            if not isinstance(values, list) or not values:
+                raise CaseError(f"vary.{key}: a non-empty list of values")
+        keys = list(vary)
+        cases = [dict(zip(keys, combo)) for combo in itertools.product(*vary.values())]
+    else:
+        table = data["cases"]
+        if not isinstance(table, list) or not table or not all(isinstance(c, dict) for c in table):
+            raise CaseError("cases: an array of tables [[cases]] of { key = value } overrides")
+        cases = [dict(c) for c in table]
+        keys = list(dict.fromkeys(k for c in cases for k in c))
+    report = data.get("report", {})
+    if not isinstance(report, dict) or set(report) - {"monitor"}:
+        raise CaseError("report: a table with the key 'monitor'")
+    monitor = report.get("monitor")
+    if monitor is not None and not isinstance(monitor, str):
+        raise CaseError("report.monitor: the name of a monitor of the case")
+    monitors = None
+    where = "vary" if "vary" in data else "cases"
+    for k, case in enumerate(cases):
+        sets = [f"{key}={toml_value(v)}" for key, v in case.items()]
+        try:
+            parsed = parse(read(case_file, sets))
+        except CaseError as exc:
+            text = ", ".join(f"{key} = {toml_value(v)}" for key, v in case.items())
+            raise CaseError(f"{where}: case {k + 1} ({text}) is invalid:\n{exc}") from None
+        monitors = monitors if monitors is not None else [m.name for m in parsed.monitor]
+    if monitor is not None and monitor not in monitors:
+        raise CaseError(f"report.monitor: the case has no monitor {monitor!r} (it has: {', '.join(monitors) or 'none'})")
+    return Sweep(case_file, keys, cases, monitor if monitor is not None else (monitors[0] if monitors else None),
+                 monitors)
+
+
+def run_case(case_file: str, overrides: list[str], out: str) -> dict[str, Any]:
+    """Run one case as `axiform run CASE --set ... --out OUT -q` would (on a worker); its row
+    of sweep.csv from the exit code and OUT/summary.json."""
+    import numpy as np
+
+    from .cli import run
+    from .malloc import keep_freed_memory
+
+    keep_freed_memory()
+    t0 = time.perf_counter()
+    said = io.StringIO()
+    try:
+        with redirect_stderr(said), np.errstate(all="ignore"):  # as `axiform run`: the guards report
+            code = run(case_file, out, quiet=True, overrides=overrides)
+    except BaseException as exc:  # noqa: BLE001 - the row says what happened, the sweep goes on
+        return {"status": "failed", "exit_code": 3, "wall_time_s": time.perf_counter() - t0,
+                "message": f"{type(exc).__name__}: {exc}"}
+    row = summary_row(Path(out))
+    row["exit_code"] = code
+    if row.get("status") in (None, "running"):
+        row["status"] = "invalid" if code == 2 else "failed"
+    if not row.get("message") and code != 0:
+        row["message"] = " ".join(said.getvalue().split())
+    row.setdefault("wall_time_s", time.perf_counter() - t0)
+    return row
+
+
+def summary_row(folder: Path) -> dict[str, Any]:
+    """status, steps, wall_time_s, message and the monitors of a results folder's summary.json
+    ({} when it has none)."""
+    try:
+        s = json.loads((folder / "summary.json").read_text())
+    except (OSError, ValueError):
+        return {}
+    return {"status": s.get("status"), "steps": s.get("steps"), "wall_time_s": s.get("wall_time_s"),
+            "message": s.get("message", ""), "monitors": s.get("monitors", {}), "sha256": s.get("case", {}).get("sha256")}
+
+
+class SweepProgress:
+    """A bar rewritten in place on a terminal, else one line per finished case."""
+
+    def __init__(self, stream, total: int):
+        self.stream = stream
+        self.tty = stream.isatty()
+        self.total = total
+        self.done = self.failed = 0
+        self.t0 = time.perf_counter()
+
+    def __call__(self, name: str, row: dict, skipped: bool = False) -> None:
+        self.done += 1
+        self.failed += row.get("status") != "finished"
+        elapsed = time.perf_counter() - self.t0
+        if self.tty:
+            frac = self.done / self.total
+            bar = "#" * int(30 * frac) + "-" * (30 - int(30 * frac))
+            self.stream.write(f"\r[{bar}] {self.done}/{self.total} cases, {self.failed} not finished, "
+                              f"{elapsed:.1f} s\x1b[K")
+        else:
+            what = "skipped (finished before)" if skipped else f"{row.get('status')} (exit {row.get('exit_code')})"
+            self.stream.write(f"case {name} {what}  [{self.done}/{self.total}, {elapsed:.1f} s]"
+                              + (f": {row['message']}" if row.get("status") != "finished" and row.get("message") else "")
+                              + "\n")
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.tty:
+            self.stream.write("\n")
+
+
+def write_table(path: Path, sweep: Sweep, rows: list[dict | None]) -> None:
+    """sweep.csv: one row per case (status "pending" for those not done yet), atomically."""
+    from .results import write_atomic
+
+    text = io.StringIO()
+    w = csv.writer(text, lineterminator="\n")
+    w.writerow(["case", *sweep.keys, *FIXED_COLUMNS, *sweep.monitors])
+    for k, row in enumerate(rows):
+        row = row or {"status": "pending"}
+        values = [v if isinstance(v, str) else toml_value(v) for v in (sweep.cases[k].get(key, "") for key in sweep.keys)]
+        wall = row.get("wall_time_s")
+        monitors = row.get("monitors", {})
+        w.writerow([f"{k + 1:04d}", *values, row.get("status", ""), row.get("exit_code", ""), row.get("steps", ""),
+                    "" if wall is None else f"{wall:.3f}", " ".join(str(row.get("message", "")).split()),
+                    *[repr(monitors[m]) if m in monitors else "" for m in sweep.monitors]])
+    write_atomic(path, text.getvalue())
+
+
+def _text(value: Any) -> str:
+    """A varied value in a label; "(case)" where a [[cases]] table leaves the key to the case."""
+    return "(case)" if value is None else toml_value(value)
+
+
+def plot_sweep(path: Path, sweep: Sweep, rows: list[dict | None]) -> bool:
+    """sweep.png: the report monitor against the first key that takes several values, one
+    line for each combination of the other such keys; cases that did not finish are left out
+    (and counted)."""
+    if sweep.report is None or not sweep.keys:
+        return False
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    # keys that take one value in every case say nothing on the picture
+    varied = [k for k in sweep.keys if len({_text(c.get(k)) for c in sweep.cases}) > 1] or sweep.keys[:1]
+    first, others = varied[0], varied[1:]
+    xs = list(dict.fromkeys(_text(case.get(first)) for case in sweep.cases))  # values as text: lists too
+    values = {_text(case.get(first)): case.get(first) for case in sweep.cases}
+    numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values.values())
+    groups: dict[str, list[tuple[float, float]]] = {}
+    for case, row in zip(sweep.cases, rows):
+        if row and row.get("status") == "finished" and sweep.report in row.get("monitors", {}):
+            label = ", ".join(f"{k} = {_text(case.get(k))}" for k in others)
+            x = _text(case.get(first))
+            groups.setdefault(label, []).append((values[x] if numeric else xs.index(x), row["monitors"][sweep.report]))
+    fig = Figure(figsize=(6.4, 4.4), layout="constrained")
+    ax = fig.add_subplot()
+    for label, points in groups.items():
+        points.sort()
+        ax.plot([p[0] for p in points], [p[1] for p in points], marker="o", label=label or None)
+    if not numeric:
+        ax.set_xticks(range(len(xs)), xs)
+    finished = sum(1 for r in rows if r and r.get("status") == "finished")
+    ax.set_xlabel(first)
+    ax.set_ylabel(sweep.report)
+    ax.set_title(f"{sweep.report} against {first}: {finished} of {len(rows)} cases finished", fontsize=10)
+    ax.grid(True, alpha=0.3)
+    if others and groups:
+        ax.legend(fontsize=8)
+    from .results import atomic
+
+    with atomic(path) as tmp:
+        fig.savefig(tmp, dpi=120, format="png")
+    return True
+
+
+def _client(scheduler: str | None, workers: int | None):
+    """A Dask client: of the scheduler at the address, or of a new LocalCluster."""
+    import logging
+
+    from distributed import Client, LocalCluster
+
+    if scheduler:
+        return Client(scheduler), None
+    cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                           dashboard_address=None, silence_logs=logging.ERROR, env=WORKER_ENV)
+    return Client(cluster), cluster
+
+
+def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: int | None = None) -> int:
+    """The `axiform sweep` command; returns the exit code."""
+    say = sys.stderr
+    try:
+        sweep = load_sweep(sweep_file)
+    except CaseError as exc:
+        print(f"axiform: invalid sweep file {sweep_file}:\n{exc}", file=say)
+        return 2
+    if workers is not None and workers < 1:
+        print("axiform: invalid sweep:\n--workers: at least 1", file=say)
+        return 2
+    root = Path(out)
+    try:
+        (root / "cases").mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        print(f"axiform: invalid output folder:\n--out: cannot create {root / 'cases'} ({exc.strerror or exc})", file=say)
+        return 2
+    n = len(sweep.cases)
+    rows: list[dict | None] = [None] * n
+    folders = [root / "cases" / f"{k + 1:04d}" for k in range(n)]
+    progress = SweepProgress(say, n)
+    todo = []
+    for k in range(n):  # resume: a finished folder of the same case text is kept
+        done = summary_row(folders[k])
+        if done.get("status") == "finished" and done.get("sha256") == fingerprint(read(sweep.case_file, sweep.overrides(k))):
+            rows[k] = done | {"exit_code": 0}
+            progress(folders[k].name, rows[k], skipped=True)
+        else:
+            todo.append(k)
+    print(f"axiform sweep: {n} cases of {sweep.case_file.name}, {len(todo)} to run -> {root}", file=say)
+    write_table(root / "sweep.csv", sweep, rows)
+    if todo:
+        from distributed import as_completed
+
+        client, cluster = _client(scheduler, workers)
+        try:
+            futures = {client.submit(run_case, str(sweep.case_file), sweep.overrides(k), str(folders[k].resolve()),
+                                     key=f"axiform-case-{k + 1:04d}-{os.getpid()}-{time.time_ns()}", pure=False): k
+                       for k in todo}
+            for future in as_completed(futures):
+                k = futures[future]
+                try:
+                    rows[k] = future.result()
+                except Exception as exc:  # noqa: BLE001 - a worker died or was lost: the row says so
+                    rows[k] = {"status": "failed", "exit_code": 3, "message": f"{type(exc).__name__}: {exc}"}
+                progress(folders[k].name, rows[k])
+                write_table(root / "sweep.csv", sweep, rows)
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    progress.close()
+    try:
+        plot_sweep(root / "sweep.png", sweep, rows)
+    except Exception as exc:  # noqa: BLE001 - the cases and sweep.csv stand; say why the picture does not
+        print(f"axiform sweep: sweep.png not written ({type(exc).__name__}: {exc})", file=say)
+    bad = [f"{k + 1:04d}" for k, r in enumerate(rows) if r.get("status") != "finished"]
+    print(f"axiform sweep: {n - len(bad)} of {n} cases finished" + (f"; not finished: {', '.join(bad)}" if bad else "")
+          + f" -> {root / 'sweep.csv'}", file=say)
+    return 1 if bad else 0
+

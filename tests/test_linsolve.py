@@ -1,0 +1,124 @@
+"""axiform.linsolve: dense LAPACK, PARDISO (analysis kept per pattern) and SuperLU (ordering
+kept per pattern) give the same solutions; a new pattern is analysed anew; an old solve
+function refuses after a new factorization; threads keep their own factorizations."""
+
+import threading
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+import axiform.linsolve as ls
+from axiform import Model, MooneyRivlin, rectangle
+from axiform.mesh import edges_on_nodes
+
+
+def _tangent(element: str, divisions, seed: int = 0):
+    """K and two right-hand sides of a deformed ring with a follower pressure (non-symmetric)."""
+    mesh = rectangle((1.0, 2.0), (0.0, 1.0), divisions, element)
+    model = Model(mesh, MooneyRivlin(80.0, 20.0, 1e4), formulation="displacement")
+    model.fix(mesh.node_sets["bottom"], ["uz"])
+    left = mesh.node_sets["left"]
+    model.pressure(edges_on_nodes(mesh, left[mesh.points[left, 1] <= 0.5 + 1e-12]), 5.0)
+    model.finalize()
+    rng = np.random.default_rng(seed)
+    u_f = 0.002 * rng.standard_normal(model.n_free)
+    ev = model.evaluate(u_f, 0.5)
+    return ev.K, np.column_stack([-ev.r, -ev.dr_dlam])
+
+
+def _backend(monkeypatch, name: str):
+    monkeypatch.setattr(ls, "DENSE_MAX", 10**9 if name == "dense" else 0)
+    if name == "superlu":
+        monkeypatch.setattr(ls, "_mkl", lambda: None)
+    elif name == "pardiso" and ls._mkl() is None:
+        pytest.skip("MKL is not installed")
+
+
+@pytest.mark.parametrize("element", ["q4", "sfr", "q8"])
+def test_backends_agree(monkeypatch, element):
+    K, B = _tangent(element, (6, 5))
+    assert abs(K - K.T).max() > 1e-8 * abs(K).max()  # really non-symmetric
+    x = {}
+    for name in ("dense", "pardiso", "superlu"):
+        _backend(monkeypatch, name)
+        x[name] = ls.factorize(K)(B)
+        monkeypatch.undo()
+    ref = np.linalg.solve(K.toarray(), B)
+    for name, xi in x.items():
+        assert np.abs(xi - ref).max() <= 1e-10 * np.abs(ref).max(), name
+        assert xi.shape == B.shape
+
+
+@pytest.mark.parametrize("name", ["pardiso", "superlu"])
+def test_pattern_kept_and_renewed(monkeypatch, name):
+    _backend(monkeypatch, name)
+    K1, B = _tangent("q4", (7, 6), seed=1)
+    K2, _ = _tangent("q4", (7, 6), seed=2)  # same pattern, other values
+    K3, B3 = _tangent("sfr", (5, 5))  # another pattern
+    for K, b in ((K1, B), (K2, B), (K3, B3), (K1, B)):
+        x = ls.factorize(K)(b)
+        assert np.abs(K @ x - b).max() <= 1e-10 * np.abs(b).max()
+
+
+def test_pardiso_analysis_once_per_pattern(monkeypatch):
+    _backend(monkeypatch, "pardiso")
+    K1, B = _tangent("q4", (7, 6), seed=1)
+    K2, _ = _tangent("q4", (7, 6), seed=2)
+    calls = []
+    original = ls._Pardiso.analyse
+    monkeypatch.setattr(ls._Pardiso, "analyse", lambda self, K: calls.append(K.shape) or original(self, K))
+    if ls._STATE.pardiso is not None:  # start from no analysis
+        ls._STATE.pardiso.release()
+    for K in (K1, K2, K1, sp.csr_matrix(K2.toarray())):  # the last: a copy, equal pattern
+        ls.factorize(K)(B)
+    assert len(calls) == 1
+
+
+def test_old_factorization_refused(monkeypatch):
+    _backend(monkeypatch, "pardiso")
+    K1, B = _tangent("q4", (7, 6), seed=1)
+    K2, _ = _tangent("q4", (7, 6), seed=2)
+    first = ls.factorize(K1)
+    first(B)
+    ls.factorize(K2)
+    with pytest.raises(RuntimeError, match="replaced"):
+        first(B)
+
+
+def test_singular_dense():
+    K = sp.csr_matrix(np.array([[1.0, 2.0], [2.0, 4.0]]))
+    with pytest.raises(ls.SingularTangentError):
+        ls.factorize(K)
+
+
+def test_threads_keep_their_own(monkeypatch):
+    _backend(monkeypatch, "pardiso")
+    problems = [_tangent("q4", (8, 7), seed=s) for s in range(2)] + [_tangent("sfr", (6, 6), seed=3)]
+    errors = []
+
+    def work(K, B):
+        for _ in range(20):
+            x = ls.factorize(K)(B)
+            errors.append(np.abs(K @ x - B).max() / np.abs(B).max())
+
+    threads = [threading.Thread(target=work, args=p) for p in problems]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len(errors) == 60 and max(errors) <= 1e-10
+
+
+def test_threads_by_size(monkeypatch):
+    """Below PARALLEL_MIN unknowns PARDISO runs on one thread, above on MKL's own setting; the
+    same answer either way."""
+    _backend(monkeypatch, "pardiso")
+    K, B = _tangent("q4", (7, 6))
+    x1 = ls.factorize(K)(B)
+    assert ls._STATE.pardiso.threads == 1
+    monkeypatch.setattr(ls, "PARALLEL_MIN", 0)
+    ls._STATE.pardiso.release()
+    x0 = ls.factorize(K)(B)
+    assert ls._STATE.pardiso.threads == 0
+    assert np.abs(x1 - x0).max() <= 1e-12 * np.abs(x0).max()
