@@ -373,8 +373,10 @@ def deformed_figure(vtu: Path, info: FolderInfo, field: str = "von_mises", surfa
     _colourbar(fig, ax, norm, cmap, label, beside)
     step = int(Path(vtu).stem.split("_")[-1])
     note = "grey: initial" + (", red: moulds" if moulds else "") + (", wall drawn wider than it is" if thin else "")
-    fig.suptitle((info.title + "\n" if info.title else "") + f"{info.state(step, history or {})}  ({note})",
-                 fontsize=11)
+    state = info.state(step, history or {})
+    # a line holds about 11 characters per inch at 11 pt: a tall part's narrow figure takes the note below
+    gap = "  " if len(state) + len(note) + 4 < 11 * size[0] else "\n"
+    fig.suptitle((info.title + "\n" if info.title else "") + f"{state}{gap}({note})", fontsize=11)
     return fig
 
 
