@@ -1,0 +1,113 @@
+"""The forming-process examples (examples/bottle_blow_moulding.toml, cup_thermoforming.toml,
+stretch_blow_moulding.toml) run from their case files, on coarser meshes (`--set`) so that
+the file stays under a minute: the bottle through its whole process; the cup and the
+preform through their first stage (the plug, the stretch rod), because today each of their
+steps takes 10 to 15 Newton iterations and the whole processes take minutes (README,
+Process examples; findings/)."""
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from axiform.assembly import element_dofs
+from axiform.case import build, parse, read
+from axiform.cli import main
+from axiform.elements import gradient_operator
+from axiform.solver import LoadControl, solve
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+QUIET = ["--set", "output.plots=false", "--set", "output.vtu=false", "-q"]
+
+
+def rows(path: Path) -> list[dict[str, str]]:
+    """The rows of contact.csv or thickness.csv (the header row after any '# ...' line)."""
+    lines = [line for line in path.read_text().splitlines() if not line.startswith("#")]
+    return list(csv.DictReader(lines))
+
+
+def run_case(name: str, target: float, *sets: str):
+    """Build an example with `--set` overrides and solve it by load control to t = target."""
+    path = EXAMPLES / f"{name}.toml"
+    built = build(parse(read(path, list(sets))), path.parent)
+    control = built.control
+    assert isinstance(control, LoadControl)
+    return built.model, solve(built.model, LoadControl(target, max(1, round(control.steps * target / control.target))),
+                              built.options)
+
+
+def volume_ratio(model, u: np.ndarray) -> float:
+    """int J dV / int dV over the body: J = det F at every Gauss point from the model's own
+    gradient operator g = G u_e, F = [[1 + U,R, U,Z], [W,R, 1 + W,Z]] and F_tt = 1 + U/R."""
+    mesh = model.mesh
+    X = mesh.points[mesh.cells]
+    G, dV = gradient_operator(mesh.element, X)  # (e, q, 5, ndof_e), (e, q)
+    G = G.reshape(*G.shape[:3], -1)
+    g = np.einsum("eqij,ej->eqi", G, u[element_dofs(mesh.cells, model.dpn)])
+    J = ((1 + g[..., 0]) * (1 + g[..., 3]) - g[..., 1] * g[..., 2]) * (1 + g[..., 4])
+    return float((J * dV).sum() / dV.sum())
+
+
+def test_bottle_reaches_the_mould_nearly_everywhere(tmp_path):
+    """The parison (30 + 4 Q8 along, 1 through the wall) blown by the gas to the end of the
+    process: every slave node but the two held ones (the pinch on the axis, the neck clamp)
+    frozen on the mould; the gas law p_abs V = content at the end; the body wall thinned
+    to 0.2-0.4 of the parison while the neck stays above 0.8 of it."""
+    out = tmp_path / "bottle"
+    sets = ["--set", "mesh.layers=1", "--set", "solver.steps=40", "--set",
+            "mesh.profile=[{arc={center=[0.0,22.0],to=[15.0,22.0],divisions=4}},"
+            "{line={to=[15.0,200.0],divisions=30}}]"]
+    assert main(["run", str(EXAMPLES / "bottle_blow_moulding.toml"), "--out", str(out), *sets, *QUIET]) == 0
+    contact = rows(out / "contact.csv")
+    frozen = [r for r in contact if r["status"] == "sticky"]
+    open_ = [r for r in contact if r["status"] == "open"]
+    assert len(frozen) / len(contact) > 0.95
+    held = {(round(float(r["r"]), 9), round(float(r["z"]), 9)) for r in open_}
+    assert held == {(0.0, 5.5), (16.5, 200.0)}
+    assert all(r["first_contact"] != "" for r in frozen)
+
+    cav = json.loads((out / "summary.json").read_text())["cavities"]["bottle"]
+    assert (cav["pressure"] + 0.1) * cav["volume"] == pytest.approx(470000.0, rel=1e-6)
+    assert 0.5 < cav["pressure"] < 0.7
+    wall = rows(out / "thickness.csv")
+    z = np.array([float(r["z"]) for r in wall])
+    ratio = np.array([float(r["ratio"]) for r in wall])
+    body = (z > 30) & (z < 120)
+    assert 0.2 < ratio[body].min() and ratio[body].max() < 0.4
+    assert ratio[z > 185].min() > 0.8
+
+
+def test_cup_plug_stage_conserves_the_material_volume():
+    """The sheet (Q8 20 x 1, kappa / mu = 1210, mixed) pushed 8.6 down by the plug (t = 0.2):
+    int J dV from the model's gradient within 0.5 % of the reference volume, the plug
+    pushing the sheet down, the sheet's centre just below the plug's face."""
+    model, res = run_case("cup_thermoforming", 0.2, "mesh.divisions=[20,1]", "mesh.element=q8")
+    assert res.status == "finished"
+    u = res.last.u
+    assert abs(volume_ratio(model, u) - 1.0) < 5e-3
+    plug = model.contacts[0]
+    assert plug.report()["force_z"] < 0  # the plug pushes the sheet down
+    centre = plug.nodes[np.argmin(plug.X[:, 0])]
+    # the plug's face starts 0.5 above the sheet and moves 43 t: the sheet, drawn down by
+    # the plug's nose, hangs at its centre just below the face (within the penalty's sink)
+    face = -(43.0 * 0.2 - 0.5)
+    assert face - 1.0 < u[centre * model.dpn + 1] < face + 0.01
+
+
+def test_preform_follows_the_stretch_rod():
+    """The preform (Q8, 4 + 15 along, 1 through the wall) stretched by the rod alone
+    (t = 0.3, before the pre-blow): the inner tip on the axis 98 t - 0.25 down (the rod's
+    travel less the initial gap), the gas still at its initial content, so almost no
+    pressure."""
+    model, res = run_case("stretch_blow_moulding", 0.3, "mesh.layers=1",
+                          "mesh.profile=[{arc={center=[0.0,115.0],to=[9.0,115.0],divisions=4}},"
+                          "{line={to=[9.0,200.0],divisions=15}}]")
+    assert res.status == "finished"
+    u = res.last.u
+    tip = int(np.flatnonzero((np.abs(model.mesh.points[:, 0]) < 1e-9)
+                             & (np.abs(model.mesh.points[:, 1] - 107.75) < 1e-9))[0])
+    assert u[tip * model.dpn + 1] == pytest.approx(-(98.0 * 0.3 - 0.25), abs=0.05)
+    cavity = model.cavities[0]
+    assert abs(cavity.pressure_now) < 0.02  # the ambient gas, stretched a little
