@@ -1,7 +1,8 @@
 """Rebuild the gallery's pictures (docs/img/): run every example, draw its plots, and keep
-small palette PNGs; the forming animation of the toric plate as a GIF.
+small palette PNGs; the forming animations of the toric plate and the process examples as
+GIFs.
 
-    python docs/gallery.py          (about a minute)
+    python docs/gallery.py          (about 25 minutes: the process examples take most of it)
 """
 
 from __future__ import annotations
@@ -17,8 +18,9 @@ from axiform.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 IMG = ROOT / "docs" / "img"
-EXAMPLES = ["hughes_carnoy_plate", "thick_cylinder", "balloon", "toric_plate", "die_drawing"]
-ANIMATED = ["toric_plate"]
+EXAMPLES = ["hughes_carnoy_plate", "thick_cylinder", "balloon", "toric_plate", "die_drawing",
+            "bottle_blow_moulding", "cup_thermoforming", "stretch_blow_moulding"]
+ANIMATED = ["toric_plate", "bottle_blow_moulding", "cup_thermoforming", "stretch_blow_moulding"]
 
 
 def small_png(source: Path, target: Path) -> None:
