@@ -2,7 +2,7 @@
 small palette PNGs; the forming animations of the toric plate and the process examples as
 GIFs.
 
-    python docs/gallery.py          (about 25 minutes: the process examples take most of it)
+    python docs/gallery.py          (about two minutes)
 """
 
 from __future__ import annotations
