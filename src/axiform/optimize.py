@@ -455,7 +455,7 @@ def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResul
     ax.set_xlabel("r" + length)
     ax.set_ylabel("z" + length)
     ax.set_title("section: parison and final wall (mid-surface)")
-    ax.legend(fontsize=7, loc="best")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)  # beside the tall part
     ax = axes[0, 1]
     s_fine = np.linspace(design.knots[0], design.knots[-1], 400)
     for values, _, colour, name in runs:
