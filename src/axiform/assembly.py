@@ -51,6 +51,17 @@ class SolidAssembly:
         if bad.any():
             raise InvertedElementError(np.flatnonzero(bad) + offset)
 
+    def chunks(self, u_full: np.ndarray):
+        """The elements in chunks: (slice of the elements, their gradients x (m, q, 5)), each
+        checked for inverted quadrature points (InvertedElementError names the elements)."""
+        e, q, _, _ = self.G.shape
+        for start in range(0, e, self.chunk):
+            sl = slice(start, min(start + self.chunk, e))
+            ue = u_full[self.dofs[sl]]
+            x = deformation_gradient(np.matmul(self._G2[sl], ue[:, :, None]).reshape(sl.stop - start, q, 5))
+            self.check_inverted(x, start)
+            yield sl, x
+
     def buffers(self, tangent: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
         """Arrays fe (e, nd) and Ke (e, nd, nd) to pass as `out` to evaluate, again and again:
         a Ke allocated afresh on every call is mapped and faulted in anew by the kernel (at
@@ -63,12 +74,8 @@ class SolidAssembly:
         written into out = (fe, Ke) when given (from `buffers`) and returned."""
         e, q, _, nd = self.G.shape
         fe, Ke = out if out is not None else self.buffers(tangent)
-        for start in range(0, e, self.chunk):
-            sl = slice(start, min(start + self.chunk, e))
+        for sl, x in self.chunks(u_full):
             m = sl.stop - sl.start
-            ue = u_full[self.dofs[sl]]
-            x = deformation_gradient(np.matmul(self._G2[sl], ue[:, :, None]).reshape(m, q, 5))
-            self.check_inverted(x, start)
             GdV_T = self._GdV[sl].transpose(0, 2, 1)
             if tangent:
                 P, A = self.material.stress_tangent(x)

@@ -28,7 +28,6 @@ from __future__ import annotations
 import numpy as np
 
 from .assembly import SolidAssembly
-from .materials import deformation_gradient
 from .materials.kinematics import from_rows, to_rows
 
 PRESSURE_SPACES = ("p0", "p1")
@@ -121,12 +120,8 @@ class MixedAssembly(SolidAssembly):
         e, q, _, nd = self.G.shape
         fe, Ke = out if out is not None else self.buffers(tangent)
         kappa = self.material.kappa
-        for start in range(0, e, self.chunk):
-            sl = slice(start, min(start + self.chunk, e))
+        for sl, x in self.chunks(u_full):
             m = sl.stop - sl.start
-            ue = u_full[self.dofs[sl]]
-            x = deformation_gradient(np.matmul(self._G2[sl], ue[:, :, None]).reshape(m, q, 5))
-            self.check_inverted(x, start)
             xt, shape = to_rows(x)
             p, dJ = self._pressure(xt, sl)
             P, A = self.material._rows(xt, 0.0, tangent)
