@@ -42,3 +42,16 @@ def difference_tangent(model, u_f, lam, h):
 @pytest.fixture(params=["mixed", "displacement"])
 def formulation(request):
     return request.param
+
+
+def clamped_plate(element, formulation="mixed", divisions=(20, 2)):
+    """The paper's plate (section 4.1): R = 7.5, h = 0.5, C1 = 80, C2 = 20, kappa = 1e4, rim
+    clamped, unit follower pressure on z = 0; a finalized model."""
+    from axiform import Model, MooneyRivlin, select_edges, select_nodes
+
+    mesh = rectangle((0.0, 7.5), (0.0, 0.5), divisions, element)
+    model = Model(mesh, MooneyRivlin(80.0, 20.0, 1e4), formulation=formulation)
+    model.fix(select_nodes(mesh, {"r": 7.5}), ["ur", "uz", "rot"])
+    model.fix(select_nodes(mesh, {"r": 0.0}), ["ur"])
+    model.pressure(select_edges(mesh, {"z": 0.0}), 1.0)
+    return model.finalize()

@@ -84,15 +84,11 @@ def test_arc_length_carries_the_papers_plate_past_its_pressure_maximum(element, 
     every step (before, the path turned back at the maximum).  The mixed SFR is left out: its
     path wanders near the maximum (the centre goes back by up to 0.8 in over a few steps while
     the fibre rotations, up to 6.5 rad, carry the arc), a known limitation."""
-    from axiform import rectangle, select_edges, select_nodes
+    from axiform import select_nodes
+    from conftest import clamped_plate
 
-    mesh = rectangle((0.0, 7.5), (0.0, 0.5), (20, 2), element)
-    model = Model(mesh, MooneyRivlin(80.0, 20.0, 1e4), formulation=formulation)
-    model.fix(select_nodes(mesh, {"r": 7.5}), ["ur", "uz", "rot"])
-    model.fix(select_nodes(mesh, {"r": 0.0}), ["ur"])
-    model.pressure(select_edges(mesh, {"z": 0.0}), 1.0)
-    model.finalize()
-    w = int(model.dof(select_nodes(mesh, {"r": 0.0, "z": 0.25})[0], "uz"))
+    model = clamped_plate(element, formulation)
+    w = int(model.dof(select_nodes(model.mesh, {"r": 0.0, "z": 0.25})[0], "uz"))
     res = solve(model, ArcLengthControl(target=100.0, steps=steps, stop_dof=w, stop_value=21.0))
     assert res.status == "finished", res.message
     deflection = np.array([s.u[w] for s in res.steps])

@@ -8,7 +8,7 @@ import pytest
 from axiform import DisplacementControl, Model, MooneyRivlin, rectangle, select_edges, select_nodes, solve
 from axiform.materials import InvertedElementError
 from axiform.solver import LoadControl, NewtonOptions
-from conftest import difference_tangent, distorted_rectangle
+from conftest import clamped_plate, difference_tangent, distorted_rectangle
 
 LAW = MooneyRivlin(0.4, 0.1, 5.0)
 
@@ -106,13 +106,8 @@ def test_newton_converges_quadratically(element, formulation):
     """Large-strain inflation of the clamped plate, 1 in of centre deflection per step.  With
     e_k = r_k / r_1 the residual relative to the first iteration's, quadratic convergence means
     the number of digits doubles: log e_(k+1) / log e_k -> 2 (linear convergence gives -> 1)."""
-    mesh = rectangle((0.0, 7.5), (0.0, 0.5), (20, 2), element)
-    model = Model(mesh, MooneyRivlin(80.0, 20.0, 1e4), formulation=formulation)
-    model.fix(select_nodes(mesh, {"r": 7.5}), ["ur", "uz", "rot"])
-    model.fix(select_nodes(mesh, {"r": 0.0}), ["ur"])
-    model.pressure(select_edges(mesh, {"z": 0.0}), 1.0)
-    model.finalize()
-    c = int(model.dof(select_nodes(mesh, {"r": 0.0, "z": 0.5})[0], "uz"))
+    model = clamped_plate(element, formulation)
+    c = int(model.dof(select_nodes(model.mesh, {"r": 0.0, "z": 0.5})[0], "uz"))
     res = solve(model, DisplacementControl(c, 6.0, 6))
     assert res.status == "finished"
     assert res.last.u[c] == pytest.approx(6.0)
