@@ -9,7 +9,7 @@ from hypothesis.extra.numpy import arrays
 
 from axiform import LoadControl, Model, NeoHooke, rectangle, select_nodes, solve
 from axiform.contact import search
-from axiform.contact.pair import ContactPair
+from axiform.contact.pair import ContactPair, pole_rows
 from axiform.contact.surfaces import Circle, Polyline
 from conftest import difference_tangent, distorted_rectangle
 
@@ -81,11 +81,11 @@ def test_corner_rules():
     assert p.g[0] > 0
 
 
-def _contact_model(element, surface, **kw):
-    mesh = distorted_rectangle((0.5, 1.5), (0.0, 1.0), (3, 3), element, 0.2, seed=11)
+def _contact_model(element, surface, inner=0.5, **kw):
+    mesh = distorted_rectangle((inner, inner + 1.0), (0.0, 1.0), (3, 3), element, 0.2, seed=11)
     model = Model(mesh, NeoHooke(0.5, 5.0))
     model.fix(select_nodes(mesh, {"z": 1.0}), ["uz"])
-    model.fix(select_nodes(mesh, {"r": 0.5}), ["ur"])
+    model.fix(select_nodes(mesh, {"r": inner}), ["ur"])
     kw.setdefault("penalty", 40.0)
     pair = ContactPair(mesh, surface, select_nodes(mesh, {"z": 0.0}), **kw)
     model.contact(pair)
@@ -123,6 +123,45 @@ def test_contact_tangent_matches_difference_of_residual(element, surface, law):
     num, dl = difference_tangent(model, u_f, lam, 1e-7)
     assert np.abs(K - num).max() < 1e-6 * np.abs(K).max()
     assert np.allclose(ev.dr_dlam, dl, atol=1e-6 * np.abs(dl).max())
+
+
+@pytest.mark.parametrize("law", [{}, {"friction": 0.05}, {"sticky": True}, {"penalty": None, "modulus": 4.0}],
+                         ids=["frictionless", "slip", "sticky", "default penalty"])
+@pytest.mark.parametrize("surface", ["plane", "circle"])
+def test_contact_tangent_with_a_pole_matches_difference_of_residual(surface, law):
+    """A Q8 body from the axis: the pole's force is the consistent integral of the
+    interpolated traction (ContactPair, pole_rows), coupled to its edge's other nodes."""
+    surfaces = {"plane": Polyline(motion=(0.05, 0.1), points=[[-1.0, 0.0], [2.0, -0.02]]),
+                "circle": Circle(motion=(0.05, 0.1), center=(0.3, -3.0), radius=3.0)}
+    model, pair = _contact_model("q8", surfaces[surface], inner=0.0, **law)
+    assert pair.pole_edge.size == 1
+    model.evaluate(np.zeros(model.n_free), 0.3)
+    model.commit()
+    u_f = 0.01 * np.random.default_rng(3).standard_normal(model.n_free)
+    ev = model.evaluate(u_f, 0.5)
+    pole = pair.edges[pair.pole_edge[0], pair.pole_corner[0]]
+    assert pair.report()["status"][pole] > 0
+    K = ev.K.toarray()
+    num, dl = difference_tangent(model, u_f, 0.5, 1e-7)
+    assert np.abs(K - num).max() < 1e-6 * np.abs(K).max()
+    assert np.allclose(ev.dr_dlam, dl, atol=1e-6 * np.abs(dl).max())
+
+
+def test_pole_force_is_the_consistent_integral_of_the_traction():
+    """The pole row of M_ij = int 2 pi r N_i N_j ds on a straight Q8 edge from the axis to
+    r = R: M_00 = -M_01 = 2 pi R^2 / 60, M_02 = 0 (its sum, the pole's consistent area, 0)."""
+    R = 2.0
+    x = np.array([[0.0, 0.0], [R, 0.0], [R / 2, 0.0]])
+    M, dM = pole_rows(x, np.array([[0, 1, 2]]), np.array([0]), derivative=True)
+    assert M[0] == pytest.approx(2 * np.pi * R**2 / 60 * np.array([1.0, -1.0, 0.0]), abs=1e-12)
+    h = 1e-6
+    for l in range(3):
+        for d in range(2):
+            xp, xm = x.copy(), x.copy()
+            xp[l, d] += h
+            xm[l, d] -= h
+            num = (pole_rows(xp, np.array([[0, 1, 2]]), np.array([0])) - pole_rows(xm, np.array([[0, 1, 2]]), np.array([0]))) / (2 * h)
+            assert np.allclose(dM[0, :, l, d], num[0], atol=1e-8)
 
 
 def _block_on_plane(mu, slide):

@@ -102,7 +102,13 @@ def test_thickness_csv_columns_and_first_contact(tmp_path):
     assert lines[0].split(",")[:7] == ["s", "r", "z", "thickness", "initial_thickness", "ratio", "first_contact"]
     assert lines[1].split(",")[6] == "" and lines[2].split(",")[6] == "0.5"
     data = np.genfromtxt(tmp_path / "t.csv", delimiter=",", names=True)
-    assert data.dtype.names == COLUMNS and np.isnan(data["first_contact"][[0, 3]]).all()
+    # per piece (the index of its pair; the pair without times has none): the second piece
+    # touched station 1 at 0.75, hidden in first_contact by the first piece's 0.5
+    assert data.dtype.names == COLUMNS + ("first_contact_0", "first_contact_1")
+    assert np.allclose(data["first_contact_0"], [np.nan, 0.5, 0.25, np.nan], equal_nan=True)
+    assert np.allclose(data["first_contact_1"], [np.nan, 0.75, np.nan, np.nan], equal_nan=True)
+    one = thickness_table(mesh, np.zeros((mesh.n_nodes, 2)), pairs[:1])
+    assert list(one) == list(COLUMNS)  # one piece: first_contact alone
 
 
 def test_vtu_fields_thickness_and_first_contact():
@@ -115,8 +121,26 @@ def test_vtu_fields_thickness_and_first_contact():
     expect[pair.nodes] = np.nan_to_num(pair.first_contact, nan=-1.0)
     assert np.array_equal(fields["first_contact"], expect)
     assert np.allclose(fields["thickness"], 0.5)
+    assert "first_contact_0" not in fields  # one piece
     del pair.first_contact  # before the contact branch: no field
     assert "first_contact" not in point_fields(model, np.zeros(model.n_full))
+
+
+def test_vtu_fields_first_contact_per_piece():
+    """Two pieces (the plug and the mould of the cup): first_contact_0 and _1 per piece, -1
+    where never, and first_contact the earliest of them."""
+    built = build(load(EXAMPLES / "cup_thermoforming.toml"), EXAMPLES)
+    model = built.model
+    plug, mould = model.contacts
+    plug.first_contact = np.where(np.arange(len(plug.nodes)) % 2 == 0, 0.5, np.nan)
+    mould.first_contact = np.where(np.arange(len(mould.nodes)) % 3 == 0, 1.5, np.nan)
+    fields = point_fields(model, np.zeros(model.n_full))
+    for k, pair in enumerate((plug, mould)):
+        expect = np.full(model.mesh.n_nodes, -1.0)
+        expect[pair.nodes] = np.nan_to_num(pair.first_contact, nan=-1.0)
+        assert np.array_equal(fields[f"first_contact_{k}"], expect)
+    earliest = np.where(fields["first_contact_0"] >= 0, fields["first_contact_0"], fields["first_contact_1"])
+    assert np.array_equal(fields["first_contact"], earliest)
 
 
 def run_plate(out: Path, *sets: str) -> Path:

@@ -2,6 +2,8 @@
 a pressure into a cup mould with sticky contact (the mould flush with the sheet's rim), and
 a case where only a tool moves until it touches, under load control and under arc length."""
 
+import copy
+
 import numpy as np
 import pytest
 
@@ -52,3 +54,39 @@ def test_only_a_tool_moves_until_it_touches():
         assert lam[-1] == pytest.approx(1.0) and (np.diff(lam) > 0).all()
         # the punch bottom went from z = 6 to z = -4: the top face centre follows it
         assert built.monitors[0].value(res.last) == pytest.approx(-5.0, abs=0.05)
+
+
+BORE = {
+    "title": "a bore blown into a sticky mould",
+    "mesh": {"kind": "rectangle", "r": [1.0, 2.0], "z": [0.0, 1.0], "divisions": [2, 1], "element": "q8"},
+    "material": {"model": "mooney-rivlin", "C1": 0.4, "C2": 0.1, "kappa": 200.0},
+    "fix": [{"at": {"z": 0.0}, "dofs": ["uz"]}, {"at": {"z": 1.0}, "dofs": ["uz"]}],
+    "cavity": [{"name": "bore", "boundary": {"r": 1.0}, "control": "gas", "ambient": 0.1, "content": 20.0,
+                "curve": [[0.0, 0.0], [0.5, 1.0]]}],
+    "contact": [{"surface": {"polyline": [[2.2, -0.5], [2.2, 1.5]]}, "slaves": {"r": 2.0}, "sticky": True}],
+    "solver": {"steps": 10, "target": 1.0},
+}
+
+
+@pytest.mark.parametrize("content, knot", [(20.0, 0.5), (9.0, 1.0)])
+def test_arc_length_finishes_the_stage_once_the_wall_is_frozen(content, knot):
+    """A bore blown by a gas onto a sticky mould r = 2.2: once its outer wall is frozen the
+    gas content still rises (to the knot) but hardly moves the structure, and past the knot
+    nothing does.  The arc length stopped there ("the load does not move the structure");
+    now it goes on by load steps to the knot and the target, and ends where load control
+    does: the gas law p_abs V = content, the wall frozen."""
+    ends = {}
+    for control in ("arc-length", "load"):
+        case = copy.deepcopy(BORE)
+        case["cavity"][0].update(content=content, curve=[[0.0, 0.0], [knot, 1.0]])
+        case["solver"]["control"] = control
+        built = build(parse(case))
+        res = solve(built.model, built.control, built.options)
+        assert res.status == "finished", (control, res.message)
+        lam = np.array([s.lam for s in res.steps])
+        assert lam[-1] == 1.0 and (np.diff(lam) > 0).all() and np.isclose(lam, knot, rtol=0, atol=1e-14).any()
+        assert (built.model.contacts[0].stuck).all()
+        cavity = built.model.cavities[0]
+        assert (cavity.pressure_now + 0.1) * cavity.volume_now == pytest.approx(content, rel=1e-9)
+        ends[control] = cavity.pressure_now
+    assert ends["arc-length"] == pytest.approx(ends["load"], rel=1e-9)

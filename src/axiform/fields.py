@@ -14,14 +14,15 @@ from __future__ import annotations
 import numpy as np
 
 from .materials import cauchy_stress
-from .thickness import contact_times, nodal_thickness, thickness_table
+from .thickness import contact_times, nodal_thickness, pieces, thickness_table
 
 
 def point_fields(model, u_full: np.ndarray) -> dict[str, np.ndarray]:
     """Nodal fields (n,) or (n, k) of the state u_full (all dofs): displacement (ur, uz, 0),
     J, cauchy_stress (rr, zz, tt, rz), von_mises, principal_stretches (in-plane major, minor,
     hoop); fibre_rotation (SFR); thickness (meshes with fibres); contact_pressure and
-    first_contact (the time a slave node first touched, -1 where never) with contact."""
+    first_contact (the time a slave node first touched, -1 where never) with contact, and
+    first_contact_K per piece K where several record it."""
     mesh = model.mesh
     dpn = model.dpn
     u = u_full.reshape(-1, dpn)
@@ -70,5 +71,7 @@ def point_fields(model, u_full: np.ndarray) -> dict[str, np.ndarray]:
         when = contact_times(mesh, model.contacts)
         if when is not None:
             out["first_contact"] = np.nan_to_num(when, nan=-1.0)
+        for k, pair in pieces(model.contacts):
+            out[f"first_contact_{k}"] = np.nan_to_num(contact_times(mesh, [pair]), nan=-1.0)
     return out
 

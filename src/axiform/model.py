@@ -323,7 +323,7 @@ class Model:
             np.add.at(r_full, dofs.ravel(), -fc.ravel())
             velocity = pair.surface.velocity(t)
             if velocity.any():
-                np.add.at(dr_full, dofs.ravel(), (Kc @ velocity).ravel())
+                np.add.at(dr_full, dofs.ravel(), pair.rate(velocity).ravel())
             contact_data.append(-Kc)
         # cavities: R -= p g, K -= p dg/du; under volume/gas control p is an unknown
         p_cav = self.cavity_pressures(u_f, t)

@@ -199,7 +199,14 @@ def thickness_figure(thickness: Path, info: FolderInfo, history: dict[str, np.nd
         ax.grid(True, alpha=0.3)
     if contact:
         a_c = axes.flat[3]
-        a_c.plot(t["s_current"], t["first_contact"], "o", ms=3, color="C3")
+        per_piece = [n for n in t if n.startswith("first_contact_") and np.isfinite(t[n]).any()]
+        for k, name in enumerate(per_piece):  # each piece, the earliest marked the largest
+            a_c.plot(t["s_current"], t[name], "o", ms=6 - 2.5 * k / len(per_piece), color=f"C{3 + k}",
+                     label=f"contact[{name.rsplit('_', 1)[1]}]")
+        if per_piece:
+            a_c.legend(fontsize=8)
+        else:
+            a_c.plot(t["s_current"], t["first_contact"], "o", ms=3, color="C3")
         a_c.set_xlabel(arc)
         a_c.set_ylabel(with_unit("time of first contact t", "time", info.units))
         a_c.set_xlim(a_s.get_xlim())
@@ -235,6 +242,8 @@ def field_values(point_data: dict[str, np.ndarray], spec: str, units: dict[str, 
         raise FieldError(f"no field '{name}' in the results (fields: {', '.join(sorted(point_data))})")
     values = np.asarray(point_data[name], float)
     label, quantity = FIELD_NAMES.get(name, (name, ""))
+    if name.startswith("first_contact_"):
+        label, quantity = f"time of first contact, contact[{name.rsplit('_', 1)[1]}]", "time"
     comps = COMPONENTS.get(name, ())
     if values.ndim == 1:
         if comp:
@@ -248,7 +257,7 @@ def field_values(point_data: dict[str, np.ndarray], spec: str, units: dict[str, 
         if name == "cauchy_stress":
             values = np.column_stack([values, values[:, 3]])
         values, label = np.linalg.norm(values, axis=1), f"{label} magnitude"
-    if name == "first_contact":
+    if name.startswith("first_contact"):
         values = np.where(values < 0, np.nan, values)
     return values, with_unit(label, quantity, units)
 

@@ -357,6 +357,7 @@ class _ArcLength(_Path):
             if not self.nominal > 0:  # nothing responds to the load yet (a tool still in the air)
                 self.nominal = self.load_step * span
         self.finished = False
+        self.loaded = False  # the last attempt was a load step (`_load_step`)
 
     def _norm(self, v):
         return float(np.sqrt(np.dot(self.weight * v, v)))
@@ -369,7 +370,7 @@ class _ArcLength(_Path):
 
     def attempt(self, size):
         u_new, lam_new, its, res, ev = self._arc_step(size)
-        if self.previous is not None and np.dot(self.weight * (u_new - self.u_f), self.previous) < 0:
+        if not self.loaded and self.previous is not None and np.dot(self.weight * (u_new - self.u_f), self.previous) < 0:
             raise StepFailed("the path turned back")
         if self.timed and (lam_new - self.lam) * np.sign(self.control.target) < 0:
             raise StepFailed("the load factor is the process time here (tools or curves follow it): it cannot "
@@ -391,16 +392,29 @@ class _ArcLength(_Path):
         super().accept(u_f, lam, size)
         self.finished = self._landed
 
+    def _load_step(self, dl):
+        """Where no arc can be measured: a load step sized like the arc (dl / nominal load
+        steps), up to the first knot of the curves or the target ahead."""
+        target = self.control.target
+        stops = np.append(self.model.knots(), target)
+        ahead = (stops - self.lam) * np.sign(target)
+        near = np.argmin(np.where(ahead > 1e-12 * abs(target), ahead, np.inf))
+        dlam = self.load_step * dl / self.nominal
+        lam = self.lam + np.sign(target) * dlam if dlam < ahead[near] * (1 - 1e-9) else stops[near]
+        self.loaded = True
+        return _newton_load(self.model, self.u_f, lam, self.opts, self.floor)
+
     def _arc_step(self, dl):
         model, opts, W = self.model, self.opts, self.weight
         ev = _evaluate(model, self.u_f, self.lam)
         t = -_factorize(ev.K)(ev.dr_dlam)  # du/dlambda along the tangent
         if not self._norm(t) > 0:
-            # the structure does not respond to the load (only a tool moves, not touching yet):
-            # no arc can be measured, so take a load step, sized like the arc
-            dlam = np.sign(self.control.target) * self.load_step * dl / self.nominal
-            return _newton_load(model, self.u_f, self.lam + dlam, opts, self.floor)
-        sign = np.sign(np.dot(W * t, self.previous)) if self.previous is not None else np.sign(self.control.target)
+            # the structure does not respond to the load (only a tool moves, not touching yet)
+            return self._load_step(dl)
+        self.loaded = False
+        # a process runs forward in time; elsewhere the path keeps its direction
+        sign = (np.sign(np.dot(W * t, self.previous)) if self.previous is not None and not self.timed
+                else np.sign(self.control.target))
         dlam = (sign or 1.0) * dl / max(self._norm(t), 1e-300)
         du = dlam * t
         residuals = [ev.force_norm]
@@ -419,7 +433,9 @@ class _ArcLength(_Path):
             C = np.dot(W * da, da) - dl * dl
             disc = B * B - 4.0 * A * C
             if A == 0:
-                raise StepFailed("arc length: the load does not move the structure")
+                # the load does not move the structure at this lambda (past the end of its
+                # curves, or every slave frozen on a mould: the stage is over)
+                return self._load_step(dl)
             if disc < 0:
                 # no point of the new line lies on the arc: take its point closest to it
                 dmu = -B / (2.0 * A)

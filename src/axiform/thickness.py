@@ -6,7 +6,9 @@ for a thick wall.
 thickness.csv has one row per station: s (reference arc length along the wall), r, z (the
 current mid-surface), thickness, initial_thickness, ratio (= thickness / initial_thickness),
 first_contact (the time t at which a node of the station's faces first touched a mould;
-empty where never) and s_current (the current arc length of the mid-surface).
+empty where never) and s_current (the current arc length of the mid-surface); with several
+mould pieces, first_contact_K per piece K (the index of its [[contact]] table, the `pair` of
+contact.csv), first_contact being the earliest of them.
 """
 
 from __future__ import annotations
@@ -25,17 +27,28 @@ def thickness_table(mesh: Mesh, u: np.ndarray, contacts: Sequence = ()) -> dict[
     """Per station (arrays of shape (stations,)): reference arc length s, current r, z of the
     fibre's middle, current and initial thickness, their ratio, the time of first contact
     of the station's faces (NaN where never) and the current arc length s_current.
-    u: nodal displacements (n, 2); contacts: the model's contact pairs.  None for meshes
-    without fibres."""
+    u: nodal displacements (n, 2); contacts: the model's contact pairs.  With more than one
+    pair recording contact times, also first_contact_K per pair K.  None for meshes without
+    fibres."""
     if mesh.fibres is None:
         return None
     f = mesh.fibres
     t0, _ = _normal_thickness(mesh.points, f)
     t, mid = _normal_thickness(mesh.points + u, f)
     s_current = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(mid, axis=0), axis=1))])
-    return {"s": mesh.fibre_s, "r": mid[:, 0], "z": mid[:, 1], "thickness": t,
-            "initial_thickness": t0, "ratio": t / t0,
-            "first_contact": first_contact(mesh, contacts), "s_current": s_current}
+    table = {"s": mesh.fibre_s, "r": mid[:, 0], "z": mid[:, 1], "thickness": t,
+             "initial_thickness": t0, "ratio": t / t0,
+             "first_contact": first_contact(mesh, contacts), "s_current": s_current}
+    for k, pair in pieces(contacts):
+        table[f"first_contact_{k}"] = first_contact(mesh, [pair])
+    return table
+
+
+def pieces(contacts: Sequence) -> list[tuple[int, object]]:
+    """(index, pair) of the pairs that record contact times, where more than one does (one
+    piece needs no column of its own beside first_contact)."""
+    timed = [(k, p) for k, p in enumerate(contacts) if getattr(p, "first_contact", None) is not None]
+    return timed if len(timed) > 1 else []
 
 
 def _normal_thickness(x: np.ndarray, fibres: np.ndarray):
@@ -89,11 +102,13 @@ def default_wall(points: np.ndarray, loaded_edges: Sequence[np.ndarray]) -> str:
 
 
 def write_thickness_csv(path: str | Path, table: dict[str, np.ndarray]) -> None:
-    """thickness.csv: the header row first (DESIGN 10.12), one row per station; the step and
-    load factor are in summary.json; first_contact is left empty where never."""
-    rows = np.column_stack([table[n] for n in COLUMNS])
+    """thickness.csv: the header row first (DESIGN 10.12), one row per station, the COLUMNS
+    then any per-piece first_contact_K; the step and load factor are in summary.json; the
+    contact times are left empty where never."""
+    names = list(COLUMNS) + [n for n in table if n not in COLUMNS]
+    rows = np.column_stack([table[n] for n in names])
     text = np.char.mod("%.10g", rows)
     text[np.isnan(rows)] = ""
-    lines = [",".join(COLUMNS)]
+    lines = [",".join(names)]
     lines += [",".join(row) for row in text]
     Path(path).write_text("\n".join(lines) + "\n")

@@ -52,6 +52,33 @@ def ring_areas(x: np.ndarray, edges: np.ndarray, derivative: bool = False):
     return a, 2 * np.pi * da
 
 
+def pole_rows(x: np.ndarray, edges: np.ndarray, corner: np.ndarray, derivative: bool = False):
+    """The row of the consistent ring-area matrix M_ij = int 2 pi r N_i N_j ds of each edge's
+    node on the axis i = corner (the pole), over the nodes j of that edge, in the
+    configuration x (n_nodes, 2); edges (q, k), corner (q,) in {0, 1}.
+
+    The row sums to the pole's consistent ring area, which is zero for a Q8 corner on the
+    axis (int r N_0 ds = 0 where r grows linearly along the edge); the row itself is not:
+    M_00 = -M_01 = 2 pi r_1 L / 60 on a straight edge.
+
+    Returns M (q, k) and, if asked, dM[q, j, l, :] = d M_ij / d x_l (q, k, k, 2)."""
+    s, wq = gauss_1d(3)  # the rule of `ring_areas`, so that the row sums to its area exactly
+    N, dN = edge_shape(edges.shape[1], s)  # (p, k)
+    X = x[edges]  # (q, k, 2)
+    t = np.einsum("pk,qkd->qpd", dN, X)
+    L = np.linalg.norm(t, axis=2)  # (q, p)
+    r = np.einsum("pk,qk->qp", N, X[..., 0])
+    Ni = N[:, corner].T  # (q, p)
+    M = 2 * np.pi * np.einsum("p,qp,pj,qp->qj", wq, Ni, N, r * L)
+    if not derivative:
+        return M
+    # d(r L) / dx_l = N_l L e_r + r dN_l t / L, as in `ring_areas`
+    dM = np.zeros(M.shape + M.shape[1:] + (2,))
+    dM[..., 0] = np.einsum("p,qp,pj,pl,qp->qjl", wq, Ni, N, N, L)
+    dM += np.einsum("p,qp,pj,pl,qpd->qjld", wq, Ni, N, dN, (r / L)[..., None] * t)
+    return M, 2 * np.pi * dM
+
+
 def _edge_heights(mesh: Mesh, edges: np.ndarray) -> np.ndarray:
     """Height of the cell under each boundary edge (m,): the cell's area in the (r, z) plane
     over the edge's chord."""
@@ -100,6 +127,14 @@ class ContactPair:
     to the next, and a node that touches a mould at rest (g = 0) feels no force; default 1e-3
     of the smallest element edge.
 
+    A node on the axis (a pole) has no ring area of its own for Q8 edges (the consistent
+    area of a corner at r = 0 vanishes), so a penalty per unit of its area would not hold it:
+    a wall pressed onto a convex mould (a push-up base) sank there by half its thickness and
+    snapped through.  Its force is instead the consistent integral of the traction
+    interpolated along its edges, f_0 = sum_j M_0j t_j (`pole_rows`), which is zero for a
+    uniform traction as the consistent area is, but holds the pole against its neighbours:
+    f_0 = M_00 (t_0 - t_1) on a straight Q8 edge.
+
     History (updated at converged steps by `commit`): stick points, sticky nodes, and
     `first_contact` (n,): the load factor (process time t) of the step in which each node
     first touched (for sticky contact: froze), NaN where it never did."""
@@ -122,6 +157,14 @@ class ContactPair:
         self.on_axis = self.area0 <= 1e-12 * self.area0.max()
         if self.on_axis.all():
             raise ValueError("the slave face lies on the axis (no ring area)")
+        # the Q8 edges with a pole (a corner on the axis, the other off it), and which corner;
+        # a Q4 corner on the axis keeps its consistent area, pi r_1 L / 3
+        on_axis = np.abs(mesh.points[self.nodes, 0]) <= 1e-12 * np.ptp(mesh.points, axis=0).max()
+        ends = on_axis[self.edges[:, :2]] & ~on_axis[self.edges[:, 1::-1]]
+        self.pole_edge = np.flatnonzero(ends.any(axis=1) & (self.edges.shape[1] == 3))
+        self.pole_corner = np.argmax(ends[self.pole_edge], axis=1)
+        # a pole's force is its own (`_poles`): no thinning of its penalty by its area
+        self.on_axis[self.edges[self.pole_edge, self.pole_corner]] = True
         self.mesh = mesh
         self.surface = surface
         self.X = mesh.points[self.nodes]
@@ -178,9 +221,42 @@ class ContactPair:
         e = self.edges
         m, k = e.shape
         C = np.einsum("mi,mid,mije->midje", dw[e], t[e], dparts)  # d f_i / d x_j through a_i
+        self._rate = None
+        if self.pole_edge.size:
+            self._rate = self._poles(xa, t, dt, f, C)
         self.coupling = C.reshape(m, 2 * k, 2 * k)
-        self.last = (x, proj, f, status, a, lam)
+        self.last = (x, proj, f, status, a, lam, ratio[:, None] * t)
+        self._K = K
         return f, K, status
+
+    def _poles(self, x, t, dt, f, C):
+        """Add to the forces f (n, 2) and to the coupling C (m, k, 2, k, 2), in place, the
+        poles' consistent forces sum_j M_0j (t_j - t_0) (what they add to the area-weighted
+        a_0 t_0); return their derivative with respect to the positions relative to the
+        surface, per pole edge and edge node (q, k, 2, 2), for the rate of a moving surface."""
+        q = np.arange(self.pole_edge.size)
+        e = self.edges[self.pole_edge]  # (q, k)
+        i = self.pole_corner
+        M, dM = pole_rows(x, e, i, derivative=True)
+        dT = t[e] - t[e[q, i]][:, None]  # (q, k, 2)
+        np.add.at(f, e[q, i], np.einsum("qj,qjd->qd", M, dT))
+        # d/dx_l: dM_il (t_l - t_0) + M_il dt_l - delta_il a_0 dt_0, a_0 = sum_j M_0j
+        D = M[:, :, None, None] * dt[e]  # (q, k, 2, 2): d f_0 / d x_l through t_l
+        D[q, i] -= M.sum(axis=1)[:, None, None] * dt[e[q, i]]
+        Cp = C[self.pole_edge]
+        Cp[q, i] += np.einsum("qjle,qjd->qdle", dM, dT) + D.transpose(0, 2, 1, 3)
+        C[self.pole_edge] = Cp
+        return D
+
+    def rate(self, velocity: np.ndarray) -> np.ndarray:
+        """d f / d lambda at fixed u of the last evaluation divided by -1, per slave node
+        (n, 2), for a surface moving with `velocity` (2,): the forces depend on the positions
+        relative to the surface, x - offset(lambda)."""
+        out = self._K @ velocity
+        if self._rate is not None:
+            q = np.arange(self.pole_edge.size)
+            np.add.at(out, self.edges[self.pole_edge][q, self.pole_corner], np.einsum("qlde,e->qd", self._rate, velocity))
+        return out
 
     def _traction(self, x: np.ndarray):
         """The contact law per unit of w (pressure per unit gap kn0, kt0): traction t (n, 2),
@@ -238,7 +314,7 @@ class ContactPair:
     def commit(self) -> None:
         """Accept the state of the last evaluation (a converged step): positions for the
         crossing test, stick points, newly stuck nodes, the time of first contact."""
-        x, proj, _, status, _, lam = self.last
+        x, proj, _, status, _, lam, _ = self.last
         self.x_prev = x.copy()
         if self.mu > 0 and not self.sticky:
             # slip beyond z = 3 (tanh = 0.995) is plastic: the stick point follows the node, so
@@ -270,13 +346,12 @@ class ContactPair:
         """Per node of the last evaluation: current (r, z) in the global frame, gap, contact
         pressure (normal force over the current ring area), status; and the totals (the
         contact area is that of the reference configuration)."""
-        _, proj, f, status, a, _ = self.last
-        fn = np.einsum("ij,ij->i", f, proj.n)
+        _, proj, f, status, a, _, traction = self.last
         in_contact = status > 0
         gap = np.where(proj.active, proj.g, np.nan)
         return {
             "node": self.nodes,
-            "pressure": np.where(in_contact, fn / a, 0.0),
+            "pressure": np.where(in_contact, np.einsum("ij,ij->i", traction, proj.n), 0.0),
             "gap": gap,
             "status": status,
             "force": f,
