@@ -4,14 +4,15 @@ layered case that gives a wanted final wall.
 Design: the thicknesses t_k of the case's `mesh.thickness` table [[s_k, t_k], ...], bounded
 to 0.2 to 5 times their initial values.  Objective (`Objective`): the mean squared relative
 misfit of the final thickness to the target over the reference arc length,
-int ((t - T) / T)^2 ds / L over the stations inside the target's range, plus a small
-smoothness term on the design, `smoothness` times the sum of its squared second differences
-relative to its initial mean.
+int ln(t / T)^2 ds / L over the stations inside the target's range (ln(t / T) = (t - T) / T
+to first order; a wall scales with its parison, so that ln t is nearly linear in the
+logarithm of the design), plus a small smoothness term on the design, `smoothness` times the
+sum of its squared second differences relative to its initial mean.
 
 Methods:
 - "gradient": SciPy's bound-constrained trust-region reflective least squares
-  (`scipy.optimize.least_squares`, method "trf"), with the Jacobian of the final thickness
-  to the design from direct differentiation along the load path (axiform.sensitivity): a
+  (`scipy.optimize.least_squares`, method "trf") over ln t_k, with the Jacobian of the final
+  thickness to the design from direct differentiation along the load path (axiform.sensitivity): a
   Gauss-Newton method, which needs few forward solves because the whole Jacobian (stations x
   design) comes with each solve;
 - "fixed-point": the plain rule, each t_k scaled by target / achieved at its station s_k.
@@ -179,7 +180,7 @@ class Objective:
     stations: reference arc length of the wall's stations (n,); the target (s, thickness) is
     interpolated linearly at the stations inside its range; weights w (n,): the trapezoid
     weights of those stations over the length they cover (zero outside), so that
-    sum w e^2 is the mean of e^2 = ((t - T) / T)^2 over the reference arc length.
+    sum w e^2 is the mean of e^2 = ln(t / T)^2 over the reference arc length.
     Smoothness: `smoothness` sum (second difference of the design / mean initial design)^2."""
 
     stations: np.ndarray
@@ -227,13 +228,14 @@ class Objective:
 
     def residuals(self, thickness: np.ndarray, design: np.ndarray) -> np.ndarray:
         """r with objective = r . r: sqrt(w) e at the stations, then sqrt(smoothness) D s."""
-        misfit = np.sqrt(self.weights[self.inside]) * self.deviation(thickness)
+        i = self.inside
+        misfit = np.sqrt(self.weights[i]) * np.log(thickness[i] / self.target[i])
         return np.concatenate([misfit, np.sqrt(self.smoothness) * self._second(len(design)) @ design])
 
-    def jacobian(self, dthickness_ds: np.ndarray) -> np.ndarray:
-        """dr/ds (len(r), m) from d thickness / ds (n, m)."""
+    def jacobian(self, thickness: np.ndarray, dthickness_ds: np.ndarray) -> np.ndarray:
+        """dr/ds (len(r), m) from the final thickness (n,) and d thickness / ds (n, m)."""
         i = self.inside
-        rows = (np.sqrt(self.weights[i]) / self.target[i])[:, None] * dthickness_ds[i]
+        rows = (np.sqrt(self.weights[i]) / thickness[i])[:, None] * dthickness_ds[i]
         return np.vstack([rows, np.sqrt(self.smoothness) * self._second(dthickness_ds.shape[1])])
 
 
@@ -307,7 +309,7 @@ def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], met
             return Iterate(x.copy(), table, np.inf, np.inf, False, result.message), None
         r = objective.residuals(table["thickness"], x)
         it = Iterate(x.copy(), table, float(r @ r), objective.max_rel_deviation(table["thickness"]), True)
-        return it, (r, None if jac is None else objective.jacobian(jac))
+        return it, (r, None if jac is None else objective.jacobian(table["thickness"], jac))
 
     def record(it: Iterate) -> None:
         row = (len(rows), it.objective, it.deviation, solves)
@@ -341,18 +343,17 @@ def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], met
                 best = current
         reached = best.deviation <= tolerance
     else:
-        cache: dict[bytes, tuple[Iterate, Any]] = {x0.tobytes(): (initial, first)}
-        state = {"best": initial, "fail": None}
+        # the optimizer's variables: y = ln t_k of the active knots
+        y0 = np.log(x0[active])
+        cache: dict[bytes, tuple[Iterate, Any]] = {y0.tobytes(): (initial, first)}
+        state = {"best": initial}
 
-        def full(x):
-            out = x0.copy()
-            out[active] = x
-            return out
-
-        def evaluate(x):
-            x = full(np.asarray(x, float))
-            key = x.tobytes()
+        def evaluate(y):
+            y = np.asarray(y, float)
+            key = y.tobytes()
             if key not in cache:
+                x = x0.copy()
+                x[active] = np.exp(y)
                 cache[key] = forward(x, True)
                 it = cache[key][0]
                 if it.finished and it.objective < state["best"].objective:
@@ -362,28 +363,27 @@ def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], met
                     raise _Reached
             return cache[key]
 
-        def fun(x):
-            it, rj = evaluate(x)
+        def fun(y):
+            it, rj = evaluate(y)
             if rj is None:  # the solve stopped (a design too thin to blow): a step to reject
                 r_best = objective.residuals(state["best"].thickness["thickness"], state["best"].design)
                 return 10.0 * np.abs(r_best) + 1.0
             return rj[0]
 
-        def jac(x):
-            it, rj = evaluate(x)
+        def jac(y):
+            it, rj = evaluate(y)
             if it is not initial:
                 record(it)  # the optimizer asks the Jacobian at each accepted iterate
             if len(rows) > max_iter:
                 raise StopIteration
-            return rj[1][:, active]
+            return rj[1][:, active] * it.design[active]  # dr/dy = dr/dt t
 
         from scipy.optimize import least_squares
 
         if initial.deviation > tolerance:
             try:
-                a = active
-                out = least_squares(fun, x0[a], jac=jac, bounds=(lo[a], hi[a]), method="trf", x_scale=x0[a],
-                                    max_nfev=4 * max_iter + 4)
+                bounds = (np.log(lo[active]), np.log(hi[active]))
+                out = least_squares(fun, y0, jac=jac, bounds=bounds, method="trf", max_nfev=4 * max_iter + 4)
                 converged = out.status > 0
                 message = f"the optimizer converged to a best fit: {out.message}" if converged else out.message
             except _Reached:
