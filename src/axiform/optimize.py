@@ -256,9 +256,11 @@ class Iterate:
 class OptimizeResult:
     """rows: (iteration, objective, max_rel_deviation, forward_solves) per iteration (the
     initial design is iteration 0); best: the best finished iterate; initial: the first;
-    reached: the tolerance was met; status "finished" (reached or converged) or "stopped"."""
+    tolerance: the max relative deviation aimed at; reached: it was met; status "finished"
+    (reached or converged) or "stopped"."""
 
     method: str
+    tolerance: float
     rows: list[tuple[int, float, float, int]]
     initial: Iterate
     best: Iterate
@@ -321,7 +323,7 @@ def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], met
     initial, first = forward(x0, method == "gradient")
     record(initial)
     if not initial.finished:
-        return OptimizeResult(method, rows, initial, initial, solves, False, "stopped",
+        return OptimizeResult(method, tolerance, rows, initial, initial, solves, False, "stopped",
                               f"the forward solve of the initial design stopped: {initial.message}",
                               time.perf_counter() - t0)
     best = initial
@@ -397,7 +399,7 @@ def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], met
     elif not message:
         message = f"the tolerance was not reached in {max_iter} iterations"
     status = "finished" if reached or converged else "stopped"
-    return OptimizeResult(method, rows, initial, best, solves, reached, status, message,
+    return OptimizeResult(method, tolerance, rows, initial, best, solves, reached, status, message,
                           time.perf_counter() - t0)
 
 
@@ -410,7 +412,7 @@ def write_outputs(out: Path, design: ThicknessDesign, result: OptimizeResult,
     buf = ["iteration,objective,max_rel_deviation,forward_solves"]
     buf += [f"{i},{o!r},{d!r},{n}" for i, o, d, n in result.rows]
     write_atomic(out / "optimize.csv", "\n".join(buf) + "\n")
-    summary = {"method": result.method, "status": result.status, "message": result.message,
+    summary = {"method": result.method, "tolerance": result.tolerance, "status": result.status, "message": result.message,
                "reached": result.reached, "iterations": len(result.rows) - 1,
                "forward_solves": result.forward_solves, "wall_time_s": round(result.wall_time_s, 3),
                "objective": result.best.objective, "max_rel_deviation": result.best.deviation,
@@ -425,10 +427,11 @@ def write_outputs(out: Path, design: ThicknessDesign, result: OptimizeResult,
 
 def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResult,
                       target: tuple[np.ndarray, np.ndarray]) -> None:
-    """optimize.png: the section (initial and optimized parison, their final mid-surfaces and
-    the moulds), the initial and optimized wall straightened (faces at +-t/2 about the
-    mid-surface against s), the final thickness of both against the target, and the
-    objective per iteration."""
+    """optimize.png: the section (initial parison filled, optimized parison outlined, their
+    final mid-surfaces and the moulds), the initial and optimized wall straightened (faces at
+    +-t/2 about the mid-surface against s, the same way), the final thickness of both against
+    the target (the stations outside the target's range shaded), and the objective per
+    iteration."""
     from .plots import _pyplot, _save
 
     plt = _pyplot()
@@ -443,7 +446,10 @@ def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResul
         f = model.mesh.fibres
         a, b = model.mesh.points[f[:, 0]], model.mesh.points[f[:, -1]]
         ring = np.vstack([a, b[::-1], a[:1]])
-        ax.fill(ring[:, 0], ring[:, 1], color=colour, alpha=0.5, lw=0.6, label=f"{name} parison")
+        if it is result.initial:
+            ax.fill(ring[:, 0], ring[:, 1], color=colour, alpha=0.5, lw=0, label=f"{name} parison")
+        else:
+            ax.plot(ring[:, 0], ring[:, 1], "-", color=colour, lw=0.9, label=f"{name} parison")
         if it.thickness is not None:
             ax.plot(it.thickness["r"], it.thickness["z"], "-", color=colour, lw=1.2, label=f"{name}: final wall")
     end = float(design.control.target)
@@ -460,7 +466,11 @@ def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResul
     s_fine = np.linspace(design.knots[0], design.knots[-1], 400)
     for values, _, colour, name in runs:
         t = np.interp(s_fine, design.knots, values)
-        ax.fill_between(s_fine, -t / 2, t / 2, color=colour, alpha=0.45, lw=0, label=f"{name} wall")
+        if values is design.initial:
+            ax.fill_between(s_fine, -t / 2, t / 2, color=colour, alpha=0.5, lw=0, label=f"{name} wall")
+        else:
+            ax.plot(s_fine, t / 2, "-", color=colour, lw=1.2, label=f"{name} wall")
+            ax.plot(s_fine, -t / 2, "-", color=colour, lw=1.2)
         ax.plot(design.knots, values / 2, "o", color=colour, ms=4)
     ax.axhline(0.0, color="k", lw=0.5)
     ax.set_xlabel("reference arc length s" + length)
@@ -470,6 +480,10 @@ def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResul
     ax = axes[1, 0]
     s_t, t_t = target
     top = [t_t.max()]
+    s_all = design.built.model.mesh.fibre_s
+    outside = [(a, b) for a, b in ((s_all[0], s_t[0]), (s_t[-1], s_all[-1])) if b > a]
+    for k, (a, b) in enumerate(outside):
+        ax.axvspan(a, b, color="0.9", lw=0, label=None if k else "not in the target")
     for _, it, colour, name in runs:
         if it.thickness is not None:
             ax.plot(it.thickness["s"], it.thickness["thickness"], ".-", color=colour, label=f"with the {name} design")
@@ -485,6 +499,7 @@ def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResul
     it = [r[0] for r in result.rows]
     ax.semilogy(it, [r[1] for r in result.rows], "o-", color=blue, label="objective")
     ax.semilogy(it, [r[2] for r in result.rows], "s--", color="C1", label="max relative deviation")
+    ax.axhline(result.tolerance, color="C1", lw=0.8, ls=":", label=f"tolerance {result.tolerance:g}")
     ax.set_xlabel("iteration")
     ax.set_title(f"{result.method}: {result.forward_solves} forward solves")
     ax.xaxis.get_major_locator().set_params(integer=True)
