@@ -161,12 +161,13 @@ def test_bad_target_on_the_command_line_exits_2(tmp_path, capsys):
 
 def test_bottle_example_is_a_design_case():
     """examples/parison_bottle.toml is valid for `axiform optimize` (its run is measured in the
-    README): a layered mesh, 19 design variables, load control, a target past the pinch-off."""
+    README): a layered mesh, 21 design variables, load control, a target over the whole wall
+    but the pinch-off's element."""
     from axiform.optimize import ThicknessDesign
 
     design = ThicknessDesign.from_case(EXAMPLES / "parison_bottle.toml")
-    assert design.initial.tolist() == [2.0] * 19
+    assert design.initial.tolist() == [2.0] * 21
     assert design.knots[-1] == pytest.approx(design.built.model.mesh.fibre_s[-1], abs=0.01)
     s, t = read_target(EXAMPLES / "parison_bottle_target.csv")
     obj = Objective(design.built.model.mesh.fibre_s, s, t, 2.0)
-    assert obj.inside.tolist() == [False] + [True] * 27 + [False] * 4  # the pinch-off station and the neck left out
+    assert obj.inside.tolist() == [False] + [True] * 31  # the pinch-off station left out, the neck in
