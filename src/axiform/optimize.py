@@ -430,8 +430,8 @@ def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResul
     """optimize.png: the section (initial parison filled, optimized parison outlined, their
     final mid-surfaces and the moulds), the initial and optimized wall straightened (faces at
     +-t/2 about the mid-surface against s, the same way), the final thickness of both against
-    the target (the stations outside the target's range shaded), and the objective per
-    iteration."""
+    the target (the stations outside the target's range shaded), and the objective and the max
+    deviation of each iteration against the forward solves spent."""
     from .plots import _pyplot, _save
 
     plt = _pyplot()
@@ -496,12 +496,12 @@ def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResul
                  f"{100 * result.best.deviation:.3g} %")
     ax.legend(fontsize=8)
     ax = axes[1, 1]
-    it = [r[0] for r in result.rows]
-    ax.semilogy(it, [r[1] for r in result.rows], "o-", color=blue, label="objective")
-    ax.semilogy(it, [r[2] for r in result.rows], "s--", color="C1", label="max relative deviation")
+    solves = [r[3] for r in result.rows]  # the cost: rejected trials of the gradient method count too
+    ax.semilogy(solves, [r[1] for r in result.rows], "o-", color=blue, label="objective")
+    ax.semilogy(solves, [r[2] for r in result.rows], "s--", color="C1", label="max relative deviation")
     ax.axhline(result.tolerance, color="C1", lw=0.8, ls=":", label=f"tolerance {result.tolerance:g}")
-    ax.set_xlabel("iteration")
-    ax.set_title(f"{result.method}: {result.forward_solves} forward solves")
+    ax.set_xlabel("forward solves (a marker per iteration)")
+    ax.set_title(f"{result.method}: {len(result.rows) - 1} iterations, {result.forward_solves} forward solves")
     ax.xaxis.get_major_locator().set_params(integer=True)
     ax.legend(fontsize=8)
     fig.tight_layout()
