@@ -94,6 +94,22 @@ def test_fixed_point_baseline_needs_more_forward_solves(runs):
     assert (folder / "fixed-point" / "final" / "thickness.csv").exists()
 
 
+@pytest.mark.parametrize("element, formulation", [("q4", "displacement"), ("q8", "mixed"), ("q8", "displacement"),
+                                                  ("sfr", "mixed"), ("sfr", "displacement")])
+def test_every_element_reaches_the_uniform_target_in_3_forward_solves(tmp_path, element, formulation):
+    """The free tube of the fixture (Q4 mixed) with the other elements and formulations, with
+    the default settings: within 1 % in 3 forward solves (measured 0.36 % to 0.45 %)."""
+    from axiform.optimize import ThicknessDesign, optimize
+
+    tree = copy.deepcopy(TUBE)
+    tree["mesh"].update(element=element, formulation=formulation)
+    case = tmp_path / "tube.toml"
+    case.write_text(toml_text(tree))
+    result = optimize(ThicknessDesign.from_case(case), (np.array([0.0, 20.0]), np.array([TARGET, TARGET])))
+    assert result.reached and result.status == "finished"
+    assert result.forward_solves == 3 and result.best.deviation <= 0.01 < result.initial.deviation
+
+
 def test_objective_weights_residuals_and_jacobian():
     s = np.array([0.0, 1.0, 3.0, 4.0])
     obj = Objective(s, np.array([1.0, 3.0]), np.array([2.0, 4.0]), scale=2.0, smoothness=0.5)
@@ -102,12 +118,12 @@ def test_objective_weights_residuals_and_jacobian():
     t = np.array([9.0, 2.2, 3.6, 9.0])
     x = np.array([1.0, 2.0, 4.0])
     r = obj.residuals(t, x)
-    e = np.array([0.1, -0.1])
+    e = np.log([1.1, 0.9])  # ln(t / T)
     assert r[:2] == pytest.approx(np.sqrt([0.5, 0.5]) * e)
     assert r[2] == pytest.approx(np.sqrt(0.5) * (1 - 4 + 4) / 2.0)
     assert obj.max_rel_deviation(t) == pytest.approx(0.1)
-    J = obj.jacobian(np.arange(12.0).reshape(4, 3))
-    assert J[0] == pytest.approx(np.sqrt(0.5) / 2.0 * np.array([3.0, 4.0, 5.0]))
+    J = obj.jacobian(t, np.arange(12.0).reshape(4, 3))
+    assert J[0] == pytest.approx(np.sqrt(0.5) / 2.2 * np.array([3.0, 4.0, 5.0]))
     assert J[2] == pytest.approx(np.sqrt(0.5) * np.array([1.0, -2.0, 1.0]) / 2.0)
 
 
@@ -161,12 +177,40 @@ def test_bad_target_on_the_command_line_exits_2(tmp_path, capsys):
 
 def test_bottle_example_is_a_design_case():
     """examples/parison_bottle.toml is valid for `axiform optimize` (its run is measured in the
-    README): a layered mesh, 19 design variables, load control, a target past the pinch-off."""
+    README): a layered mesh, 21 design variables, load control, a target over the whole wall
+    but the pinch-off's element."""
     from axiform.optimize import ThicknessDesign
 
     design = ThicknessDesign.from_case(EXAMPLES / "parison_bottle.toml")
-    assert design.initial.tolist() == [2.0] * 19
+    assert design.initial.tolist() == [2.0] * 21
     assert design.knots[-1] == pytest.approx(design.built.model.mesh.fibre_s[-1], abs=0.01)
     s, t = read_target(EXAMPLES / "parison_bottle_target.csv")
     obj = Objective(design.built.model.mesh.fibre_s, s, t, 2.0)
-    assert obj.inside.tolist() == [False] + [True] * 27 + [False] * 4  # the pinch-off station and the neck left out
+    assert obj.inside.tolist() == [False] + [True] * 31  # the pinch-off station left out, the neck in
+
+
+@pytest.mark.slow
+def test_bottle_whole_wall_within_5_percent_in_fewer_forward_solves_than_the_rule(tmp_path):
+    """The bottle example on a coarser mesh (16 Q8 elements, 10 steps, a knot every 8 mm and at
+    s = 68): the whole wall but the pinch-off's element, neck included, within 5 % of a uniform
+    target; the gradient method needs 3 forward solves, the fixed-point rule 5."""
+    from axiform.optimize import ThicknessDesign, optimize
+
+    tree = tomllib.loads((EXAMPLES / "parison_bottle.toml").read_text())
+    for piece, n in zip(tree["mesh"]["profile"], (2, 2, 12)):
+        next(iter(piece.values()))["divisions"] = n
+    tree["mesh"]["thickness"] = [[s, 2.0] for s in (0, 8, 16, 24, 32, 40, 48, 56, 64, 68, 72.28)]
+    tree["solver"]["steps"] = 10
+    case = tmp_path / "bottle.toml"
+    case.write_text(toml_text(tree))
+    design = ThicknessDesign.from_case(case)
+    stations = design.built.model.mesh.fibre_s
+    target = (np.array([stations[1], stations[-1]]), np.array([1.15, 1.15]))  # all but the pinch-off's element
+    grad = optimize(design, target, "gradient", tolerance=0.05)
+    rule = optimize(design, target, "fixed-point", tolerance=0.05)
+    for result in (grad, rule):
+        assert result.reached and result.initial.deviation > 0.6
+        wall = result.best.thickness["thickness"][1:]
+        assert np.abs(wall / 1.15 - 1).max() == pytest.approx(result.best.deviation, rel=1e-12)
+        assert result.best.deviation <= 0.05
+    assert (grad.forward_solves, rule.forward_solves) == (3, 5)

@@ -1,8 +1,8 @@
 """Sensitivities by direct differentiation along the load path (axiform.sensitivity) against
 central differences of whole forward solves: a free tube blown by a cavity under volume
-control, and tubes blown against a conical mould with sticky contact and with Coulomb
-friction (nodes touch at different steps, so the history counts), in the mixed and the
-displacement formulations.  Relative error <= 1e-5 where the path keeps its contact set."""
+control, and tubes blown against a conical mould with sticky contact (mixed) and with
+Coulomb friction (mixed and displacement); nodes touch at different steps, so the history
+counts.  Relative error <= 1e-5 where the path keeps its contact set."""
 
 import copy
 
@@ -24,7 +24,11 @@ TUBE = {
     "cavity": [{"name": "gas", "boundary": {"set": "inner"}, "control": "volume", "volume": 6000.0}],
     "solver": {"steps": 6},
 }
-MOULD = {"surface": {"polyline": [[11.5, -3.0], [14.0, 15.0]]}, "slaves": {"set": "outer"}}
+# a conical mould that holds the blown tube: the outer face touches it from the bottom up, one
+# node after the other (a narrower cone, [[11.5, -3], [14, 15]], holds less than the cavity's
+# 6000 with the wall inside it: the mixed element then stops with J <= 0 and the displacement
+# element finishes only 0.7 mm into the mould)
+MOULD = {"surface": {"polyline": [[10.8, -3.0], [16.0, 15.0]]}, "slaves": {"set": "outer"}}
 
 
 def tube(formulation="mixed", element="q4", contact=None, volume=6000.0):
@@ -84,19 +88,24 @@ def test_free_tube_under_volume_control(formulation):
 
 
 def test_sticky_mould_with_nodes_freezing_at_different_steps_mixed():
-    tree = tube("mixed", contact={"sticky": True}, volume=7000.0)
-    tree["solver"]["steps"] = 12  # 6 steps need 13-20 Newton iterations each, at the limit of 20
+    sens = check_against_forward_differences(tube("mixed", contact={"sticky": True}))
+    pair = sens.model.contacts[0]
+    assert np.unique(pair.first_contact[~np.isnan(pair.first_contact)]).size >= 3  # froze over several steps
+    assert (pair.report()["status"] == 3).sum() >= 5  # of the 7 outer nodes, 5 frozen (and 1 touching)
+    assert pair.report()["penetration"] < 0.05  # the mould holds the tube
+
+
+@pytest.mark.parametrize("formulation", ["mixed", "displacement"])
+def test_coulomb_friction_on_the_mould(formulation):
+    tree = tube(formulation, contact={"friction": 0.3})
+    # the same path for the differences: no step grows, and the steps where sliding nodes stick
+    # (up to 24 Newton iterations in the mixed element) are not cut back
+    tree["solver"].update(growth=1.0, max_iterations=30)
     sens = check_against_forward_differences(tree)
-    first = sens.model.contacts[0].first_contact
-    assert np.unique(first[~np.isnan(first)]).size >= 3  # the wall froze on the mould over several steps
-    assert (sens.model.contacts[0].report()["status"] == 3).sum() >= 6
-
-
-def test_coulomb_friction_on_the_mould():
-    sens = check_against_forward_differences(tube("displacement", contact={"friction": 0.3}, volume=6000.0))
     pair = sens.model.contacts[0]
     assert (pair.report()["status"] > 0).sum() >= 6
     assert np.unique(pair.first_contact[~np.isnan(pair.first_contact)]).size >= 3
+    assert pair.report()["penetration"] < 0.05
 
 
 def test_design_changing_the_supports_is_refused():

@@ -4,14 +4,15 @@ layered case that gives a wanted final wall.
 Design: the thicknesses t_k of the case's `mesh.thickness` table [[s_k, t_k], ...], bounded
 to 0.2 to 5 times their initial values.  Objective (`Objective`): the mean squared relative
 misfit of the final thickness to the target over the reference arc length,
-int ((t - T) / T)^2 ds / L over the stations inside the target's range, plus a small
-smoothness term on the design, `smoothness` times the sum of its squared second differences
-relative to its initial mean.
+int ln(t / T)^2 ds / L over the stations inside the target's range (ln(t / T) = (t - T) / T
+to first order; a wall scales with its parison, so that ln t is nearly linear in the
+logarithm of the design), plus a small smoothness term on the design, `smoothness` times the
+sum of its squared second differences relative to its initial mean.
 
 Methods:
 - "gradient": SciPy's bound-constrained trust-region reflective least squares
-  (`scipy.optimize.least_squares`, method "trf"), with the Jacobian of the final thickness
-  to the design from direct differentiation along the load path (axiform.sensitivity): a
+  (`scipy.optimize.least_squares`, method "trf") over ln t_k, with the Jacobian of the final
+  thickness to the design from direct differentiation along the load path (axiform.sensitivity): a
   Gauss-Newton method, which needs few forward solves because the whole Jacobian (stations x
   design) comes with each solve;
 - "fixed-point": the plain rule, each t_k scaled by target / achieved at its station s_k.
@@ -179,7 +180,7 @@ class Objective:
     stations: reference arc length of the wall's stations (n,); the target (s, thickness) is
     interpolated linearly at the stations inside its range; weights w (n,): the trapezoid
     weights of those stations over the length they cover (zero outside), so that
-    sum w e^2 is the mean of e^2 = ((t - T) / T)^2 over the reference arc length.
+    sum w e^2 is the mean of e^2 = ln(t / T)^2 over the reference arc length.
     Smoothness: `smoothness` sum (second difference of the design / mean initial design)^2."""
 
     stations: np.ndarray
@@ -227,13 +228,14 @@ class Objective:
 
     def residuals(self, thickness: np.ndarray, design: np.ndarray) -> np.ndarray:
         """r with objective = r . r: sqrt(w) e at the stations, then sqrt(smoothness) D s."""
-        misfit = np.sqrt(self.weights[self.inside]) * self.deviation(thickness)
+        i = self.inside
+        misfit = np.sqrt(self.weights[i]) * np.log(thickness[i] / self.target[i])
         return np.concatenate([misfit, np.sqrt(self.smoothness) * self._second(len(design)) @ design])
 
-    def jacobian(self, dthickness_ds: np.ndarray) -> np.ndarray:
-        """dr/ds (len(r), m) from d thickness / ds (n, m)."""
+    def jacobian(self, thickness: np.ndarray, dthickness_ds: np.ndarray) -> np.ndarray:
+        """dr/ds (len(r), m) from the final thickness (n,) and d thickness / ds (n, m)."""
         i = self.inside
-        rows = (np.sqrt(self.weights[i]) / self.target[i])[:, None] * dthickness_ds[i]
+        rows = (np.sqrt(self.weights[i]) / thickness[i])[:, None] * dthickness_ds[i]
         return np.vstack([rows, np.sqrt(self.smoothness) * self._second(dthickness_ds.shape[1])])
 
 
@@ -254,9 +256,11 @@ class Iterate:
 class OptimizeResult:
     """rows: (iteration, objective, max_rel_deviation, forward_solves) per iteration (the
     initial design is iteration 0); best: the best finished iterate; initial: the first;
-    reached: the tolerance was met; status "finished" (reached or converged) or "stopped"."""
+    tolerance: the max relative deviation aimed at; reached: it was met; status "finished"
+    (reached or converged) or "stopped"."""
 
     method: str
+    tolerance: float
     rows: list[tuple[int, float, float, int]]
     initial: Iterate
     best: Iterate
@@ -307,7 +311,7 @@ def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], met
             return Iterate(x.copy(), table, np.inf, np.inf, False, result.message), None
         r = objective.residuals(table["thickness"], x)
         it = Iterate(x.copy(), table, float(r @ r), objective.max_rel_deviation(table["thickness"]), True)
-        return it, (r, None if jac is None else objective.jacobian(jac))
+        return it, (r, None if jac is None else objective.jacobian(table["thickness"], jac))
 
     def record(it: Iterate) -> None:
         row = (len(rows), it.objective, it.deviation, solves)
@@ -319,7 +323,7 @@ def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], met
     initial, first = forward(x0, method == "gradient")
     record(initial)
     if not initial.finished:
-        return OptimizeResult(method, rows, initial, initial, solves, False, "stopped",
+        return OptimizeResult(method, tolerance, rows, initial, initial, solves, False, "stopped",
                               f"the forward solve of the initial design stopped: {initial.message}",
                               time.perf_counter() - t0)
     best = initial
@@ -341,18 +345,17 @@ def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], met
                 best = current
         reached = best.deviation <= tolerance
     else:
-        cache: dict[bytes, tuple[Iterate, Any]] = {x0.tobytes(): (initial, first)}
-        state = {"best": initial, "fail": None}
+        # the optimizer's variables: y = ln t_k of the active knots
+        y0 = np.log(x0[active])
+        cache: dict[bytes, tuple[Iterate, Any]] = {y0.tobytes(): (initial, first)}
+        state = {"best": initial}
 
-        def full(x):
-            out = x0.copy()
-            out[active] = x
-            return out
-
-        def evaluate(x):
-            x = full(np.asarray(x, float))
-            key = x.tobytes()
+        def evaluate(y):
+            y = np.asarray(y, float)
+            key = y.tobytes()
             if key not in cache:
+                x = x0.copy()
+                x[active] = np.exp(y)
                 cache[key] = forward(x, True)
                 it = cache[key][0]
                 if it.finished and it.objective < state["best"].objective:
@@ -362,28 +365,27 @@ def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], met
                     raise _Reached
             return cache[key]
 
-        def fun(x):
-            it, rj = evaluate(x)
+        def fun(y):
+            it, rj = evaluate(y)
             if rj is None:  # the solve stopped (a design too thin to blow): a step to reject
                 r_best = objective.residuals(state["best"].thickness["thickness"], state["best"].design)
                 return 10.0 * np.abs(r_best) + 1.0
             return rj[0]
 
-        def jac(x):
-            it, rj = evaluate(x)
+        def jac(y):
+            it, rj = evaluate(y)
             if it is not initial:
                 record(it)  # the optimizer asks the Jacobian at each accepted iterate
             if len(rows) > max_iter:
                 raise StopIteration
-            return rj[1][:, active]
+            return rj[1][:, active] * it.design[active]  # dr/dy = dr/dt t
 
         from scipy.optimize import least_squares
 
         if initial.deviation > tolerance:
             try:
-                a = active
-                out = least_squares(fun, x0[a], jac=jac, bounds=(lo[a], hi[a]), method="trf", x_scale=x0[a],
-                                    max_nfev=4 * max_iter + 4)
+                bounds = (np.log(lo[active]), np.log(hi[active]))
+                out = least_squares(fun, y0, jac=jac, bounds=bounds, method="trf", max_nfev=4 * max_iter + 4)
                 converged = out.status > 0
                 message = f"the optimizer converged to a best fit: {out.message}" if converged else out.message
             except _Reached:
@@ -397,7 +399,7 @@ def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], met
     elif not message:
         message = f"the tolerance was not reached in {max_iter} iterations"
     status = "finished" if reached or converged else "stopped"
-    return OptimizeResult(method, rows, initial, best, solves, reached, status, message,
+    return OptimizeResult(method, tolerance, rows, initial, best, solves, reached, status, message,
                           time.perf_counter() - t0)
 
 
@@ -410,7 +412,7 @@ def write_outputs(out: Path, design: ThicknessDesign, result: OptimizeResult,
     buf = ["iteration,objective,max_rel_deviation,forward_solves"]
     buf += [f"{i},{o!r},{d!r},{n}" for i, o, d, n in result.rows]
     write_atomic(out / "optimize.csv", "\n".join(buf) + "\n")
-    summary = {"method": result.method, "status": result.status, "message": result.message,
+    summary = {"method": result.method, "tolerance": result.tolerance, "status": result.status, "message": result.message,
                "reached": result.reached, "iterations": len(result.rows) - 1,
                "forward_solves": result.forward_solves, "wall_time_s": round(result.wall_time_s, 3),
                "objective": result.best.objective, "max_rel_deviation": result.best.deviation,
@@ -425,10 +427,11 @@ def write_outputs(out: Path, design: ThicknessDesign, result: OptimizeResult,
 
 def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResult,
                       target: tuple[np.ndarray, np.ndarray]) -> None:
-    """optimize.png: the section (initial and optimized parison, their final mid-surfaces and
-    the moulds), the initial and optimized wall straightened (faces at +-t/2 about the
-    mid-surface against s), the final thickness of both against the target, and the
-    objective per iteration."""
+    """optimize.png: the section (initial parison filled, optimized parison outlined, their
+    final mid-surfaces and the moulds), the initial and optimized wall straightened (faces at
+    +-t/2 about the mid-surface against s, the same way), the final thickness of both against
+    the target (the stations outside the target's range shaded), and the objective and the max
+    deviation of each iteration against the forward solves spent."""
     from .plots import _pyplot, _save
 
     plt = _pyplot()
@@ -443,7 +446,10 @@ def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResul
         f = model.mesh.fibres
         a, b = model.mesh.points[f[:, 0]], model.mesh.points[f[:, -1]]
         ring = np.vstack([a, b[::-1], a[:1]])
-        ax.fill(ring[:, 0], ring[:, 1], color=colour, alpha=0.5, lw=0.6, label=f"{name} parison")
+        if it is result.initial:
+            ax.fill(ring[:, 0], ring[:, 1], color=colour, alpha=0.5, lw=0, label=f"{name} parison")
+        else:
+            ax.plot(ring[:, 0], ring[:, 1], "-", color=colour, lw=0.9, label=f"{name} parison")
         if it.thickness is not None:
             ax.plot(it.thickness["r"], it.thickness["z"], "-", color=colour, lw=1.2, label=f"{name}: final wall")
     end = float(design.control.target)
@@ -460,7 +466,11 @@ def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResul
     s_fine = np.linspace(design.knots[0], design.knots[-1], 400)
     for values, _, colour, name in runs:
         t = np.interp(s_fine, design.knots, values)
-        ax.fill_between(s_fine, -t / 2, t / 2, color=colour, alpha=0.45, lw=0, label=f"{name} wall")
+        if values is design.initial:
+            ax.fill_between(s_fine, -t / 2, t / 2, color=colour, alpha=0.5, lw=0, label=f"{name} wall")
+        else:
+            ax.plot(s_fine, t / 2, "-", color=colour, lw=1.2, label=f"{name} wall")
+            ax.plot(s_fine, -t / 2, "-", color=colour, lw=1.2)
         ax.plot(design.knots, values / 2, "o", color=colour, ms=4)
     ax.axhline(0.0, color="k", lw=0.5)
     ax.set_xlabel("reference arc length s" + length)
@@ -470,6 +480,10 @@ def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResul
     ax = axes[1, 0]
     s_t, t_t = target
     top = [t_t.max()]
+    s_all = design.built.model.mesh.fibre_s
+    outside = [(a, b) for a, b in ((s_all[0], s_t[0]), (s_t[-1], s_all[-1])) if b > a]
+    for k, (a, b) in enumerate(outside):
+        ax.axvspan(a, b, color="0.9", lw=0, label=None if k else "not in the target")
     for _, it, colour, name in runs:
         if it.thickness is not None:
             ax.plot(it.thickness["s"], it.thickness["thickness"], ".-", color=colour, label=f"with the {name} design")
@@ -482,11 +496,12 @@ def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResul
                  f"{100 * result.best.deviation:.3g} %")
     ax.legend(fontsize=8)
     ax = axes[1, 1]
-    it = [r[0] for r in result.rows]
-    ax.semilogy(it, [r[1] for r in result.rows], "o-", color=blue, label="objective")
-    ax.semilogy(it, [r[2] for r in result.rows], "s--", color="C1", label="max relative deviation")
-    ax.set_xlabel("iteration")
-    ax.set_title(f"{result.method}: {result.forward_solves} forward solves")
+    solves = [r[3] for r in result.rows]  # the cost: rejected trials of the gradient method count too
+    ax.semilogy(solves, [r[1] for r in result.rows], "o-", color=blue, label="objective")
+    ax.semilogy(solves, [r[2] for r in result.rows], "s--", color="C1", label="max relative deviation")
+    ax.axhline(result.tolerance, color="C1", lw=0.8, ls=":", label=f"tolerance {result.tolerance:g}")
+    ax.set_xlabel("forward solves (a marker per iteration)")
+    ax.set_title(f"{result.method}: {len(result.rows) - 1} iterations, {result.forward_solves} forward solves")
     ax.xaxis.get_major_locator().set_params(integer=True)
     ax.legend(fontsize=8)
     fig.tight_layout()
