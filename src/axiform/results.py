@@ -60,7 +60,7 @@ class ResultsWriter:
                  vtu: bool = True, gid_files: bool = False, revolved: int = 0, plots: bool = True,
                  thickness_every: int | None = None, labels: dict | None = None,
                  case: dict | None = None, restart_every: int = 0, restart_meta: dict | None = None,
-                 resume: dict | None = None):
+                 resume: dict | None = None, plotter=None):
         """labels: units, load and monitor_quantities for summary.json (labels.case_labels);
         case: where the case came from and its fingerprint.  restart_every: write the step's
         checkpoint to restart/ every k steps (and at the end of the run, whatever stopped it),
@@ -75,6 +75,7 @@ class ResultsWriter:
         self.gid = gid_files
         self.revolved = revolved
         self.plots = plots
+        self.plotter = plotter
         self.thickness_every = thickness_every
         self.t0 = time.perf_counter()
         self.steps = 0
@@ -292,9 +293,11 @@ class ResultsWriter:
             self._write_revolved(self._last_step)
         self._write_summary()
         if self.plots and self.steps:
-            from .plots import plot_folder
+            if self.plotter is None:
+                from .plots import plot_folder
 
-            plot_folder(self.out)
+                self.plotter = plot_folder
+            self.plotter(self.out)
 
 
     def save_checkpoint(self) -> None:
