@@ -1,0 +1,65 @@
+"""The PNG plots of `axiform run` drawn by a second Python process, started before the model
+is built: it imports matplotlib (0.3 to 0.5 s, half of what the plots cost) on the other core
+while this one builds and solves, then waits for the results folder and draws its plots
+(`plots.plot_folder`) when the run ends.
+
+The second process ignores SIGINT (a Ctrl-C reaches the whole process group; the run winds
+up and still asks for its plots) and leaves without drawing when its input closes unasked,
+as it does when the run dies.
+"""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+from pathlib import Path
+from typing import Self
+
+# the folder containing the axiform package: the second process imports this same code
+_ROOT = str(Path(__file__).resolve().parent.parent)
+
+
+class PlotProcess:
+    """A plotting process for one run: `plot(folder)` once, or nothing (the `with` block's
+    end ends it)."""
+
+    def __init__(self):
+        code = f"import sys; sys.path.insert(0, {_ROOT!r}); from axiform.plot_process import serve; serve()"
+        self.proc = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+    def plot(self, folder: str | Path) -> list[Path]:
+        """Draw the plots of `folder` there; returns the files written.  RuntimeError with
+        the process's last line when it failed."""
+        out, err = self.proc.communicate(f"{folder}\n")
+        if self.proc.returncode != 0:
+            last = err.strip().splitlines()[-1] if err.strip() else f"exit code {self.proc.returncode}"
+            raise RuntimeError(f"plotting {folder} failed: {last}")
+        return [Path(line) for line in out.splitlines()]
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self.proc.returncode is None:  # never asked (an invalid case, a failed start)
+            self.proc.kill()
+            self.proc.communicate()
+
+
+def serve() -> None:
+    """The second process: import what the plots need, read one folder from stdin, plot it,
+    print the files written; nothing when stdin closes empty."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    import meshio  # noqa: F401 - read by plot_folder: imported while the run solves
+
+    import numpy as np
+
+    from .plots import _pyplot, plot_folder
+
+    _pyplot()
+    folder = sys.stdin.readline().strip()
+    if folder:
+        with np.errstate(all="ignore"):  # as in `axiform run`
+            for png in plot_folder(folder):
+                print(png)
