@@ -6,7 +6,8 @@ The solver is chosen by the size n of K (benchmarks/README.md § 3.2 measured ea
 - n <= DENSE_MAX: dense LAPACK LU (getrf / getrs), where the sparse solvers' fixed costs
   exceed the whole dense work;
 - larger: MKL PARDISO (matrix type 11, real non-symmetric) called through ctypes, phase 11
-  (METIS ordering, symbolic factorization) once for each sparsity pattern, then phase 22
+  (ordering: minimum degree below MINIMUM_DEGREE_MAX unknowns, METIS nested dissection
+  above; symbolic factorization) once for each sparsity pattern, then phase 22
   (numerical factorization) for each K and phase 33 for each solve.  pypardiso, which
   installs MKL, redoes phase 11 on every factorization, and its import scans site-packages
   (0.1 to 0.5 s): only the library it brings is used here, found when first needed;
@@ -38,6 +39,9 @@ import scipy.sparse as sp
 
 DENSE_MAX = 150  # largest n factorized as a dense matrix
 PARALLEL_MIN = 2000  # smallest n that PARDISO factorizes with MKL's threads (smaller: one thread)
+# largest n ordered by minimum degree: Q8 at 1e3 unknowns factorizes 9 to 14 % faster than with
+# METIS, Q4 and SFR alike; from 3e3 on METIS wins for Q4 and SFR (benchmarks/README.md § 3.2)
+MINIMUM_DEGREE_MAX = 2000
 
 Solve = Callable[[np.ndarray], np.ndarray]
 
@@ -106,7 +110,7 @@ class _Pardiso:
         self.pt = np.zeros(64, dtype=np.int64)
         self.iparm = np.zeros(64, dtype=np.int32)
         self.iparm[0] = 1  # the values below, not the defaults
-        self.iparm[1] = 2  # nested dissection (METIS)
+        self.iparm[1] = 2  # nested dissection (METIS); minimum degree (0) for small n: analyse()
         self.iparm[7] = 0  # iterative refinement only where pivots were perturbed
         self.iparm[9] = 13  # pivots below 1e-13 |K| are perturbed (and counted: iparm[13])
         self.iparm[10] = 1  # scaling and
@@ -152,6 +156,7 @@ class _Pardiso:
         self.release()
         self.n = K.shape[0]
         self.threads = 1 if self.n < PARALLEL_MIN else 0
+        self.iparm[1] = 0 if self.n <= MINIMUM_DEGREE_MAX else 2
         self._src_indptr, self._src_indices = K.indptr, K.indices
         self.indptr = np.ascontiguousarray(K.indptr, dtype=np.int32)
         self.indices = np.ascontiguousarray(K.indices, dtype=np.int32)
