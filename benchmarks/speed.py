@@ -4,7 +4,7 @@ tables measured side by side in one run.
 
     .venv/bin/python benchmarks/speed.py --before /tmp/axiform-before/src          # everything
     .venv/bin/python benchmarks/speed.py --before /tmp/axiform-before/src --only process newton
-    git worktree add --detach /tmp/axiform-before 540a80b   # the code before issue 9
+    git worktree add --detach /tmp/axiform-before 92e1edc   # the code before (the last round: 540a80b)
 
 Sections (each a table in benchmarks/results/speed.md):
 - process: the whole process of the plate Q8 4x40 to w = 8 in (`axiform run`, a fresh Python
@@ -177,7 +177,9 @@ def timed(cmd: list[str], env: dict | None = None, cwd: Path | None = None) -> t
 
 
 def env_for(src: Path, threads_one: bool = True) -> dict:
-    env = dict(os.environ, PYTHONPATH=str(src))
+    """The environment of a child on the source tree src: src first on the path, then the
+    caller's PYTHONPATH (where a peer such as FElupe may be installed)."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(src), os.environ.get("PYTHONPATH")])))
     if threads_one:
         env.update(ONE_THREAD)
     return env
@@ -342,7 +344,7 @@ def section_sweep(tmp: Path) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--before", help="the src/ folder of the code before (a git worktree of 540a80b)")
+    ap.add_argument("--before", help="the src/ folder of the code before (a git worktree of an earlier commit)")
     ap.add_argument("--only", nargs="*", default=["process", "newton", "memory", "sweep"])
     ap.add_argument("--repeat", type=int, default=5, help="repeats of the process runs (interleaved)")
     ap.add_argument("--big", type=int, default=223, help="ring divisions for the 1e5-dof rows (223: Q4 1e5 dofs)")
