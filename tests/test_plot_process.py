@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from axiform.cli import run
-from axiform.plot_process import PlotProcess
+from axiform.plot_process import PlotProcess, idle_core
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 SRC = Path(__file__).resolve().parents[1] / "src"
@@ -30,9 +30,9 @@ def test_a_run_plots_in_a_second_process(tmp_path):
     assert all((out / png).exists() for png in PNGS)
 
 
-def test_the_command_plots_in_a_second_process(tmp_path):
-    """`axiform run` from a shell: matplotlib is not in the process, the plots come from the
-    second one, which is gone when the command returns."""
+def test_the_command_plots(tmp_path):
+    """`axiform run` from a shell: the plots come from a second process when a core is idle
+    (idle_core), from this one otherwise: the same files, no process left behind."""
     out = tmp_path / "plate"
     env = {**os.environ, "PYTHONPATH": str(SRC)}
     proc = subprocess.run([sys.executable, "-m", "axiform.cli", "run", str(EXAMPLES / "hughes_carnoy_plate.toml"),
@@ -56,3 +56,11 @@ def test_an_unused_plot_process_ends_with_its_block():
         with PlotProcess() as waiting:
             waiting.proc.wait(timeout=0.2)
     assert waiting.proc.returncode is not None
+
+
+def test_idle_core_reads_the_load(monkeypatch):
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1}, raising=False)
+    monkeypatch.setattr(os, "getloadavg", lambda: (0.4, 0.0, 0.0))
+    assert idle_core()
+    monkeypatch.setattr(os, "getloadavg", lambda: (1.3, 0.0, 0.0))
+    assert not idle_core()

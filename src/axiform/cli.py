@@ -463,9 +463,12 @@ def main(argv: list[str] | None = None) -> int:
             if args.command == "plot":
                 return plot(args.folder, args.field, args.animate)
             if args.command == "run":
-                # a second process pays when this one would have to import matplotlib for the plots
+                from .plot_process import idle_core
+
+                # a second process pays when this one would have to import matplotlib for the
+                # plots and a core is idle to do it while the model is built and solved
                 return run(args.case, args.out, args.quiet, args.set, args.resume,
-                           plot_process="matplotlib" not in sys.modules)
+                           plot_process="matplotlib" not in sys.modules and idle_core())
             return check(args.case, args.set)
     except KeyboardInterrupt:
         _say("axiform: interrupted")

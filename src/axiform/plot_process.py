@@ -1,5 +1,5 @@
 """The PNG plots of `axiform run` drawn by a second Python process, started before the model
-is built: it imports matplotlib (0.3 to 0.5 s, half of what the plots cost) on the other core
+is built when a core is idle (`idle_core`): it imports matplotlib (0.3 to 0.5 s, half of what the plots cost) on the other core
 while this one builds and solves, then waits for the results folder and draws its plots
 (`plots.plot_folder`) when the run ends.  While it waits it draws a small figure to memory
 (fonts loaded, caches filled: the plots then take 0.1 to 0.25 s less).
@@ -11,6 +11,7 @@ as it does when the run dies.
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
@@ -19,6 +20,18 @@ from typing import Self
 
 # the folder containing the axiform package: the second process imports this same code
 _ROOT = str(Path(__file__).resolve().parent.parent)
+
+
+def idle_core() -> bool:
+    """True when a core is free for a second process: the cores this process may run on less
+    the load average of the last minute leave at least one (Linux, macOS; False elsewhere).
+    On a busy machine the second process only adds its own start (0.2 to 0.35 s of CPU:
+    Python, NumPy, a figure) to the work (benchmarks/README.md § 3.5)."""
+    try:
+        cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+        return cores - os.getloadavg()[0] >= 1.0
+    except OSError:
+        return False
 
 
 class PlotProcess:
