@@ -14,7 +14,7 @@ Sections (each a table in benchmarks/results/speed.md):
   on the same mesh, the same 44 pressures, default and tight tolerances);
   `import axiform.cli` alone.  Interleaved repeats, minimum wall time of each.
 - newton: one Newton iteration (evaluate + factorize + solve with two right-hand sides) at
-  about 1e3 and 1e5 dofs, Q4 and SFR, displacement and mixed formulation, on the ring of
+  about 1e3 and 1e5 dofs, Q4, SFR and Q8, displacement and mixed formulation, on the ring of
   _perf_common.py, before / after (the same code run in a subprocess on each source tree).
 - memory: RSS after each of 10 steps and the peak, SFR at 1e5 dofs, before / after.
 - sweep: 8 plate cases (Q8 4x40, C1 and the target varied) by `axiform run` one after another
@@ -178,8 +178,11 @@ def timed(cmd: list[str], env: dict | None = None, cwd: Path | None = None) -> t
 
 def env_for(src: Path, threads_one: bool = True) -> dict:
     """The environment of a child on the source tree src: src first on the path, then the
-    caller's PYTHONPATH (where a peer such as FElupe may be installed)."""
+    caller's PYTHONPATH (where a peer such as FElupe may be installed); Python's bytecode
+    cache on, as in an installed package (PYTHONDONTWRITEBYTECODE set would recompile
+    axiform's 40-odd modules in every run: 0.1 s)."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(src), os.environ.get("PYTHONPATH")])))
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
     if threads_one:
         env.update(ONE_THREAD)
     return env
@@ -360,7 +363,7 @@ def main(argv=None) -> int:
             parts += ["## Whole process: the plate, Q8 4x40, w to 8 in\n", section_process(trees, args.repeat, tmp), ""]
             print(parts[-2], flush=True)
         if "newton" in args.only:
-            sizes = {"q4": [21, args.big], "sfr": [17, int(args.big / 1.2247)]}
+            sizes = {"q4": [21, args.big], "sfr": [17, int(args.big / 1.2247)], "q8": [12, int(args.big / 1.73)]}
             parts += ["## One Newton iteration (CPU ms, one thread)\n", section_newton(trees, sizes, 200, tmp), ""]
             print(parts[-2], flush=True)
         if "memory" in args.only:
