@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from axiform.cli import run
-from axiform.plot_process import PlotProcess, idle_core
+from axiform.plot_process import PlotProcess, draw_in_parallel, idle_cores
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 SRC = Path(__file__).resolve().parents[1] / "src"
@@ -32,7 +32,7 @@ def test_a_run_plots_in_a_second_process(tmp_path):
 
 def test_the_command_plots(tmp_path):
     """`axiform run` from a shell: the plots come from a second process when a core is idle
-    (idle_core), from this one otherwise: the same files, no process left behind."""
+    (idle_cores), from this one otherwise: the same files, no process left behind."""
     out = tmp_path / "plate"
     env = {**os.environ, "PYTHONPATH": str(SRC)}
     proc = subprocess.run([sys.executable, "-m", "axiform.cli", "run", str(EXAMPLES / "hughes_carnoy_plate.toml"),
@@ -58,9 +58,26 @@ def test_an_unused_plot_process_ends_with_its_block():
     assert waiting.proc.returncode is not None
 
 
-def test_idle_core_reads_the_load(monkeypatch):
+def test_idle_cores_read_the_load(monkeypatch):
     monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1}, raising=False)
     monkeypatch.setattr(os, "getloadavg", lambda: (0.4, 0.0, 0.0))
-    assert idle_core()
-    monkeypatch.setattr(os, "getloadavg", lambda: (1.3, 0.0, 0.0))
-    assert not idle_core()
+    assert idle_cores() == pytest.approx(1.6)
+
+
+def test_drawing_in_parallel_keeps_the_order_and_reports_a_failure(tmp_path):
+    def draw(name):
+        def job():
+            (tmp_path / name).write_text(name)
+            return tmp_path / name
+        return job
+
+    def nothing():
+        return None
+
+    def broken():
+        raise ValueError("no such field")
+
+    assert draw_in_parallel([draw("a"), nothing, draw("b"), draw("c")]) == [tmp_path / n for n in "abc"]
+    assert (tmp_path / "c").read_text() == "c"
+    with pytest.raises(RuntimeError, match="ValueError: no such field"):
+        draw_in_parallel([draw("d"), broken])

@@ -463,12 +463,12 @@ def main(argv: list[str] | None = None) -> int:
             if args.command == "plot":
                 return plot(args.folder, args.field, args.animate)
             if args.command == "run":
-                from .plot_process import idle_core
+                from .plot_process import idle_cores
 
                 # a second process pays when this one would have to import matplotlib for the
                 # plots and a core is idle to do it while the model is built and solved
                 return run(args.case, args.out, args.quiet, args.set, args.resume,
-                           plot_process="matplotlib" not in sys.modules and idle_core())
+                           plot_process="matplotlib" not in sys.modules and idle_cores() >= 1.0)
             return check(args.case, args.set)
     except KeyboardInterrupt:
         _say("axiform: interrupted")
