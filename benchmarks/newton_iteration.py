@@ -80,11 +80,10 @@ def _src(K):
 
 def src_solver() -> str:
     """What axiform.linsolve.factorize uses on this machine."""
-    if linsolve._pypardiso is None:
-        return "SciPy SuperLU, permc_spec MMD_ATA (pypardiso is not installed)"
-    from importlib.metadata import version
-
-    return f"MKL PARDISO, matrix type 11, through pypardiso {version('pypardiso')}"
+    if linsolve._mkl() is None:
+        return "SciPy SuperLU, permc_spec MMD_ATA (MKL is not installed)"
+    return ("MKL PARDISO, matrix type 11, through ctypes (analysis kept per pattern; minimum degree "
+            f"up to {linsolve.MINIMUM_DEGREE_MAX} unknowns, METIS above)")
 
 
 def _umfpack():
@@ -165,7 +164,7 @@ def run(element: str, dof_targets: list[int], names: list[str], repeat: int, bud
         u_f, lam = deformed_state(model)
         n = model.n_free
         ev = model.evaluate(u_f, lam)
-        K = ev.K
+        K = ev.K.tocsr()  # SciPy's, for the solvers compared
         B = np.column_stack([-ev.r, -ev.dr_dlam])
         reps = repeat if n <= 150_000 else 1
         t_eval = None
@@ -230,7 +229,7 @@ def sensitivity(element: str, target: int, names: list[str], log) -> str:
         model = build_model(element, divisions_for_dofs(element, target), pressed=pressed)
         for seed, noise in ((0, 0.01), (1, 0.01), (2, 0.03)):
             u_f, lam = deformed_state(model, seed=seed, noise=noise)
-            K = model.evaluate(u_f, lam).K
+            K = model.evaluate(u_f, lam).K.tocsr()
             cells = [f"{'half' if pressed < 1 else 'whole'} face, seed {seed}, noise {noise:g} h",
                      f"{abs(K - K.T).max() / abs(K).max():.0e}"]
             for name in names:
@@ -263,7 +262,7 @@ def singular(element: str, names: list[str], log) -> str:
     model.finalize()
     u_f, lam = deformed_state(model)
     ev = model.evaluate(u_f, lam)
-    K, b = ev.K, -ev.r
+    K, b = ev.K.tocsr(), -ev.r
     rows = []
     for name in names:
         try:

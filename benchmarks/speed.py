@@ -4,7 +4,7 @@ tables measured side by side in one run.
 
     .venv/bin/python benchmarks/speed.py --before /tmp/axiform-before/src          # everything
     .venv/bin/python benchmarks/speed.py --before /tmp/axiform-before/src --only process newton
-    git worktree add --detach /tmp/axiform-before 540a80b   # the code before issue 9
+    git worktree add --detach /tmp/axiform-before 92e1edc   # the code before (the last round: 540a80b)
 
 Sections (each a table in benchmarks/results/speed.md):
 - process: the whole process of the plate Q8 4x40 to w = 8 in (`axiform run`, a fresh Python
@@ -14,7 +14,7 @@ Sections (each a table in benchmarks/results/speed.md):
   on the same mesh, the same 44 pressures, default and tight tolerances);
   `import axiform.cli` alone.  Interleaved repeats, minimum wall time of each.
 - newton: one Newton iteration (evaluate + factorize + solve with two right-hand sides) at
-  about 1e3 and 1e5 dofs, Q4 and SFR, displacement and mixed formulation, on the ring of
+  about 1e3 and 1e5 dofs, Q4, SFR and Q8, displacement and mixed formulation, on the ring of
   _perf_common.py, before / after (the same code run in a subprocess on each source tree).
 - memory: RSS after each of 10 steps and the peak, SFR at 1e5 dofs, before / after.
 - sweep: 8 plate cases (Q8 4x40, C1 and the target varied) by `axiform run` one after another
@@ -177,7 +177,12 @@ def timed(cmd: list[str], env: dict | None = None, cwd: Path | None = None) -> t
 
 
 def env_for(src: Path, threads_one: bool = True) -> dict:
-    env = dict(os.environ, PYTHONPATH=str(src))
+    """The environment of a child on the source tree src: src first on the path, then the
+    caller's PYTHONPATH (where a peer such as FElupe may be installed); Python's bytecode
+    cache on, as in an installed package (PYTHONDONTWRITEBYTECODE set would recompile
+    axiform's 40-odd modules in every run: 0.1 s)."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(src), os.environ.get("PYTHONPATH")])))
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
     if threads_one:
         env.update(ONE_THREAD)
     return env
@@ -342,7 +347,7 @@ def section_sweep(tmp: Path) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--before", help="the src/ folder of the code before (a git worktree of 540a80b)")
+    ap.add_argument("--before", help="the src/ folder of the code before (a git worktree of an earlier commit)")
     ap.add_argument("--only", nargs="*", default=["process", "newton", "memory", "sweep"])
     ap.add_argument("--repeat", type=int, default=5, help="repeats of the process runs (interleaved)")
     ap.add_argument("--big", type=int, default=223, help="ring divisions for the 1e5-dof rows (223: Q4 1e5 dofs)")
@@ -358,7 +363,7 @@ def main(argv=None) -> int:
             parts += ["## Whole process: the plate, Q8 4x40, w to 8 in\n", section_process(trees, args.repeat, tmp), ""]
             print(parts[-2], flush=True)
         if "newton" in args.only:
-            sizes = {"q4": [21, args.big], "sfr": [17, int(args.big / 1.2247)]}
+            sizes = {"q4": [21, args.big], "sfr": [17, int(args.big / 1.2247)], "q8": [12, int(args.big / 1.73)]}
             parts += ["## One Newton iteration (CPU ms, one thread)\n", section_newton(trees, sizes, 200, tmp), ""]
             print(parts[-2], flush=True)
         if "memory" in args.only:

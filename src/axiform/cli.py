@@ -19,13 +19,16 @@ import sys
 import threading
 import time
 import traceback
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from typing import Self
 
 from . import __version__
 
 EXIT = {"finished": 0, "stopped": 1, "failed": 3}
+# history.csv, summary.json, thickness.csv and fields.pvd are rewritten at most every half
+# second (and whenever the run ends): four atomic rewrites a step (benchmarks/README.md § 3.1)
+FLUSH_EVERY_S = 0.5
 
 
 class Interrupted(Exception):
@@ -172,27 +175,33 @@ def _resume_state(folder: Path, data: dict) -> dict:
 
 
 def run(case_path: str, out: str | None, quiet: bool = False, overrides: list[str] = (),
-        resume: str | None = None) -> int:
-    """Read, check, solve and write a case (or resume a run in its folder); returns the exit code."""
-    with Stops() as stops:
+        resume: str | None = None, plot_process: bool = False) -> int:
+    """Read, check, solve and write a case (or resume a run in its folder); returns the exit code.
+    plot_process: the PNG plots drawn by a second process that imports matplotlib while this
+    one solves (plot_process.py; `axiform run` does, a sweep's worker plots in its own process)."""
+    with Stops() as stops, ExitStack() as stack:
         try:
-            return _run(Path(case_path), out, quiet, list(overrides), stops, resume)
+            return _run(Path(case_path), out, quiet, list(overrides), stops, resume, stack if plot_process else None)
         except Interrupted as exc:  # before the results folder was there
             _say(f"axiform: {exc} before the first step")
             return 128 + exc.signum
 
 
 def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], stops: Stops,
-         resume: str | None = None) -> int:
+         resume: str | None = None, stack: ExitStack | None = None) -> int:
     from .case import CaseError, build, fingerprint, parse, read
     from .labels import case_labels
     from .results import NonFiniteResult, ResultsWriter
     from .solver import StepFailed, solve
 
-    state = None
+    state = plotter = None
     try:
         data = read(case_file, overrides)
         case = parse(data)
+        if stack is not None and case.output.plots:  # before the model is built
+            from .plot_process import PlotProcess
+
+            plotter = stack.enter_context(PlotProcess()).plot
         if resume is not None:
             if out is not None and Path(out).resolve() != Path(resume).resolve():
                 raise CaseError("--out: a resumed run writes in the folder it resumes (--resume)")
@@ -239,7 +248,8 @@ def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], st
                                        gid_files=o.gid, revolved=o.revolved, plots=o.plots,
                                        thickness_every=o.thickness_every, labels=case_labels(case),
                                        case={"file": str(case_file), "overrides": overrides, "sha256": digest},
-                                       restart_every=case.restart.every, restart_meta=restart_meta, resume=state)
+                                       restart_every=case.restart.every, restart_meta=restart_meta, resume=state,
+                                       plotter=plotter, flush_every_s=FLUSH_EVERY_S)
         except (ValueError, KeyError) as exc:
             return _invalid(case_file, CaseError(f"--resume: {exc}"))
     try:
@@ -248,7 +258,8 @@ def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], st
                                    gid_files=o.gid, revolved=o.revolved, plots=o.plots,
                                    thickness_every=o.thickness_every, labels=case_labels(case),
                                    case={"file": str(case_file), "overrides": overrides, "sha256": digest},
-                                   restart_every=case.restart.every, restart_meta=restart_meta, resume=state)
+                                   restart_every=case.restart.every, restart_meta=restart_meta, resume=state,
+                                   plotter=plotter, flush_every_s=FLUSH_EVERY_S)
         if not quiet:
             _say(f"axiform {__version__}: {case.title or case_file.name}: {model.mesh.n_cells} "
                  f"{model.mesh.element.name} elements, {model.n_free} free dofs -> {out_dir}{note}")
@@ -452,7 +463,12 @@ def main(argv: list[str] | None = None) -> int:
             if args.command == "plot":
                 return plot(args.folder, args.field, args.animate)
             if args.command == "run":
-                return run(args.case, args.out, args.quiet, args.set, args.resume)
+                from .plot_process import idle_cores
+
+                # a second process pays when this one would have to import matplotlib for the
+                # plots and a core is idle to do it while the model is built and solved
+                return run(args.case, args.out, args.quiet, args.set, args.resume,
+                           plot_process="matplotlib" not in sys.modules and idle_cores() >= 1.0)
             return check(args.case, args.set)
     except KeyboardInterrupt:
         _say("axiform: interrupted")

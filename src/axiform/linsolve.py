@@ -6,7 +6,8 @@ The solver is chosen by the size n of K (benchmarks/README.md § 3.2 measured ea
 - n <= DENSE_MAX: dense LAPACK LU (getrf / getrs), where the sparse solvers' fixed costs
   exceed the whole dense work;
 - larger: MKL PARDISO (matrix type 11, real non-symmetric) called through ctypes, phase 11
-  (METIS ordering, symbolic factorization) once for each sparsity pattern, then phase 22
+  (ordering: minimum degree below MINIMUM_DEGREE_MAX unknowns, METIS nested dissection
+  above; symbolic factorization) once for each sparsity pattern, then phase 22
   (numerical factorization) for each K and phase 33 for each solve.  pypardiso, which
   installs MKL, redoes phase 11 on every factorization, and its import scans site-packages
   (0.1 to 0.5 s): only the library it brings is used here, found when first needed;
@@ -31,13 +32,18 @@ import glob
 import os
 import sys
 import threading
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
-import scipy.sparse as sp
+
+if TYPE_CHECKING:  # K: csr.CSRMatrix or any SciPy sparse matrix; scipy.sparse imported only for SuperLU
+    import scipy.sparse as sp
 
 DENSE_MAX = 150  # largest n factorized as a dense matrix
 PARALLEL_MIN = 2000  # smallest n that PARDISO factorizes with MKL's threads (smaller: one thread)
+# largest n ordered by minimum degree: Q8 at 1e3 unknowns factorizes 9 to 14 % faster than with
+# METIS, Q4 and SFR alike; from 3e3 on METIS wins for Q4 and SFR (benchmarks/README.md § 3.2)
+MINIMUM_DEGREE_MAX = 2000
 
 Solve = Callable[[np.ndarray], np.ndarray]
 
@@ -56,25 +62,31 @@ def _check(x: np.ndarray) -> np.ndarray:
 _MKL: ctypes.CDLL | None | bool = False  # False: not looked for yet; None: not found
 
 
+def _mkl_candidates():
+    """Paths to try for libmkl_rt, in order: $PYPARDISO_MKL_RT, the library folder of this
+    Python's prefix (where the mkl wheel installs it), the linker's path (asked last, only
+    when needed: find_library runs ldconfig, gcc and ld, 0.02 to 0.05 s)."""
+    yield os.environ.get("PYPARDISO_MKL_RT")
+    for prefix in dict.fromkeys((sys.prefix, sys.base_prefix)):
+        yield from sorted(glob.glob(os.path.join(prefix, "lib", "libmkl_rt.so*")), key=len)
+        yield from sorted(glob.glob(os.path.join(prefix, "Library", "bin", "mkl_rt*.dll")), key=len)
+    import ctypes.util
+
+    yield ctypes.util.find_library("mkl_rt")
+    yield ctypes.util.find_library("mkl_rt.1")
+
+
 def _mkl() -> ctypes.CDLL | None:
-    """MKL's runtime library (libmkl_rt), looked for once: $PYPARDISO_MKL_RT, the library
-    folder of this Python's prefix (where the mkl wheel installs it), the linker's path."""
+    """MKL's runtime library (libmkl_rt), looked for once (_mkl_candidates)."""
     global _MKL
     if _MKL is not False:
         return _MKL
-    candidates = [os.environ.get("PYPARDISO_MKL_RT")]
-    for prefix in dict.fromkeys((sys.prefix, sys.base_prefix)):
-        candidates += sorted(glob.glob(os.path.join(prefix, "lib", "libmkl_rt.so*")), key=len)
-        candidates += sorted(glob.glob(os.path.join(prefix, "Library", "bin", "mkl_rt*.dll")), key=len)
-    import ctypes.util
-
-    candidates += [ctypes.util.find_library("mkl_rt"), ctypes.util.find_library("mkl_rt.1")]
     # MKL's OpenMP threads otherwise spin 200 ms after each factorization, on the core that
     # the evaluation between two factorizations needs (on a loaded machine the plate's solve
     # took twice as long); read when the runtime starts, so set before the library loads
     os.environ.setdefault("KMP_BLOCKTIME", "0")
     _MKL = None
-    for path in filter(None, candidates):
+    for path in filter(None, _mkl_candidates()):
         try:
             lib = ctypes.CDLL(path)
             lib.pardiso.restype = None
@@ -106,7 +118,7 @@ class _Pardiso:
         self.pt = np.zeros(64, dtype=np.int64)
         self.iparm = np.zeros(64, dtype=np.int32)
         self.iparm[0] = 1  # the values below, not the defaults
-        self.iparm[1] = 2  # nested dissection (METIS)
+        self.iparm[1] = 2  # nested dissection (METIS); minimum degree (0) for small n: analyse()
         self.iparm[7] = 0  # iterative refinement only where pivots were perturbed
         self.iparm[9] = 13  # pivots below 1e-13 |K| are perturbed (and counted: iparm[13])
         self.iparm[10] = 1  # scaling and
@@ -152,6 +164,7 @@ class _Pardiso:
         self.release()
         self.n = K.shape[0]
         self.threads = 1 if self.n < PARALLEL_MIN else 0
+        self.iparm[1] = 0 if self.n <= MINIMUM_DEGREE_MAX else 2
         self._src_indptr, self._src_indices = K.indptr, K.indices
         self.indptr = np.ascontiguousarray(K.indptr, dtype=np.int32)
         self.indices = np.ascontiguousarray(K.indices, dtype=np.int32)
@@ -258,7 +271,8 @@ def _factorize_dense(K: sp.spmatrix) -> Solve:
 
 
 def factorize(K: sp.spmatrix) -> Solve:
-    """A function b -> K^-1 b for b (n,) or several right-hand sides (n, k)."""
+    """A function b -> K^-1 b for b (n,) or several right-hand sides (n, k); K a csr.CSRMatrix
+    (Model.evaluate's) or any SciPy sparse matrix."""
     n = K.shape[0]
     if n <= DENSE_MAX:
         return _factorize_dense(K)

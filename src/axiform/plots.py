@@ -12,8 +12,9 @@ from __future__ import annotations
 import csv
 import json
 from dataclasses import dataclass, field as dc_field
+from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 from xml.etree import ElementTree as ET
 
 import numpy as np
@@ -459,20 +460,28 @@ def _save(fig, out: Path) -> Path | None:
     return out
 
 
-def plot_folder(folder: str | Path, field: str = "von_mises", animation: bool = False) -> list[Path]:
-    """Every picture the folder's files allow (and forming.gif if asked); returns the files
-    written."""
+def plot_jobs(folder: str | Path, field: str = "von_mises", animation: bool = False) -> list[Callable[[], Path | None]]:
+    """The pictures the folder's files allow (and forming.gif if asked), each a function
+    that draws it and returns its file (None when there is nothing to draw): independent of
+    each other, so that they can be drawn in parallel (plot_process)."""
     folder = Path(folder)
     info = FolderInfo.read(folder)
     history = read_history(folder / "history.csv") if (folder / "history.csv").exists() else {}
-    made = []
+    jobs = []
     if history:
-        made.append(plot_load_curves(folder / "history.csv", folder / "load_curve.png", info))
+        jobs.append(partial(plot_load_curves, folder / "history.csv", folder / "load_curve.png", info))
     if (folder / "thickness.csv").exists():
-        made.append(plot_thickness(folder / "thickness.csv", folder / "thickness.png", info, history))
+        jobs.append(partial(plot_thickness, folder / "thickness.csv", folder / "thickness.png", info, history))
     vtu = last_vtu(folder)
     if vtu is not None and vtu.exists():
-        made.append(plot_deformed(vtu, folder / "deformed.png", field, _surfaces_of(vtu), info, history))
+        jobs.append(partial(plot_deformed, vtu, folder / "deformed.png", field, _surfaces_of(vtu), info, history))
     if animation:
-        made.append(animate(folder, folder / "forming.gif", info))
+        jobs.append(partial(animate, folder, folder / "forming.gif", info))
+    return jobs
+
+
+def plot_folder(folder: str | Path, field: str = "von_mises", animation: bool = False) -> list[Path]:
+    """Every picture the folder's files allow (and forming.gif if asked); returns the files
+    written."""
+    made = [job() for job in plot_jobs(folder, field, animation)]
     return [p for p in made if p is not None]

@@ -27,6 +27,7 @@ import numpy as np
 from . import gid
 from .fields import point_fields
 from .thickness import thickness_table, write_thickness_csv
+from .vtu import write_vtu
 
 
 @contextmanager
@@ -60,12 +61,18 @@ class ResultsWriter:
                  vtu: bool = True, gid_files: bool = False, revolved: int = 0, plots: bool = True,
                  thickness_every: int | None = None, labels: dict | None = None,
                  case: dict | None = None, restart_every: int = 0, restart_meta: dict | None = None,
-                 resume: dict | None = None):
+                 resume: dict | None = None, plotter=None, flush_every_s: float = 0.0):
         """labels: units, load and monitor_quantities for summary.json (labels.case_labels);
         case: where the case came from and its fingerprint.  restart_every: write the step's
         checkpoint to restart/ every k steps (and at the end of the run, whatever stopped it),
         with restart_meta beside it.  resume: the checkpoint a resumed run starts from: the
-        folder's rows and files up to its step are kept, later ones dropped."""
+        folder's rows and files up to its step are kept, later ones dropped.  plotter: draws
+        the plots at the end, folder -> files (plot_process.PlotProcess.plot); by default
+        plots.plot_folder in this process.  flush_every_s: history.csv, summary.json,
+        thickness.csv and fields.pvd are rewritten after a step when that long has passed
+        since they last were (0: after every step), before every checkpoint and by `finish`,
+        whatever ended the run: a run that never reaches `finish` (kill -9) loses at most
+        that long of rows."""
         self.out = Path(out)
         self.out.mkdir(parents=True, exist_ok=True)
         self.model = model
@@ -75,6 +82,11 @@ class ResultsWriter:
         self.gid = gid_files
         self.revolved = revolved
         self.plots = plots
+        self.plotter = plotter
+        self.flush_every_s = flush_every_s
+        self._flushed = -np.inf  # time of the last flush: the first step is written at once
+        self._thickness = None  # the table of the last field step, not yet in thickness.csv
+        self._pvd_written = 0  # entries of self._pvd in fields.pvd
         self.thickness_every = thickness_every
         self.t0 = time.perf_counter()
         self.steps = 0
@@ -170,15 +182,34 @@ class ResultsWriter:
             if not np.isfinite(v):
                 raise NonFiniteResult(f"step {step.number}: monitor {name} is {v}: not written")
 
+    def _flush(self) -> None:
+        """Rewrite history.csv, thickness.csv and fields.pvd if they changed, then
+        summary.json (whose `steps` the others then hold)."""
+        write_atomic(self.out / "history.csv", self._history.getvalue())
+        if self._thickness is not None:
+            with atomic(self.out / "thickness.csv") as tmp:
+                write_thickness_csv(tmp, self._thickness)
+            self._thickness = None
+        if self._pvd_written != len(self._pvd):
+            root = ET.Element("VTKFile", type="Collection", version="0.1")
+            coll = ET.SubElement(root, "Collection")
+            for t, f in self._pvd:
+                ET.SubElement(coll, "DataSet", timestep=repr(t), part="0", file=f)
+            with atomic(self.out / "fields.pvd") as tmp:
+                ET.ElementTree(root).write(tmp)
+            self._pvd_written = len(self._pvd)
+        self._write_summary()
+        self._flushed = time.perf_counter()
+
     def step(self, step) -> dict[str, float]:
         """Record a converged step; returns the monitor values.  history.csv and summary.json
-        are rewritten whole (atomically), so they always parse; a step holding NaN or inf
-        raises NonFiniteResult and nothing of it is written."""
+        are rewritten whole (atomically), so they always parse, after this step or within
+        flush_every_s; a step holding NaN or inf raises NonFiniteResult and nothing of it is
+        written."""
         values = {m.name: m.value(step) for m in self.monitors}
         self._guard(step, values)
         self._csv.writerow([step.number, repr(float(step.lam)), step.iterations]
                            + [repr(v) for v in values.values()])
-        write_atomic(self.out / "history.csv", self._history.getvalue())
         if self.model.contacts:
             self._write_contact(step)
         self.steps = step.number
@@ -195,8 +226,10 @@ class ResultsWriter:
         self._last_step = step
         self._checkpoint = step.checkpoint
         if self.restart_every and step.checkpoint is not None and step.number % self.restart_every == 0:
+            self._flush()  # the checkpoint's rows first: a resumed run keeps them
             self.save_checkpoint()
-        self._write_summary()
+        if time.perf_counter() - self._flushed >= self.flush_every_s:
+            self._flush()
         return values
 
     def _write_contact(self, step):
@@ -223,10 +256,7 @@ class ResultsWriter:
         mesh = self.model.mesh
         self._last_written = step.number
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
-        table = thickness_table(mesh, u, self.model.contacts)
-        if table is not None:
-            with atomic(self.out / "thickness.csv") as tmp:
-                write_thickness_csv(tmp, table)
+        self._thickness = thickness_table(mesh, u, self.model.contacts)
         if self.vtu and self.model.contacts:
             write_atomic(self.out / "fields" / f"surfaces_{step.number:04d}.csv",
                          mould_outlines(self.model.contacts, float(step.lam)))
@@ -240,20 +270,10 @@ class ResultsWriter:
                 gid.append_results(tmp, step.number, data)
         if not self.vtu:
             return
-        import meshio  # here: 0.1 s to import, for VTU files only
-
-        cell_type = "quad8" if mesh.element.nodes == 8 else "quad"
-        pts = np.column_stack([mesh.points, np.zeros(mesh.n_nodes)])
         name = f"step_{step.number:04d}.vtu"
         with atomic(self.out / "fields" / name) as tmp:
-            meshio.write(tmp, meshio.Mesh(pts, [(cell_type, mesh.cells)], point_data=data), file_format="vtu")
+            write_vtu(tmp, mesh.points, mesh.cells, data)
         self._pvd.append((float(step.number), f"fields/{name}"))
-        root = ET.Element("VTKFile", type="Collection", version="0.1")
-        coll = ET.SubElement(root, "Collection")
-        for t, f in self._pvd:
-            ET.SubElement(coll, "DataSet", timestep=repr(t), part="0", file=f)
-        with atomic(self.out / "fields.pvd") as tmp:
-            ET.ElementTree(root).write(tmp)
 
     def _write_thickness_step(self, step):
         """thickness/step_NNNN.csv: the thickness table of one step."""
@@ -279,7 +299,7 @@ class ResultsWriter:
         self.summary["status"] = status
         if message:
             self.summary["message"] = message
-        self._write_summary()
+        self._flush()
         if self.restart_every:
             self.save_checkpoint()
         if not hasattr(self, "_last_step"):  # a resumed run that added no step
@@ -290,11 +310,13 @@ class ResultsWriter:
             self._write_thickness_step(self._last_step)
         if self.steps and self.revolved:
             self._write_revolved(self._last_step)
-        self._write_summary()
+        self._flush()
         if self.plots and self.steps:
-            from .plots import plot_folder
+            if self.plotter is None:
+                from .plots import plot_folder
 
-            plot_folder(self.out)
+                self.plotter = plot_folder
+            self.plotter(self.out)
 
 
     def save_checkpoint(self) -> None:

@@ -1,0 +1,83 @@
+"""The plots of `axiform run` drawn by a second process (plot_process.py): the same pictures as
+in this process, its failure reported, and no process left behind."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from axiform.cli import run
+from axiform.plot_process import PlotProcess, draw_in_parallel, idle_cores
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+SRC = Path(__file__).resolve().parents[1] / "src"
+PNGS = ["load_curve.png", "thickness.png", "deformed.png"]
+
+
+def test_a_run_plots_in_a_second_process(tmp_path):
+    out = tmp_path / "plate"
+    assert run(str(EXAMPLES / "hughes_carnoy_plate.toml"), str(out), quiet=True,
+               overrides=["solver.steps=3", "solver.target=1.0"], plot_process=True) == 0
+    for png in PNGS:
+        assert (out / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # the same folder plotted again: the second process returns the files it wrote
+    for png in PNGS:
+        (out / png).unlink()
+    with PlotProcess() as plotter:
+        assert sorted(p.name for p in plotter.plot(out)) == sorted(PNGS)
+    assert all((out / png).exists() for png in PNGS)
+
+
+def test_the_command_plots(tmp_path):
+    """`axiform run` from a shell: the plots come from a second process when a core is idle
+    (idle_cores), from this one otherwise: the same files, no process left behind."""
+    out = tmp_path / "plate"
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    proc = subprocess.run([sys.executable, "-m", "axiform.cli", "run", str(EXAMPLES / "hughes_carnoy_plate.toml"),
+                           "--out", str(out), "-q", "--set", "solver.steps=2", "--set", "solver.target=0.5"],
+                          env=env, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert all((out / png).exists() for png in PNGS)
+
+
+def test_a_failed_plot_raises_with_its_reason(tmp_path):
+    (tmp_path / "history.csv").write_text("step,load_factor,iterations\n1,not a number,3\n")
+    with PlotProcess() as plotter, pytest.raises(RuntimeError, match="could not convert string to float"):
+        plotter.plot(tmp_path)
+
+
+def test_an_unused_plot_process_ends_with_its_block():
+    with PlotProcess() as plotter:
+        pass
+    assert plotter.proc.returncode is not None
+    with pytest.raises(subprocess.TimeoutExpired):  # nothing else: it waits for its folder
+        with PlotProcess() as waiting:
+            waiting.proc.wait(timeout=0.2)
+    assert waiting.proc.returncode is not None
+
+
+def test_idle_cores_read_the_load(monkeypatch):
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1}, raising=False)
+    monkeypatch.setattr(os, "getloadavg", lambda: (0.4, 0.0, 0.0))
+    assert idle_cores() == pytest.approx(1.6)
+
+
+def test_drawing_in_parallel_keeps_the_order_and_reports_a_failure(tmp_path):
+    def draw(name):
+        def job():
+            (tmp_path / name).write_text(name)
+            return tmp_path / name
+        return job
+
+    def nothing():
+        return None
+
+    def broken():
+        raise ValueError("no such field")
+
+    assert draw_in_parallel([draw("a"), nothing, draw("b"), draw("c")]) == [tmp_path / n for n in "abc"]
+    assert (tmp_path / "c").read_text() == "c"
+    with pytest.raises(RuntimeError, match="ValueError: no such field"):
+        draw_in_parallel([draw("d"), broken])
