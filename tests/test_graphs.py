@@ -14,9 +14,8 @@ def test_random_graphs(seed):
     rng = np.random.default_rng(seed)
     n = int(rng.integers(1, 400))
     m = int(rng.integers(0, 2 * n))
-    i, j = rng.integers(0, n, m), rng.integers(0, n, m)
-    graph = sp.coo_matrix((np.ones(m), (i, j)), shape=(n, n))
-    count, labels = connected_components(n, i, j)
+    graph = sp.coo_matrix((np.ones(m), (rng.integers(0, n, m), rng.integers(0, n, m))), shape=(n, n))
+    count, labels = connected_components(graph)
     ref_count, ref_labels = scipy_components(graph, directed=False)
     assert count == ref_count
     assert np.array_equal(labels, ref_labels)
@@ -26,6 +25,8 @@ def test_two_meshes_side_by_side():
     a = rectangle((0.0, 1.0), (0.0, 1.0), (7, 5), "q8")
     cells = np.vstack([a.cells, a.cells + a.n_nodes])
     rows = np.repeat(cells[:, 0], cells.shape[1])
-    count, labels = connected_components(2 * a.n_nodes, rows, cells.ravel())
+    n = 2 * a.n_nodes
+    graph = sp.coo_matrix((np.ones(rows.size), (rows, cells.ravel())), shape=(n, n))
+    count, labels = connected_components(graph)
     assert count == 2
     assert np.array_equal(labels, np.repeat([0, 1], a.n_nodes))

@@ -9,8 +9,8 @@ load factor lambda.
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
-from .csr import CSRMatrix
 from .graphs import connected_components
 
 
@@ -22,7 +22,8 @@ class DofMap:
         root = np.arange(n_full)
         if len(ties):
             pairs = np.vstack([np.column_stack([g[:-1], g[1:]]) for g in map(np.asarray, ties) if len(g) > 1])
-            _, label = connected_components(n_full, pairs[:, 0], pairs[:, 1])
+            graph = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n_full, n_full))
+            _, label = connected_components(graph, directed=False)
             first = np.full(label.max() + 1, n_full)
             np.minimum.at(first, label, np.arange(n_full))
             root = first[label]
@@ -107,18 +108,20 @@ class SparsePattern:
         data += add
         return data
 
-    def free_block(self, data: np.ndarray) -> CSRMatrix:
-        """K_ff (free rows and columns) as a CSR matrix on a view of data (its columns sorted
-        in each row: the keys are)."""
+    def free_block(self, data: np.ndarray) -> sp.csr_matrix:
+        """K_ff (free rows and columns) as a CSR matrix on a view of data."""
         i, p, s = self._ff_csr
-        return CSRMatrix(data[: self.n_ff], i, p, s)
+        K = sp.csr_matrix((data[: self.n_ff], i, p), shape=s)
+        K.has_sorted_indices = True  # the keys are sorted: spares a scan of every row
+        return K
 
     def fp_product(self, data: np.ndarray, v: np.ndarray) -> np.ndarray:
         """K_fp v (nf,) for v (np,) on the prescribed equations."""
         w = data[self.n_ff: self.n_ff + self.n_fp] * v[self._fp_cols]
         return np.bincount(self._fp_rows, weights=w, minlength=self.dofmap.nf)
 
-    def blocks(self, data: np.ndarray) -> tuple[CSRMatrix, CSRMatrix]:
+    def blocks(self, data: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """K_ff and K_fp (free rows; free and prescribed columns) as CSR matrices."""
         i, p, s = self._fp_csr
-        return self.free_block(data), CSRMatrix(data[self.n_ff: self.n_ff + self.n_fp], i, p, s)
+        K_fp = sp.csr_matrix((data[self.n_ff: self.n_ff + self.n_fp], i, p), shape=s)
+        return self.free_block(data), K_fp

@@ -12,6 +12,7 @@ from datetime import date, datetime, time
 from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
 
 from .graphs import connected_components
 
@@ -106,7 +107,8 @@ def boundary_crossing(points: np.ndarray, edges: np.ndarray) -> tuple[int, int] 
 def bodies(n_nodes: int, cells: np.ndarray) -> np.ndarray:
     """The connected body (0, 1, ...) each node belongs to, (n_nodes,), through shared cells."""
     rows = np.repeat(cells[:, 0], cells.shape[1])
-    return connected_components(n_nodes, rows, cells.ravel())[1]
+    graph = sp.coo_matrix((np.ones(rows.size), (rows, cells.ravel())), shape=(n_nodes, n_nodes))
+    return connected_components(graph, directed=False)[1]
 
 
 def free_to_slide(n_nodes: int, cells: np.ndarray, held_uz: np.ndarray, touching: np.ndarray) -> list[int]:
@@ -124,10 +126,10 @@ def free_to_slide(n_nodes: int, cells: np.ndarray, held_uz: np.ndarray, touching
 _MODES: list = []  # [(dofmap, modes)] of the last model asked about
 
 
-def rigid_translations(model) -> np.ndarray:
+def rigid_translations(model) -> sp.csc_matrix:
     """Unit translations along z of the bodies that no prescribed uz holds, as columns over
-    the free equations, (n_free, k), k mostly 0 or 1: zero-energy modes of the tangent unless
-    contact (or a tie) resists them.  Cached for the model's current numbering."""
+    the free equations, (n_free, k): zero-energy modes of the tangent unless contact (or a
+    tie) resists them.  Cached for the model's current numbering."""
     dm = model.dofmap
     if _MODES and _MODES[0][0] is dm:
         return _MODES[0][1]
@@ -138,17 +140,15 @@ def rigid_translations(model) -> np.ndarray:
     held[body[eq >= dm.nf]] = True
     free = (eq < dm.nf) & ~held[body]
     _, col = np.unique(body[free], return_inverse=True)
-    modes = np.zeros((dm.nf, col.max(initial=-1) + 1))
-    modes[eq[free], col] = 1.0
+    modes = sp.csc_matrix((np.ones(free.sum()), (eq[free], col)), shape=(dm.nf, col.max(initial=-1) + 1))
     _MODES[:] = [(dm, modes)]
     return modes
 
 
-def evaluation_fault(model, r_full: np.ndarray, K) -> str | None:
+def evaluation_fault(model, r_full: np.ndarray, K: sp.spmatrix | None) -> str | None:
     """What makes a state unusable, with its place: a residual (r_full, (n_full,)) that is not
-    finite (node, dof, an element holding the node), or a tangent K (n_free, n_free), CSR
-    (csr.CSRMatrix or SciPy's), left without stiffness against a rigid translation along z
-    (a mechanism)."""
+    finite (node, dof, an element holding the node), or a tangent K (n_free, n_free) left
+    without stiffness against a rigid translation along z (a mechanism)."""
     bad = np.flatnonzero(~np.isfinite(r_full))
     if bad.size:
         node, k = divmod(int(bad[0]), model.dpn)
@@ -162,8 +162,8 @@ def evaluation_fault(model, r_full: np.ndarray, K) -> str | None:
         return None
     # ||K m||_1 against ||K||_1 ||m||_1: zero to round-off for a free mode, about 1 / (nodes of
     # the body) for a body held at a few nodes
-    force = np.abs(K @ modes).sum(axis=0)
-    size = np.bincount(K.indices, weights=np.abs(K.data), minlength=K.shape[1]).max() * modes.sum(axis=0)
+    force = np.asarray(abs(sp.csr_matrix(K) @ modes).sum(axis=0)).ravel()
+    size = abs(K).sum(axis=0).max() * np.asarray(modes.sum(axis=0)).ravel()
     free = np.flatnonzero(force <= 1e-9 * size)
     if free.size:
         return ("a mechanism: the tangent has no stiffness against a rigid translation along z of "

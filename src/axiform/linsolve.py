@@ -32,12 +32,10 @@ import glob
 import os
 import sys
 import threading
-from typing import TYPE_CHECKING, Callable
+from typing import Callable
 
 import numpy as np
-
-if TYPE_CHECKING:  # K: csr.CSRMatrix or any SciPy sparse matrix; scipy.sparse imported only for SuperLU
-    import scipy.sparse as sp
+import scipy.sparse as sp
 
 DENSE_MAX = 150  # largest n factorized as a dense matrix
 PARALLEL_MIN = 2000  # smallest n that PARDISO factorizes with MKL's threads (smaller: one thread)
@@ -271,8 +269,7 @@ def _factorize_dense(K: sp.spmatrix) -> Solve:
 
 
 def factorize(K: sp.spmatrix) -> Solve:
-    """A function b -> K^-1 b for b (n,) or several right-hand sides (n, k); K a csr.CSRMatrix
-    (Model.evaluate's) or any SciPy sparse matrix."""
+    """A function b -> K^-1 b for b (n,) or several right-hand sides (n, k)."""
     n = K.shape[0]
     if n <= DENSE_MAX:
         return _factorize_dense(K)

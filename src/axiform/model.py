@@ -11,10 +11,10 @@ from functools import cached_property
 from typing import Iterable, Sequence
 
 import numpy as np
+import scipy.sparse as sp
 
 from .assembly import SolidAssembly
 from .constraints import DofMap, SparsePattern
-from .csr import CSRMatrix
 from .cavity import Cavity
 from .curves import PROPORTIONAL, Curve
 from .graphs import connected_components
@@ -40,7 +40,7 @@ class Evaluation:
 
     r: np.ndarray
     dr_dlam: np.ndarray
-    K: CSRMatrix | None  # SciPy's csr_matrix when cavities border it
+    K: sp.csr_matrix | None
     r_full: np.ndarray
     f_ext_full: np.ndarray
     force_scale: float
@@ -180,7 +180,9 @@ class Model:
         # one theta per connected body, unless some theta of that body is already held
         cells = self.mesh.cells
         rows = np.repeat(cells[:, 0], cells.shape[1])
-        _, body = connected_components(self.mesh.n_nodes, rows, cells.ravel())
+        graph = sp.coo_matrix((np.ones(rows.size), (rows, cells.ravel())),
+                              shape=(self.mesh.n_nodes, self.mesh.n_nodes))
+        _, body = connected_components(graph, directed=False)
         held = {body[d // self.dpn] for d in fixed if d % self.dpn == 2}
         for b in np.unique(body[cells[:, 0]]):
             if b not in held:
@@ -372,9 +374,7 @@ class Model:
             r = np.concatenate([r, C])
             dr_dt = np.concatenate([dr_dt, dC_dt])
             if K is not None:
-                import scipy.sparse as sp
-
-                K = sp.bmat([[K.tocsr(), sp.csr_matrix(-G)], [sp.csr_matrix(Cu), sp.csr_matrix(Cp)]], format="csr")
+                K = sp.bmat([[K, sp.csr_matrix(-G)], [sp.csr_matrix(Cu), sp.csr_matrix(Cp)]], format="csr")
             constraint_error = float(np.max(np.abs(C) / np.array([c[4] for c in constraints])))
         else:
             constraint_error = 0.0

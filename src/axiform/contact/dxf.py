@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import scipy.sparse as sp
 
 from .surfaces import Polyline
 
@@ -165,7 +166,6 @@ def _extent_points(entity):
 
 def _chain(pieces: list[Piece], tol: float, reverse: bool, motion) -> Polyline:
     """Join the pieces end to end into one path (see read_dxf)."""
-    import scipy.sparse as sp
     from scipy.sparse.csgraph import connected_components  # imported when needed (0.3 s with cKDTree)
     from scipy.spatial import cKDTree
 
