@@ -98,3 +98,18 @@ def test_arc_length_carries_the_papers_plate_past_its_pressure_maximum(element, 
     imax = p.argmax()
     assert 0 < imax < len(p) - 1 and p[-1] < p[imax]
     assert 41.0 < p[imax] < 43.0
+
+
+@pytest.mark.parametrize("steps", [20, 80, 400])
+def test_arc_length_takes_about_the_steps_asked_for(steps):
+    """The plate (Q8 2 x 20) to w = 21 takes about `steps` steps (measured 26, 79, 390; the
+    first arc, from the compliant initial tangent, is cut back a few times at 20).  Before the
+    arc was adapted to the way left, 20, 80 and 400 all gave 24."""
+    from axiform import select_nodes
+    from conftest import clamped_plate
+
+    model = clamped_plate("q8")
+    w = int(model.dof(select_nodes(model.mesh, {"r": 0.0, "z": 0.25})[0], "uz"))
+    res = solve(model, ArcLengthControl(target=100.0, steps=steps, stop_dof=w, stop_value=21.0))
+    assert res.status == "finished", res.message
+    assert 0.9 * steps <= res.n_steps <= 1.35 * steps

@@ -40,10 +40,16 @@ class DisplacementControl:
 @dataclass
 class ArcLengthControl:
     """Crisfield's cylindrical arc length: each step keeps ||du|| (displacements, and fibre
-    rotations times the size of the body) equal to the arc length, lambda free, so limit points are passed.  Runs until
-    lambda reaches target, or the dof `stop_dof` reaches `stop_value` if given (the last step
-    lands exactly there); the first arc length is that of a load step target / steps unless
-    `arc_length` is given; at most max_steps steps."""
+    rotations times the size of the body) equal to the arc length, lambda free, so limit
+    points are passed.  Runs until lambda reaches target, or the dof `stop_dof` reaches
+    `stop_value` if given (the last step lands exactly there); at most max_steps steps.
+
+    The run takes about `steps` steps: the first arc is that of a load step target / steps
+    along the initial tangent; after every step the nominal arc becomes the arc travelled
+    over the fraction f of the way done, divided by `steps` (f: the largest of lambda / target
+    and u_stop / stop_value reached so far), so that the arc left is covered in the steps
+    left.  Cutbacks and the growth after easy steps act below this nominal arc.  A given
+    `arc_length` is the nominal arc of every step instead."""
 
     target: float = 1.0
     steps: int = 10
@@ -140,8 +146,7 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
     else:
         path = _Load(model, control, opts)
     result = SolveResult("finished")
-    nominal = path.nominal
-    size = nominal
+    size = path.nominal
     first = 1
     if resume is not None:
         path.restore(resume["path"])
@@ -155,7 +160,7 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
             u_new, lam_new, its, res, ev = path.attempt(trial)
         except StepFailed as exc:
             size = trial / 2.0
-            if abs(size) < opts.min_step * abs(nominal):
+            if abs(size) < opts.min_step * abs(path.nominal):
                 result.status = "stopped"
                 result.message = f"step {first + result.n_steps}: no convergence with the step cut below the minimum ({exc})"
                 result.message += path.diagnosis()
@@ -165,7 +170,8 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
         model.commit()
         result.newton_iterations += its
         if its <= opts.easy_iterations:
-            size = min(size * opts.growth, nominal, key=abs)
+            size *= opts.growth
+        size = min(size, path.nominal, key=abs)  # the nominal step may change (arc length)
         result.n_steps += 1
         number = first + result.n_steps - 1
         checkpoint = {"path": path.state(), "model": model.state(), "size": size, "step": number,
@@ -324,7 +330,7 @@ class _Displacement(_Path):
 
 
 class _ArcLength(_Path):
-    _state_keys = ("u_f", "lam", "previous", "finished")
+    _state_keys = ("u_f", "lam", "previous", "finished", "nominal", "travelled", "progress")
 
     def __init__(self, model, control: ArcLengthControl, opts):
         super().__init__(model, opts)
@@ -357,6 +363,17 @@ class _ArcLength(_Path):
             if not self.nominal > 0:  # nothing responds to the load yet (a tool still in the air)
                 self.nominal = self.load_step * span
         self.finished = False
+        self.travelled = 0.0  # the arc length of the converged steps
+        self.progress = 0.0  # the largest fraction of the way to the end reached so far
+
+    def _fraction(self, u_f, lam) -> float:
+        """How far (u_f, lambda) is on the way to the end: lambda / target, or u_stop /
+        stop_value where that is further."""
+        c = self.control
+        f = lam / c.target if c.target else 0.0
+        if self.stop is not None and c.stop_value:
+            f = max(f, u_f[self.stop] / c.stop_value)
+        return f
 
     def _norm(self, v):
         return float(np.sqrt(np.dot(self.weight * v, v)))
@@ -388,6 +405,11 @@ class _ArcLength(_Path):
 
     def accept(self, u_f, lam, size):
         self.previous = u_f - self.u_f
+        self.travelled += self._norm(self.previous)
+        self.progress = max(self.progress, self._fraction(u_f, lam))
+        if self.control.arc_length is None and self.progress > 0 and self.travelled > 0:
+            # the arc left in the steps left: the run takes about `steps` steps
+            self.nominal = self.travelled / (self.progress * self.control.steps)
         super().accept(u_f, lam, size)
         self.finished = self._landed
 
