@@ -45,11 +45,12 @@ class ArcLengthControl:
     `stop_value` if given (the last step lands exactly there); at most max_steps steps.
 
     The run takes about `steps` steps: the first arc is that of a load step target / steps
-    along the initial tangent; after every step the nominal arc becomes the arc travelled
-    over the fraction f of the way done, divided by `steps` (f: the largest of lambda / target
-    and u_stop / stop_value reached so far), so that the arc left is covered in the steps
-    left.  Cutbacks and the growth after easy steps act below this nominal arc.  A given
-    `arc_length` is the nominal arc of every step instead."""
+    along the initial tangent; after every step the arc of the whole run is estimated, and
+    the nominal arc is that estimate divided by `steps`.  The estimate: the arc travelled plus
+    the way left at the last step's rate (arc per fraction of the way), and at least the arc
+    travelled over the fraction f done (f: the largest of lambda / target and u_stop /
+    stop_value reached so far).  Cutbacks and the growth after easy steps act below this
+    nominal arc.  A given `arc_length` is the nominal arc of every step instead."""
 
     target: float = 1.0
     steps: int = 10
@@ -405,11 +406,16 @@ class _ArcLength(_Path):
 
     def accept(self, u_f, lam, size):
         self.previous = u_f - self.u_f
-        self.travelled += self._norm(self.previous)
-        self.progress = max(self.progress, self._fraction(u_f, lam))
+        ds = self._norm(self.previous)
+        self.travelled += ds
+        f = max(self.progress, self._fraction(u_f, lam))
+        df, self.progress = f - self.progress, f
         if self.control.arc_length is None and self.progress > 0 and self.travelled > 0:
-            # the arc left in the steps left: the run takes about `steps` steps
-            self.nominal = self.travelled / (self.progress * self.control.steps)
+            # the arc of the whole run over `steps`: the run takes about `steps` steps
+            total = self.travelled / self.progress
+            if df > 0:
+                total = max(total, self.travelled + (1 - f) * ds / df)
+            self.nominal = total / self.control.steps
         super().accept(u_f, lam, size)
         self.finished = self._landed
 
