@@ -45,11 +45,12 @@ class ArcLengthControl:
     `stop_value` if given (the last step lands exactly there); at most max_steps steps.
 
     The run takes about `steps` steps: the first arc is that of a load step target / steps
-    along the initial tangent; after every step the arc of the whole run is estimated, and
-    the nominal arc is that estimate divided by `steps`.  The estimate: the arc travelled plus
-    the way left at the last step's rate (arc per fraction of the way), and at least the arc
-    travelled over the fraction f done (f: the largest of lambda / target and u_stop /
-    stop_value reached so far).  Cutbacks and the growth after easy steps act below this
+    along the initial tangent; after every step the nominal arc is the arc that makes
+    1 / steps of the way to the end, at the mean rate so far (the arc travelled over the
+    fraction f of the way done; f: the largest of lambda / target and u_stop / stop_value
+    reached so far), or at the last step's rate where that is smaller (a path that stiffens,
+    a wall pressed on a mould).  Where f stands still (a limit point of the stop dof, lambda
+    falling) the mean rate holds.  Cutbacks and the growth after easy steps act below this
     nominal arc.  A given `arc_length` is the nominal arc of every step instead."""
 
     target: float = 1.0
@@ -411,11 +412,12 @@ class _ArcLength(_Path):
         f = max(self.progress, self._fraction(u_f, lam))
         df, self.progress = f - self.progress, f
         if self.control.arc_length is None and self.progress > 0 and self.travelled > 0:
-            # the arc of the whole run over `steps`: the run takes about `steps` steps
-            total = self.travelled / self.progress
+            # the arc that makes 1 / steps of the way: at the mean rate so far, or at the last
+            # step's where that is smaller (a stiffening path: a wall pressed on a mould)
+            rate = self.travelled / self.progress
             if df > 0:
-                total = max(total, self.travelled + (1 - f) * ds / df)
-            self.nominal = total / self.control.steps
+                rate = min(rate, ds / df)
+            self.nominal = rate / self.control.steps
         super().accept(u_f, lam, size)
         self.finished = self._landed
 
