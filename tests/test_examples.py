@@ -35,8 +35,8 @@ def test_plate_rim_carries_the_pressure(tmp_path):
 def test_plate_goes_through_its_pressure_maximum_to_three_times_its_radius(tmp_path):
     """Arc length with the default settings (Q8 4 x 40 graded to the clamp, mixed): the plate
     passes its pressure maximum (41.09 psi measured, 41.03 on the uniform mesh, which stops at
-    w = 21.98 where its clamp corner element folds) and lands on w = 23 in, in about the 80
-    steps asked for, the rim carrying the pressure on the disc."""
+    w = 21.98: tests/test_folds.py) and lands on w = 23 in, in about the 80 steps asked for,
+    the rim carrying the pressure on the disc."""
     s = run("plate_arc_length", tmp_path)
     assert s["monitors"]["w_center"] == pytest.approx(23.0, rel=1e-12)
     assert s["monitors"]["rim_force_z"] == pytest.approx(-s["load_factor"] * np.pi * 7.5**2, rel=1e-6)

@@ -14,6 +14,7 @@ from typing import Callable
 
 import numpy as np
 
+from .folds import folded_nodes
 from .guards import evaluation_fault
 from .linsolve import SingularTangentError, factorize
 from .materials import InvertedElementError
@@ -224,8 +225,17 @@ class _Path:
             setattr(self, key, v.copy() if isinstance(v, np.ndarray) else v)
 
     def diagnosis(self) -> str:
-        """Why the path stopped, where the state tells (appended to the stop message)."""
-        return ""
+        """Why the path stopped, where the state tells (appended to the stop message): an
+        element folded at one of its nodes in the last converged state."""
+        folds = folded_nodes(self.model.mesh, self.model.expand(self.u_f, self.lam))
+        if not folds:
+            return ""
+        element, node, j = folds[0]
+        r, z = self.model.mesh.points[node]
+        more = f" ({len(folds)} element nodes folded in all)" if len(folds) > 1 else ""
+        return (f"; element {element} is folded at its node {node} (r, z = {r:.6g}, {z:.6g}; in-plane J = {j:.2g} "
+                f"there at the last converged step){more}: the mesh there no longer maps the body one to one, "
+                "and other elements there (larger or finer) move the stop")
 
     def _stiffness_ratio(self) -> float | None:
         """The current stiffness parameter: ||du/dlambda|| at the start over ||du/dlambda|| at
@@ -293,7 +303,7 @@ class _Load(_Path):
             return (f"; this is a limit point of the load: the structure's stiffness against it has fallen to "
                     f"{100 * ratio:.2g} % of its initial value, so it carries no more load; follow the path "
                     "past it with control = \"arc-length\" or \"displacement\", or a cavity under volume control")
-        return ""
+        return super().diagnosis()
 
 
 class _Displacement(_Path):
