@@ -142,3 +142,18 @@ def test_the_uniform_mixed_sfr_plate_turns_back_at_its_clamp():
     assert res.steps[k].u[next_to_clamp] < 0
     assert res.last.u[next_to_clamp] > 3.0
 
+
+
+def test_a_given_arc_length_is_the_arc_of_every_step():
+    """With `arc_length` the nominal arc stays that value whatever the steps: every step but
+    the landing one keeps ||du|| (the free dofs) at most 2 in, the growth after easy steps
+    brings it back up to 2 in after any cutback."""
+    from conftest import clamped_plate
+
+    model = clamped_plate("q8")
+    w = plate_centre(model)
+    res = solve(model, ArcLengthControl(target=100.0, steps=400, arc_length=2.0, stop_dof=w, stop_value=21.0))
+    assert res.status == "finished", res.message
+    arcs = np.linalg.norm(np.diff([np.zeros(model.n_free)] + [s.u_f for s in res.steps], axis=0), axis=1)[:-1]
+    assert arcs.max() == pytest.approx(2.0, rel=1e-9)
+    assert np.median(arcs) == pytest.approx(2.0, rel=1e-9)
