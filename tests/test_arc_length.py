@@ -89,8 +89,9 @@ def test_arc_length_carries_the_papers_plate_past_its_pressure_maximum(element, 
     mid-thickness centre deflection of 21 in: the pressure rises to its maximum (measured
     42.46 psi Q4, 41.32 psi Q8, 41.88 psi SFR, 42.05 psi SFR displacement) and falls after it
     while the deflection grows at every step, in about `steps` steps (measured for 20, 80, 400:
-    Q4 24, 80, 390; Q8 26, 79, 392; SFR 34, 117, 583; SFR displacement 28, 103, 519: the
-    fibre rotations grow faster than the deflection; before, 17 to 50 whatever the steps).
+    Q4 23, 82, 401; Q8 28, 81, 402; SFR 24, 81, 402; SFR displacement 21, 81, 412; the first
+    arc, from the compliant initial tangent, is cut back a few times; before, 17 to 50
+    whatever the steps).
     The mixed SFR runs on the mesh graded to the clamp (elements there half the size of those
     at the centre): on the uniform mesh its path turns back at w = 20.46 (the next test)."""
     from conftest import clamped_plate
@@ -106,7 +107,7 @@ def test_arc_length_carries_the_papers_plate_past_its_pressure_maximum(element, 
     imax = p.argmax()
     assert 0 < imax < len(p) - 1 and p[-1] < p[imax]
     assert 41.0 < p[imax] < 43.0
-    assert 0.9 * steps <= res.n_steps <= 1.75 * steps
+    assert 0.9 * steps <= res.n_steps <= 1.5 * steps
 
 
 def test_the_uniform_mixed_sfr_plate_turns_back_at_its_clamp():
@@ -117,7 +118,7 @@ def test_the_uniform_mixed_sfr_plate_turns_back_at_its_clamp():
     control stops where the path turns (w = 20.457, no equilibrium beyond it nearby); arc
     length follows the turn there, back to w = 18.1 at a pressure within 1 % of the maximum,
     and on to the stop: every point of the path is an equilibrium, the same for 20, 80 or 400
-    steps (measured: the turn at 20.41, 20.45, 20.46), and det K changes sign only at the
+    steps (measured: the turn at 20.46, 20.45, 20.45), and det K changes sign only at the
     maxima and the minimum of the pressure along it (limit points, no bifurcation)."""
     from axiform import select_nodes
     from axiform.solver import DisplacementControl

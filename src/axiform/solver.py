@@ -47,12 +47,14 @@ class ArcLengthControl:
 
     The run takes about `steps` steps: the first arc is that of a load step target / steps
     along the initial tangent; after every step the nominal arc is the arc that makes
-    1 / steps of the way to the end, at the mean rate so far (the arc travelled over the
-    fraction f of the way done; f: the largest of lambda / target and u_stop / stop_value
-    reached so far), or at the last step's rate where that is smaller (a path that stiffens,
-    a wall pressed on a mould).  Where f stands still (a limit point of the stop dof, lambda
-    falling) the mean rate holds.  Cutbacks and the growth after easy steps act below this
-    nominal arc.  A given `arc_length` is the nominal arc of every step instead."""
+    1 / steps of the way to the end (f: the fraction of the way done, the largest of
+    lambda / target and u_stop / stop_value reached so far) at the last step's rate of arc
+    per f, but at most 4 times the mean rate so far (the arc travelled over f), and at the
+    mean rate where f stands still (a limit point of the stop dof, lambda falling).  An arc
+    step that would move lambda by more than target / steps (the displacements hardly
+    moving: a wall pressed on a mould) is replaced by a load step of target / steps, as
+    load control takes.  Cutbacks and the growth after easy steps act below the nominal arc.
+    A given `arc_length` is the nominal arc of every step instead, with no such load steps."""
 
     target: float = 1.0
     steps: int = 10
@@ -341,6 +343,9 @@ class _Displacement(_Path):
         self.reached += size
 
 
+RATE_GROWTH = 4.0  # arc length: the arc per 1 / steps of the way, at most this times its mean so far
+
+
 class _ArcLength(_Path):
     _state_keys = ("u_f", "lam", "previous", "finished", "nominal", "travelled", "progress")
 
@@ -398,6 +403,12 @@ class _ArcLength(_Path):
 
     def attempt(self, size):
         u_new, lam_new, its, res, ev = self._arc_step(size)
+        if self.control.arc_length is None and abs(lam_new - self.lam) > self.load_step:
+            # where the displacements hardly move (a wall pressed on a mould) an arc of them is
+            # no measure of the load: a load step instead, of the size load control takes
+            dlam = np.copysign(self.load_step, lam_new - self.lam)
+            guess = self.u_f + dlam / (lam_new - self.lam) * (u_new - self.u_f)
+            u_new, lam_new, its, res, ev = _newton_load(self.model, self.u_f, self.lam + dlam, self.opts, self.floor, guess)
         if self.previous is not None and np.dot(self.weight * (u_new - self.u_f), self.previous) < 0:
             raise StepFailed("the path turned back")
         if self.timed and (lam_new - self.lam) * np.sign(self.control.target) < 0:
@@ -422,11 +433,10 @@ class _ArcLength(_Path):
         f = max(self.progress, self._fraction(u_f, lam))
         df, self.progress = f - self.progress, f
         if self.control.arc_length is None and self.progress > 0 and self.travelled > 0:
-            # the arc that makes 1 / steps of the way: at the mean rate so far, or at the last
-            # step's where that is smaller (a stiffening path: a wall pressed on a mould)
-            rate = self.travelled / self.progress
-            if df > 0:
-                rate = min(rate, ds / df)
+            # the arc that makes 1 / steps of the way at the last step's rate, up to RATE_GROWTH
+            # times the mean rate so far; at the mean rate where the way does not advance
+            mean = self.travelled / self.progress
+            rate = min(RATE_GROWTH * mean, ds / df) if df > 0 else mean
             self.nominal = rate / self.control.steps
         super().accept(u_f, lam, size)
         self.finished = self._landed
