@@ -44,12 +44,13 @@ def formulation(request):
     return request.param
 
 
-def clamped_plate(element, formulation="mixed", divisions=(20, 2)):
+def clamped_plate(element, formulation="mixed", divisions=(20, 2), grading=1.0):
     """The paper's plate (section 4.1): R = 7.5, h = 0.5, C1 = 80, C2 = 20, kappa = 1e4, rim
-    clamped, unit follower pressure on z = 0; a finalized model."""
+    clamped, unit follower pressure on z = 0; a finalized model.  grading: the size of the
+    element at the clamp over that at the centre (radially)."""
     from axiform import Model, MooneyRivlin, select_edges, select_nodes
 
-    mesh = rectangle((0.0, 7.5), (0.0, 0.5), divisions, element)
+    mesh = rectangle((0.0, 7.5), (0.0, 0.5), divisions, element, grading=(grading, 1.0))
     model = Model(mesh, MooneyRivlin(80.0, 20.0, 1e4), formulation=formulation)
     model.fix(select_nodes(mesh, {"r": 7.5}), ["ur", "uz", "rot"])
     model.fix(select_nodes(mesh, {"r": 0.0}), ["ur"])

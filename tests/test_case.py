@@ -104,6 +104,8 @@ BAD = [
      r"solver: displacement control needs 'dof' and 'target'"),
     ("negative steps", lambda t: t.replace("steps = 6", "steps = -1"), r"solver\.steps: Input should be greater than or equal to 1"),
     ("not toml", lambda t: t + "\n[[[", r"not valid TOML"),
+    ("zero grading", lambda t: t.replace("divisions = [10, 2]", "divisions = [10, 2]\ngrading = [0.0, 1.0]"),
+     r"mesh\.grading\[0\]: Input should be greater than 0"),
 ]
 
 

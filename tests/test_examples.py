@@ -32,6 +32,21 @@ def test_plate_rim_carries_the_pressure(tmp_path):
     assert 32.0 < p < 35.0
 
 
+def test_plate_goes_through_its_pressure_maximum_to_three_times_its_radius(tmp_path):
+    """Arc length with the default settings (Q8 4 x 40 graded to the clamp, mixed): the plate
+    passes its pressure maximum (41.09 psi measured, 41.03 on the uniform mesh, which stops at
+    w = 21.98: tests/test_folds.py) and lands on w = 23 in, in about the 80 steps asked for,
+    the rim carrying the pressure on the disc."""
+    s = run("plate_arc_length", tmp_path)
+    assert s["monitors"]["w_center"] == pytest.approx(23.0, rel=1e-12)
+    assert s["monitors"]["rim_force_z"] == pytest.approx(-s["load_factor"] * np.pi * 7.5**2, rel=1e-6)
+    history = np.genfromtxt(tmp_path / "plate_arc_length" / "history.csv", delimiter=",", names=True)
+    p, w = history["load_factor"], history["w_center"]
+    assert (np.diff(w) > 0).all()
+    assert 41.0 < p.max() < 41.2 and p[-1] < p.max() - 0.3
+    assert 0.9 * 80 <= s["steps"] <= 1.2 * 80
+
+
 def test_thick_cylinder_nearly_keeps_its_volume(tmp_path):
     """Bore from 1 to 1.5: an incompressible tube would have b^2 = B^2 + a^2 - A^2 (b = 2.2913);
     with kappa/mu = 1e3 the outer radius is within 0.5 % of it."""

@@ -111,6 +111,7 @@ class MeshSpec(Strict):
     profile: Annotated[list[PieceSpec], Field(min_length=1)] | None = None
     thickness: PositiveFloat | Annotated[list[tuple[float, PositiveFloat]], Field(min_length=2)] | None = None
     wall: Literal["r", "z"] | None = None  # rectangle: direction through the wall (thickness)
+    grading: tuple[PositiveFloat, PositiveFloat] | None = None  # rectangle: last element / first
     layers: Annotated[int, Field(ge=1)] | None = None
     sfr_edges: Literal["tie", "fix", "free"] = "tie"
     formulation: Literal["mixed", "displacement"] = "mixed"
@@ -126,6 +127,8 @@ class MeshSpec(Strict):
                     raise ValueError(f"'{key}' belongs to kind = \"{kind}\"")
         if self.wall is not None and self.kind != "rectangle":
             raise ValueError("'wall' belongs to kind = \"rectangle\" (a layered wall knows its own)")
+        if self.grading is not None and self.kind != "rectangle":
+            raise ValueError("'grading' belongs to kind = \"rectangle\"")
         if self.kind == "rectangle":
             if not self.r[0] < self.r[1] or not self.z[0] < self.z[1]:
                 raise ValueError("r and z must be given as [min, max] with min < max")
@@ -561,7 +564,7 @@ class Built:
 
 def _mesh(spec: MeshSpec, base: Path) -> Mesh:
     if spec.kind == "rectangle":
-        return rectangle(spec.r, spec.z, spec.divisions, spec.element)
+        return rectangle(spec.r, spec.z, spec.divisions, spec.element, grading=spec.grading or (1.0, 1.0))
     if spec.kind == "layered":
         try:
             return layered(spec.build_profile(), spec.thickness, spec.layers, spec.element)

@@ -113,12 +113,15 @@ def jacobian(kind: ElementKind, X: np.ndarray, xi: np.ndarray):
     return N, dNdX, detJ, Xq
 
 
-def gradient_operator(kind: ElementKind, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """G (e, q, 5, ndof_e) with g = G u_e, and dV = 2 pi R detJ w (e, q) (eq. 28).
+def gradient_operator(kind: ElementKind, X: np.ndarray, points: tuple[np.ndarray, np.ndarray] | None = None
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """G (e, q, 5, ndof_e) with g = G u_e, and dV = 2 pi R detJ w (e, q) (eq. 28), at the
+    element's Gauss points, or at the points (xi (q, 2), w (q,)) given.
 
-    Element dofs are ordered node by node: (U, W) or, for SFR, (U, W, theta) (eq. 4).
+    Element dofs are ordered node by node: (U, W) or, for SFR, (U, W, theta) (eq. 4).  At a
+    point on the axis (R = 0) the row of U/R is not finite.
     """
-    xi, w = gauss_quad(kind.gauss)
+    xi, w = gauss_quad(kind.gauss) if points is None else points
     N, dNdX, detJ, Xq = jacobian(kind, X, xi)
     e, q, k = dNdX.shape[:3]
     R = Xq[..., 0]
@@ -141,6 +144,14 @@ def gradient_operator(kind: ElementKind, X: np.ndarray) -> tuple[np.ndarray, np.
         G[:, :, 4, :, 2] = -Nq * dZ / R[..., None]
     dV = 2.0 * np.pi * R * detJ * w
     return G.reshape(e, q, 5, k * kind.dofs_per_node), dV
+
+
+def node_coordinates(kind: ElementKind) -> np.ndarray:
+    """The element's nodes in its reference square, (k, 2): corners, then Q8 mid-sides."""
+    corners = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+    if kind.nodes == 8:
+        return np.vstack([corners, [[0.0, -1.0], [1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]]])
+    return corners
 
 
 def edge_shape(n: int, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

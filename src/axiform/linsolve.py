@@ -262,8 +262,12 @@ def _factorize_dense(K: sp.spmatrix) -> Solve:
         raise SingularTangentError("the tangent is singular (a zero pivot)")
 
     def solve(b: np.ndarray) -> np.ndarray:
-        x, info = dgetrs(lu, piv, np.asarray(b, dtype=float))
-        return _check(x)
+        b = np.asarray(b, dtype=float)
+        if b.ndim == 1:
+            return _check(dgetrs(lu, piv, b)[0])
+        # one right-hand side at a time: getrs with several goes through threaded BLAS
+        # (trsm), ten to a hundred times slower at these sizes on busy cores
+        return _check(np.column_stack([dgetrs(lu, piv, b[:, k])[0] for k in range(b.shape[1])]))
 
     return solve
 

@@ -14,6 +14,7 @@ from typing import Callable
 
 import numpy as np
 
+from .folds import folded_nodes
 from .guards import evaluation_fault
 from .linsolve import SingularTangentError, factorize
 from .materials import InvertedElementError
@@ -40,10 +41,20 @@ class DisplacementControl:
 @dataclass
 class ArcLengthControl:
     """Crisfield's cylindrical arc length: each step keeps ||du|| (displacements, and fibre
-    rotations times the size of the body) equal to the arc length, lambda free, so limit points are passed.  Runs until
-    lambda reaches target, or the dof `stop_dof` reaches `stop_value` if given (the last step
-    lands exactly there); the first arc length is that of a load step target / steps unless
-    `arc_length` is given; at most max_steps steps."""
+    rotations times the size of the body) equal to the arc length, lambda free, so limit
+    points are passed.  Runs until lambda reaches target, or the dof `stop_dof` reaches
+    `stop_value` if given (the last step lands exactly there); at most max_steps steps.
+
+    The run takes about `steps` steps: the first arc is that of a load step target / steps
+    along the initial tangent; after every step the nominal arc is the arc that makes
+    1 / steps of the way to the end (f: the fraction of the way done, the largest of
+    lambda / target and u_stop / stop_value reached so far) at the last step's rate of arc
+    per f, but at most 4 times the mean rate so far (the arc travelled over f), and at the
+    mean rate where f stands still (a limit point of the stop dof, lambda falling).  An arc
+    step that would move lambda by more than target / steps (the displacements hardly
+    moving: a wall pressed on a mould) is replaced by a load step of target / steps, as
+    load control takes.  Cutbacks and the growth after easy steps act below the nominal arc.
+    A given `arc_length` is the nominal arc of every step instead, with no such load steps."""
 
     target: float = 1.0
     steps: int = 10
@@ -140,8 +151,7 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
     else:
         path = _Load(model, control, opts)
     result = SolveResult("finished")
-    nominal = path.nominal
-    size = nominal
+    size = path.nominal
     first = 1
     if resume is not None:
         path.restore(resume["path"])
@@ -155,7 +165,7 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
             u_new, lam_new, its, res, ev = path.attempt(trial)
         except StepFailed as exc:
             size = trial / 2.0
-            if abs(size) < opts.min_step * abs(nominal):
+            if abs(size) < opts.min_step * abs(path.nominal):
                 result.status = "stopped"
                 result.message = f"step {first + result.n_steps}: no convergence with the step cut below the minimum ({exc})"
                 result.message += path.diagnosis()
@@ -165,7 +175,8 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
         model.commit()
         result.newton_iterations += its
         if its <= opts.easy_iterations:
-            size = min(size * opts.growth, nominal, key=abs)
+            size *= opts.growth
+        size = min(size, path.nominal, key=abs)  # the nominal step may change (arc length)
         result.n_steps += 1
         number = first + result.n_steps - 1
         checkpoint = {"path": path.state(), "model": model.state(), "size": size, "step": number,
@@ -211,13 +222,26 @@ class _Path:
         return out
 
     def restore(self, state: dict) -> None:
+        missing = [key for key in self._state_keys if key not in state]
+        if missing:
+            raise ValueError(f"the checkpoint lacks the path's {', '.join(missing)} (written by another version "
+                             "of axiform, or for another control): run the case again from its start")
         for key in self._state_keys:
             v = state[key]
             setattr(self, key, v.copy() if isinstance(v, np.ndarray) else v)
 
     def diagnosis(self) -> str:
-        """Why the path stopped, where the state tells (appended to the stop message)."""
-        return ""
+        """Why the path stopped, where the state tells (appended to the stop message): an
+        element folded at one of its nodes in the last converged state."""
+        folds = folded_nodes(self.model.mesh, self.model.expand(self.u_f, self.lam))
+        if not folds:
+            return ""
+        element, node, j = folds[0]
+        r, z = self.model.mesh.points[node]
+        more = f" ({len(folds)} element nodes folded in all)" if len(folds) > 1 else ""
+        return (f"; element {element} is folded at its node {node} (r, z = {r:.6g}, {z:.6g}; in-plane J = {j:.2g} "
+                f"there at the last converged step){more}: the mesh there no longer maps the body one to one, "
+                "and other elements there (larger or finer) move the stop")
 
     def _stiffness_ratio(self) -> float | None:
         """The current stiffness parameter: ||du/dlambda|| at the start over ||du/dlambda|| at
@@ -285,7 +309,7 @@ class _Load(_Path):
             return (f"; this is a limit point of the load: the structure's stiffness against it has fallen to "
                     f"{100 * ratio:.2g} % of its initial value, so it carries no more load; follow the path "
                     "past it with control = \"arc-length\" or \"displacement\", or a cavity under volume control")
-        return ""
+        return super().diagnosis()
 
 
 class _Displacement(_Path):
@@ -323,8 +347,11 @@ class _Displacement(_Path):
         self.reached += size
 
 
+RATE_GROWTH = 4.0  # arc length: the arc per 1 / steps of the way, at most this times its mean so far
+
+
 class _ArcLength(_Path):
-    _state_keys = ("u_f", "lam", "previous", "finished")
+    _state_keys = ("u_f", "lam", "previous", "finished", "nominal", "travelled", "progress")
 
     def __init__(self, model, control: ArcLengthControl, opts):
         super().__init__(model, opts)
@@ -358,6 +385,17 @@ class _ArcLength(_Path):
                 self.nominal = self.load_step * span
         self.finished = False
         self.loaded = False  # the last attempt was a load step (`_load_step`)
+        self.travelled = 0.0  # the arc length of the converged steps
+        self.progress = 0.0  # the largest fraction of the way to the end reached so far
+
+    def _fraction(self, u_f, lam) -> float:
+        """How far (u_f, lambda) is on the way to the end: lambda / target, or u_stop /
+        stop_value where that is further."""
+        c = self.control
+        f = lam / c.target if c.target else 0.0
+        if self.stop is not None and c.stop_value:
+            f = max(f, u_f[self.stop] / c.stop_value)
+        return f
 
     def _norm(self, v):
         return float(np.sqrt(np.dot(self.weight * v, v)))
@@ -370,6 +408,12 @@ class _ArcLength(_Path):
 
     def attempt(self, size):
         u_new, lam_new, its, res, ev = self._arc_step(size)
+        if not self.loaded and self.control.arc_length is None and abs(lam_new - self.lam) > self.load_step:
+            # where the displacements hardly move (a wall pressed on a mould) an arc of them is
+            # no measure of the load: a load step instead, of the size load control takes
+            dlam = np.copysign(self.load_step, lam_new - self.lam)
+            guess = self.u_f + dlam / (lam_new - self.lam) * (u_new - self.u_f)
+            u_new, lam_new, its, res, ev = _newton_load(self.model, self.u_f, self.lam + dlam, self.opts, self.floor, guess)
         if not self.loaded and self.previous is not None and np.dot(self.weight * (u_new - self.u_f), self.previous) < 0:
             raise StepFailed("the path turned back")
         if self.timed and (lam_new - self.lam) * np.sign(self.control.target) < 0:
@@ -389,6 +433,17 @@ class _ArcLength(_Path):
 
     def accept(self, u_f, lam, size):
         self.previous = u_f - self.u_f
+        ds = self._norm(self.previous)
+        self.travelled += ds
+        f = max(self.progress, self._fraction(u_f, lam))
+        df, self.progress = f - self.progress, f
+        if self.control.arc_length is None and self.progress > 0 and self.travelled > 0:
+            # the arc that makes 1 / steps of the way at the last step's rate, up to RATE_GROWTH
+            # times the mean rate so far; at the mean rate where the way does not advance
+            mean = self.travelled / self.progress
+            rate = min(RATE_GROWTH * mean, ds / df) if df > 0 else mean
+            if rate > 0:  # a step of load alone (a frozen wall) leaves the arc as it was
+                self.nominal = rate / self.control.steps
         super().accept(u_f, lam, size)
         self.finished = self._landed
 
@@ -399,7 +454,7 @@ class _ArcLength(_Path):
         stops = np.append(self.model.knots(), target)
         ahead = (stops - self.lam) * np.sign(target)
         near = np.argmin(np.where(ahead > 1e-12 * abs(target), ahead, np.inf))
-        dlam = self.load_step * dl / self.nominal
+        dlam = self.load_step * dl / self.nominal if self.nominal > 0 else self.load_step
         lam = self.lam + np.sign(target) * dlam if dlam < ahead[near] * (1 - 1e-9) else stops[near]
         self.loaded = True
         return _newton_load(self.model, self.u_f, lam, self.opts, self.floor)
