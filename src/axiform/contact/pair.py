@@ -15,6 +15,9 @@ from .surfaces import RigidSurface
 
 STATUS = {0: "open", 1: "stick", 2: "slip", 3: "sticky"}  # slip: |ft| > tanh(1) mu fn
 PENALTY_FACTOR = 10.0  # default penalty: PENALTY_FACTOR E / h, h the current element height
+# a slip z = kt (s - s0) / (mu fn) beyond Z_SATURATED is the sliding force to 1e-10:
+# 1 - tanh(12) = 7.6e-11
+Z_SATURATED = 12.0
 
 
 def slave_edges(mesh: Mesh, nodes: np.ndarray) -> np.ndarray:
@@ -317,10 +320,15 @@ class ContactPair:
         x, proj, _, status, _, lam, _ = self.last
         self.x_prev = x.copy()
         if self.mu > 0 and not self.sticky:
-            # slip beyond z = 3 (tanh = 0.995) is plastic: the stick point follows the node, so
-            # that a reversal of the slip finds the force at once
+            # slip beyond z = Z_SATURATED is plastic: the stick point follows the node, so that
+            # a reversal of the slip finds the opposite force after a slip of about
+            # Z_SATURATED mu fn / kt, not after the whole slide.  Only there, where the force
+            # is mu fn to 1e-10, so that the next step starts from the converged force (a
+            # stick point moved to z = 3 changed it by 0.5 %: the next step started out of
+            # equilibrium by that much, and on a wall sliding round a rod's tip Newton went
+            # off along the soft sliding mode)
             contact, s0, z, limit = self._slip_state
-            zc = np.clip(z, -3.0, 3.0)
+            zc = np.clip(z, -Z_SATURATED, Z_SATURATED)
             s_new = np.where(z != zc, proj.s - zc * limit / np.maximum(self.kt0, 1e-300), s0)
             self.s_stick = np.where(contact, s_new, np.nan)
         if self.sticky:
