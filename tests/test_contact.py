@@ -148,6 +148,27 @@ def test_contact_tangent_with_a_pole_matches_difference_of_residual(surface, law
     assert np.allclose(ev.dr_dlam, dl, atol=1e-6 * np.abs(dl).max())
 
 
+@pytest.mark.parametrize("element", ["q4", "sfr"])
+def test_contact_tangent_with_a_guarded_mid_point_matches_difference_of_residual(element):
+    """A small punch (radius 0.15) pressed into the bottom of a Q4 / SFR body between two
+    nodes, deeper than the guard's allowance (0.1 of the element height) at the edge's
+    mid-point: the guard's force and its tangent, and the rate of the moving punch."""
+    punch = Circle(motion=(0.02, 0.1), center=(1.0, -0.08), radius=0.15)
+    model, pair = _contact_model(element, punch, friction=0.05)
+    model.evaluate(np.zeros(model.n_free), 0.3)
+    model.commit()
+    u_f = 0.001 * np.random.default_rng(3).standard_normal(model.n_free)
+    ev = model.evaluate(u_f, 0.5)
+    x = pair.X + model.expand(u_f, 0.5).reshape(-1, model.dpn)[pair.nodes, :2] - punch.offset(0.5)
+    mid = 0.5 * (x[pair.edges[:, 0]] + x[pair.edges[:, 1]])
+    gap = np.linalg.norm(mid - punch.center, axis=1) - punch.radius
+    assert (gap < -pair.guard_allowance).sum() == 1  # the guard of one edge acts
+    K = ev.K.toarray()
+    num, dl = difference_tangent(model, u_f, 0.5, 1e-7)
+    assert np.abs(K - num).max() < 1e-6 * np.abs(K).max()
+    assert np.allclose(ev.dr_dlam, dl, atol=1e-6 * np.abs(dl).max())
+
+
 def test_pole_force_is_the_consistent_integral_of_the_traction():
     """The pole row of M_ij = int 2 pi r N_i N_j ds on a straight Q8 edge from the axis to
     r = R: M_00 = -M_01 = 2 pi R^2 / 60, M_02 = 0 (its sum, the pole's consistent area, 0)."""

@@ -126,3 +126,24 @@ def test_preform_blown_into_the_mould():
     assert 0.7 < cavity.pressure_now < 0.9
     status = model.contacts[1].report()["status"]
     assert (status == 3).mean() > 0.9
+
+
+@pytest.mark.parametrize("element", ["q4", "sfr"])
+def test_coarse_straight_edged_preform_passes_the_pre_blow(element):
+    """The coarse preform in Q4 and SFR (4 + 15 elements, one through the wall) to t = 0.4,
+    past the start of the pre-blow (0.3), where the wall slid round the rod's tip, the chord
+    of the tip's element cut into the rod by half the wall, and the element inverted at
+    t = 0.31: the mid-point guard of the straight edges holds the chord, on Q4 less than
+    0.3 of the preform's wall (3.5) inside the rod's tip (radius 5, centre 98 t above z = 15)."""
+    model, res = run_case("stretch_blow_moulding", 0.4, "mesh.layers=1", f"mesh.element={element}",
+                          "mesh.profile=[{arc={center=[0.0,115.0],to=[9.0,115.0],divisions=4}},"
+                          "{line={to=[9.0,200.0],divisions=15}}]")
+    assert res.status == "finished"
+    if element == "q4":  # an SFR edge bulges with the fibre rotations: its chord is not the wall
+        rod = model.contacts[0]
+        x = rod.X + res.last.u.reshape(-1, model.dpn)[rod.nodes, :2]
+        mid = 0.5 * (x[rod.edges[:, 0]] + x[rod.edges[:, 1]])
+        centre = np.array([0.0, 113.0 - 98.0 * 0.4])
+        on_tip = mid[:, 1] < centre[1]
+        depth = 5.0 - np.linalg.norm(mid[on_tip] - centre, axis=1)
+        assert on_tip.sum() >= 1 and depth.max() < 0.3 * 3.5

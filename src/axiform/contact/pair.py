@@ -18,6 +18,9 @@ PENALTY_FACTOR = 10.0  # default penalty: PENALTY_FACTOR E / h, h the current el
 # a slip z = kt (s - s0) / (mu fn) beyond Z_SATURATED is the sliding force to 1e-10:
 # 1 - tanh(12) = 7.6e-11
 Z_SATURATED = 12.0
+# the mid-point of a straight slave edge is held this fraction of the reference wall height
+# behind the surface: a convex tool does not cut through the wall between two nodes
+GUARD_ALLOWANCE = 0.1
 
 
 def slave_edges(mesh: Mesh, nodes: np.ndarray) -> np.ndarray:
@@ -99,6 +102,16 @@ def _edge_heights(mesh: Mesh, edges: np.ndarray) -> np.ndarray:
     return area / chord
 
 
+def _normal_law(g: np.ndarray, touching: np.ndarray, kn, d: float):
+    """The normal law (eqs. 40-41) rounded over -d < g < 0: the force fn (n,) (>= 0, along
+    the normal) at gaps g (n,) where `touching` (and g < 0), and dfn/dg (n,)."""
+    contact = touching & (g < 0.0)
+    band = contact & (g > -d)
+    fn = np.where(contact, np.where(band, kn * g * g / (2 * d), -kn * (g + 0.5 * d)), 0.0)
+    dfn = np.where(contact, np.where(band, kn * g / d, -kn), 0.0)
+    return fn, dfn
+
+
 def outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Row-wise outer products (n, 2, 2) of a and b (n, 2)."""
     return a[:, :, None] * b[:, None, :]
@@ -137,6 +150,17 @@ class ContactPair:
     interpolated along its edges, f_0 = sum_j M_0j t_j (`pole_rows`), which is zero for a
     uniform traction as the consistent area is, but holds the pole against its neighbours:
     f_0 = M_00 (t_0 - t_1) on a straight Q8 edge.
+
+    A straight slave edge (Q4, SFR) touches the surface only at its ends, so a convex tool
+    (a stretch rod's tip) can cut into the wall between two nodes that slide round it: on a
+    coarse wall the chord of one element spanned 66 degrees of the rod's tip, the tip sank
+    into it by half the wall, and the wall snapped round the tip until the element inverted.
+    The mid-point of each straight edge is therefore guarded (`_guard`): a frictionless
+    penalty (the mean of its nodes' penalties, over 2/3 of the edge's reference ring area,
+    Simpson's mid-point weight) that acts only where the mid-point is more than
+    GUARD_ALLOWANCE of the reference height of the element under the edge behind the
+    surface.  Where the penalty's penetration stays small (flat and concave moulds, fine
+    meshes) it never acts; it holds the wall's chord off the tool where it would cut through.
 
     History (updated at converged steps by `commit`): stick points, sticky nodes, and
     `first_contact` (n,): the load factor (process time t) of the step in which each node
@@ -183,6 +207,12 @@ class ContactPair:
         else:
             self.kn0 = np.full(len(self.nodes), float(penalty))
             self.thinning = 0.0
+        # the mid-point guards of straight edges (reference weight, penalty and allowance)
+        self.guarded = self.edges.shape[1] == 2
+        if self.guarded:
+            self.guard_weight = (2.0 / 3.0) * parts.sum(axis=1)
+            self.guard_kn = 0.5 * self.kn0[self.edges].sum(axis=1)
+            self.guard_allowance = GUARD_ALLOWANCE * _edge_heights(mesh, edges)
         self.kt0 = self.kn0 if tangential_penalty is None else np.full(len(self.nodes), float(tangential_penalty))
         self.mu = friction
         self.sticky = sticky
@@ -227,6 +257,7 @@ class ContactPair:
         self._rate = None
         if self.pole_edge.size:
             self._rate = self._poles(xa, t, dt, f, C)
+        self._guard_K = self._guard(xa - self.surface.offset(lam), f, C) if self.guarded else None
         self.coupling = C.reshape(m, 2 * k, 2 * k)
         self.last = (x, proj, f, status, a, lam, ratio[:, None] * t)
         self._K = K
@@ -251,11 +282,36 @@ class ContactPair:
         C[self.pole_edge] = Cp
         return D
 
+    def _guard(self, x, f, C):
+        """Add to the forces f (n, 2) and to the coupling C (m, 2, 2, 2, 2), in place, the
+        mid-point guards of the straight edges at positions x (n, 2) relative to the surface:
+        the rounded normal law at the gap g + allowance, its force shared equally by the
+        edge's two nodes.  Returns its derivative with respect to the mid-point's position
+        (m, 2, 2), for the rate of a moving surface."""
+        e = self.edges
+        mid = 0.5 * (x[e[:, 0]] + x[e[:, 1]])
+        mid_prev = 0.5 * (self.x_prev[e[:, 0]] + self.x_prev[e[:, 1]])
+        proj = self.surface.local(mid, mid_prev, self.depth + self.guard_allowance.max(), self.search)
+        g = proj.g + self.guard_allowance
+        fn, dfn = _normal_law(g, proj.active, self.guard_kn, self.smoothing)
+        w = self.guard_weight
+        force = (w * fn)[:, None] * proj.n
+        K = ((w * dfn)[:, None, None] * outer(proj.n, proj.n)
+             + (w * fn * proj.kappa)[:, None, None] * outer(proj.t, proj.t))
+        np.add.at(f, e[:, 0], 0.5 * force)
+        np.add.at(f, e[:, 1], 0.5 * force)
+        C += 0.25 * K[:, None, :, None, :]  # d f_i / d x_j = N_i N_j K, N = 1/2 at the mid-point
+        return K
+
     def rate(self, velocity: np.ndarray) -> np.ndarray:
         """d f / d lambda at fixed u of the last evaluation divided by -1, per slave node
         (n, 2), for a surface moving with `velocity` (2,): the forces depend on the positions
         relative to the surface, x - offset(lambda)."""
         out = self._K @ velocity
+        if self._guard_K is not None:
+            mid = 0.5 * self._guard_K @ velocity
+            np.add.at(out, self.edges[:, 0], mid)
+            np.add.at(out, self.edges[:, 1], mid)
         if self._rate is not None:
             q = np.arange(self.pole_edge.size)
             np.add.at(out, self.edges[self.pole_edge][q, self.pole_corner], np.einsum("qlde,e->qd", self._rate, velocity))
@@ -275,9 +331,7 @@ class ContactPair:
         contact = proj.active & (g < 0.0) & ~self.stuck
         # normal law (eqs. 40-41): f = fn n, fn = -kn g, rounded over -d < g < 0 so that a node
         # touching the surface (g = 0) feels no force and the force has a continuous slope
-        band = contact & (g > -d)
-        fn = np.where(contact, np.where(band, kn * g * g / (2 * d), -kn * (g + 0.5 * d)), 0.0)
-        dfn = np.where(contact, np.where(band, kn * g / d, -kn), 0.0)  # dfn/dg
+        fn, dfn = _normal_law(g, contact, kn, d)
         nv, tv = proj.n, proj.t
         f += fn[:, None] * nv
         K += dfn[:, None, None] * outer(nv, nv)
