@@ -151,16 +151,21 @@ def test_contact_tangent_with_a_pole_matches_difference_of_residual(surface, law
 @pytest.mark.parametrize("element", ["q4", "sfr"])
 def test_contact_tangent_with_a_guarded_mid_point_matches_difference_of_residual(element):
     """A small punch (radius 0.15) pressed into the bottom of a Q4 / SFR body between two
-    nodes, deeper than the guard's allowance (0.1 of the element height) at the edge's
-    mid-point: the guard's force and its tangent, and the rate of the moving punch."""
-    punch = Circle(motion=(0.02, 0.1), center=(1.0, -0.08), radius=0.15)
+    nodes, deeper than the guard's allowance (0.25 of the element height) at the edge's
+    mid-point: the guard's force and its tangent (for SFR through the fibre rotations too),
+    and the rate of the moving punch."""
+    punch = Circle(motion=(0.02, 0.1), center=(1.0, -0.03), radius=0.15)
     model, pair = _contact_model(element, punch, friction=0.05)
     model.evaluate(np.zeros(model.n_free), 0.3)
     model.commit()
     u_f = 0.001 * np.random.default_rng(3).standard_normal(model.n_free)
     ev = model.evaluate(u_f, 0.5)
-    x = pair.X + model.expand(u_f, 0.5).reshape(-1, model.dpn)[pair.nodes, :2] - punch.offset(0.5)
+    u = model.expand(u_f, 0.5).reshape(-1, model.dpn)[pair.nodes]
+    x = pair.X + u[:, :2] - punch.offset(0.5)
     mid = 0.5 * (x[pair.edges[:, 0]] + x[pair.edges[:, 1]])
+    if element == "sfr":  # eq. 3 at the edge's mid-point
+        dX = pair.X[pair.edges[:, 1]] - pair.X[pair.edges[:, 0]]
+        mid += 0.25 * (u[pair.edges[:, 0], 2] - u[pair.edges[:, 1], 2])[:, None] * np.column_stack([-dX[:, 1], dX[:, 0]])
     gap = np.linalg.norm(mid - punch.center, axis=1) - punch.radius
     assert (gap < -pair.guard_allowance).sum() == 1  # the guard of one edge acts
     K = ev.K.toarray()

@@ -20,7 +20,7 @@ PENALTY_FACTOR = 10.0  # default penalty: PENALTY_FACTOR E / h, h the current el
 Z_SATURATED = 12.0
 # the mid-point of a straight slave edge is held this fraction of the reference wall height
 # behind the surface: a convex tool does not cut through the wall between two nodes
-GUARD_ALLOWANCE = 0.1
+GUARD_ALLOWANCE = 0.25
 
 
 def slave_edges(mesh: Mesh, nodes: np.ndarray) -> np.ndarray:
@@ -155,7 +155,7 @@ class ContactPair:
     (a stretch rod's tip) can cut into the wall between two nodes that slide round it: on a
     coarse wall the chord of one element spanned 66 degrees of the rod's tip, the tip sank
     into it by half the wall, and the wall snapped round the tip until the element inverted.
-    The mid-point of each straight edge is therefore guarded (`_guard`): a frictionless
+    The mid-point of each straight edge is therefore guarded (`guard`): a frictionless
     penalty (the mean of its nodes' penalties, over 2/3 of the edge's reference ring area,
     Simpson's mid-point weight) that acts only where the mid-point is more than
     GUARD_ALLOWANCE of the reference height of the element under the edge behind the
@@ -213,6 +213,9 @@ class ContactPair:
             self.guard_weight = (2.0 / 3.0) * parts.sum(axis=1)
             self.guard_kn = 0.5 * self.kn0[self.edges].sum(axis=1)
             self.guard_allowance = GUARD_ALLOWANCE * _edge_heights(mesh, edges)
+            chord = mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]]
+            self.guard_arm = 0.25 * np.column_stack([-chord[:, 1], chord[:, 0]])  # SFR: d x_m / d theta_a
+            self.guard_force = np.zeros((len(edges), 2))
         self.kt0 = self.kn0 if tangential_penalty is None else np.full(len(self.nodes), float(tangential_penalty))
         self.mu = friction
         self.sticky = sticky
@@ -257,7 +260,6 @@ class ContactPair:
         self._rate = None
         if self.pole_edge.size:
             self._rate = self._poles(xa, t, dt, f, C)
-        self._guard_K = self._guard(xa - self.surface.offset(lam), f, C) if self.guarded else None
         self.coupling = C.reshape(m, 2 * k, 2 * k)
         self.last = (x, proj, f, status, a, lam, ratio[:, None] * t)
         self._K = K
@@ -282,36 +284,46 @@ class ContactPair:
         C[self.pole_edge] = Cp
         return D
 
-    def _guard(self, x, f, C):
-        """Add to the forces f (n, 2) and to the coupling C (m, 2, 2, 2, 2), in place, the
-        mid-point guards of the straight edges at positions x (n, 2) relative to the surface:
-        the rounded normal law at the gap g + allowance, its force shared equally by the
-        edge's two nodes.  Returns its derivative with respect to the mid-point's position
-        (m, 2, 2), for the rate of a moving surface."""
+    def guard_dofs(self, dpn: int) -> np.ndarray:
+        """Full dofs of the nodes of each guarded edge, node by node (m, 2 dpn): (ur, uz), and
+        for SFR the fibre rotation theta, which moves the edge's mid-point."""
+        return (self.nodes[self.edges][:, :, None] * dpn + np.arange(dpn)).reshape(len(self.edges), -1)
+
+    def guard(self, u: np.ndarray, lam: float, velocity: np.ndarray):
+        """The mid-point guards of the straight edges at node displacements u (n_nodes, dpn)
+        and load factor lam: the rounded normal law at the mid-point's gap plus its allowance.
+        The mid-point is x_m = (x_a + x_b) / 2, and for SFR (eq. 3) also
+        + (theta_a - theta_b) (-dZ, dR) / 4 with (dR, dZ) = X_b - X_a.
+
+        Returns per edge over `guard_dofs` the force on the body F (m, 2 dpn), its derivative
+        K = dF/du (m, 2 dpn, 2 dpn), and the rate K_x velocity (m, 2 dpn) of a surface moving
+        with velocity (2,) (the force depends on x_m - offset(lam))."""
         e = self.edges
-        mid = 0.5 * (x[e[:, 0]] + x[e[:, 1]])
+        dpn = u.shape[1]
+        un = u[self.nodes]
+        mid = self.X[e].mean(axis=1) + un[e, :2].mean(axis=1) - self.surface.offset(lam)
+        P = np.zeros((len(e), 2, 2, dpn))  # d x_m / d (node, dof)
+        P[:, :, 0, :2] = P[:, :, 1, :2] = 0.5 * np.eye(2)
+        if dpn == 3:
+            mid += (un[e[:, 0], 2] - un[e[:, 1], 2])[:, None] * self.guard_arm
+            P[:, :, 0, 2], P[:, :, 1, 2] = self.guard_arm, -self.guard_arm
+        P = P.reshape(len(e), 2, 2 * dpn)
         mid_prev = 0.5 * (self.x_prev[e[:, 0]] + self.x_prev[e[:, 1]])
         proj = self.surface.local(mid, mid_prev, self.depth + self.guard_allowance.max(), self.search)
-        g = proj.g + self.guard_allowance
-        fn, dfn = _normal_law(g, proj.active, self.guard_kn, self.smoothing)
+        fn, dfn = _normal_law(proj.g + self.guard_allowance, proj.active, self.guard_kn, self.smoothing)
         w = self.guard_weight
-        force = (w * fn)[:, None] * proj.n
-        K = ((w * dfn)[:, None, None] * outer(proj.n, proj.n)
-             + (w * fn * proj.kappa)[:, None, None] * outer(proj.t, proj.t))
-        np.add.at(f, e[:, 0], 0.5 * force)
-        np.add.at(f, e[:, 1], 0.5 * force)
-        C += 0.25 * K[:, None, :, None, :]  # d f_i / d x_j = N_i N_j K, N = 1/2 at the mid-point
-        return K
+        force = (w * fn)[:, None] * proj.n  # on the mid-point (m, 2)
+        Kx = ((w * dfn)[:, None, None] * outer(proj.n, proj.n)
+              + (w * fn * proj.kappa)[:, None, None] * outer(proj.t, proj.t))
+        self.guard_force = force
+        return (np.einsum("mdi,md->mi", P, force), np.einsum("mdi,mde,mej->mij", P, Kx, P),
+                np.einsum("mdi,mde,e->mi", P, Kx, velocity))
 
     def rate(self, velocity: np.ndarray) -> np.ndarray:
         """d f / d lambda at fixed u of the last evaluation divided by -1, per slave node
         (n, 2), for a surface moving with `velocity` (2,): the forces depend on the positions
         relative to the surface, x - offset(lambda)."""
         out = self._K @ velocity
-        if self._guard_K is not None:
-            mid = 0.5 * self._guard_K @ velocity
-            np.add.at(out, self.edges[:, 0], mid)
-            np.add.at(out, self.edges[:, 1], mid)
         if self._rate is not None:
             q = np.arange(self.pole_edge.size)
             np.add.at(out, self.edges[self.pole_edge][q, self.pole_corner], np.einsum("qlde,e->qd", self._rate, velocity))
@@ -409,6 +421,7 @@ class ContactPair:
         pressure (normal force over the current ring area), status; and the totals (the
         contact area is that of the reference configuration)."""
         _, proj, f, status, a, _, traction = self.last
+        guard = self.guard_force if self.guarded else np.zeros((1, 2))
         in_contact = status > 0
         gap = np.where(proj.active, proj.g, np.nan)
         return {
@@ -420,8 +433,8 @@ class ContactPair:
             "area": self.area0,
             "current_area": a,
             "first_contact": self.first_contact,
-            "force_r": float(f[:, 0].sum()),
-            "force_z": float(f[:, 1].sum()),
+            "force_r": float(f[:, 0].sum() + guard[:, 0].sum()),
+            "force_z": float(f[:, 1].sum() + guard[:, 1].sum()),
             "contact_area": float(self.area0[in_contact].sum()),
             "penetration": float(max(0.0, -np.nanmin(np.where(in_contact, gap, np.nan)))
                                  if (in_contact & proj.active).any() else 0.0),
