@@ -162,6 +162,18 @@ class ContactPair:
     surface.  Where the penalty's penetration stays small (flat and concave moulds, fine
     meshes) it never acts; it holds the wall's chord off the tool where it would cut through.
 
+    A node resting on the surface (0 <= g < smoothing: a sheet flush with its mould) feels
+    no force and no stiffness, so the first Newton correction of a step that presses it
+    drives it deep into the surface (the sheet on its mould: a residual 2e4 times the
+    first, 14 iterations).  While `predicting` (set by the solver for the tangent of a
+    step's first iteration only) such nodes get the penalty kn n n^T in the tangent, not in
+    the force: the first correction stops them at the surface; the later iterations have
+    the exact tangent, so the converged state and the convergence rate are unchanged.  Not
+    with friction: the first correction then leaves the nodes near g = 0, where the normal
+    force and so the friction limit are nearly zero, every slip saturates the friction and
+    Newton did not converge (a block pressed and pushed on a plane with mu = 2); the
+    penalty's overshoot gave them the normal force to stick with.
+
     History (updated at converged steps by `commit`): stick points, sticky nodes, and
     `first_contact` (n,): the load factor (process time t) of the step in which each node
     first touched (for sticky contact: froze), NaN where it never did."""
@@ -230,6 +242,7 @@ class ContactPair:
         self.first_contact = np.full(n, np.nan)
         self.coupling: np.ndarray | None = None
         self.last = None
+        self.predicting = False
 
     def dofs(self, dpn: int) -> np.ndarray:
         """Full dofs (ur, uz) of the slave nodes, (n, 2)."""
@@ -345,6 +358,10 @@ class ContactPair:
         # touching the surface (g = 0) feels no force and the force has a continuous slope
         fn, dfn = _normal_law(g, contact, kn, d)
         nv, tv = proj.n, proj.t
+        if self.predicting and (self.mu == 0 or self.sticky):
+            # nodes resting on the surface (0 <= g < d) get the penalty in the tangent only
+            resting = proj.active & (g >= 0.0) & (g < d) & ~self.stuck
+            K -= (resting * kn)[:, None, None] * outer(nv, nv)
         f += fn[:, None] * nv
         K += dfn[:, None, None] * outer(nv, nv)
         K += (fn * proj.kappa)[:, None, None] * outer(tv, tv)  # fn dn/dx
