@@ -11,6 +11,7 @@ from axiform import LoadControl, Model, NeoHooke, rectangle, select_nodes, solve
 from axiform.contact import search
 from axiform.contact.pair import ContactPair, pole_rows
 from axiform.contact.surfaces import Circle, Polyline
+from axiform.solver import NewtonOptions
 from conftest import difference_tangent, distorted_rectangle
 
 coords = st.floats(-10, 10, allow_nan=False, allow_infinity=False)
@@ -147,6 +148,32 @@ def test_contact_tangent_with_a_pole_matches_difference_of_residual(surface, law
     assert np.allclose(ev.dr_dlam, dl, atol=1e-6 * np.abs(dl).max())
 
 
+@pytest.mark.parametrize("element", ["q4", "sfr"])
+def test_contact_tangent_with_a_guarded_mid_point_matches_difference_of_residual(element):
+    """A small punch (radius 0.15) pressed into the bottom of a Q4 / SFR body between two
+    nodes, deeper than the guard's allowance (0.25 of the element height) at the edge's
+    mid-point: the guard's force and its tangent (for SFR through the fibre rotations too),
+    and the rate of the moving punch."""
+    punch = Circle(motion=(0.02, 0.1), center=(1.0, -0.03), radius=0.15)
+    model, pair = _contact_model(element, punch, friction=0.05)
+    model.evaluate(np.zeros(model.n_free), 0.3)
+    model.commit()
+    u_f = 0.001 * np.random.default_rng(3).standard_normal(model.n_free)
+    ev = model.evaluate(u_f, 0.5)
+    u = model.expand(u_f, 0.5).reshape(-1, model.dpn)[pair.nodes]
+    x = pair.X + u[:, :2] - punch.offset(0.5)
+    mid = 0.5 * (x[pair.edges[:, 0]] + x[pair.edges[:, 1]])
+    if element == "sfr":  # eq. 3 at the edge's mid-point
+        dX = pair.X[pair.edges[:, 1]] - pair.X[pair.edges[:, 0]]
+        mid += 0.25 * (u[pair.edges[:, 0], 2] - u[pair.edges[:, 1], 2])[:, None] * np.column_stack([-dX[:, 1], dX[:, 0]])
+    gap = np.linalg.norm(mid - punch.center, axis=1) - punch.radius
+    assert (gap < -pair.guard_allowance).sum() == 1  # the guard of one edge acts
+    K = ev.K.toarray()
+    num, dl = difference_tangent(model, u_f, 0.5, 1e-7)
+    assert np.abs(K - num).max() < 1e-6 * np.abs(K).max()
+    assert np.allclose(ev.dr_dlam, dl, atol=1e-6 * np.abs(dl).max())
+
+
 def test_pole_force_is_the_consistent_integral_of_the_traction():
     """The pole row of M_ij = int 2 pi r N_i N_j ds on a straight Q8 edge from the axis to
     r = R: M_00 = -M_01 = 2 pi R^2 / 60, M_02 = 0 (its sum, the pole's consistent area, 0)."""
@@ -189,6 +216,24 @@ def test_friction_sliding_force_is_mu_times_normal_force():
     assert rep["force_r"] == pytest.approx(-0.2 * rep["force_z"], rel=1e-9)  # opposes the outward slide
     base = pair.nodes[touching]
     assert (res.last.u.reshape(-1, 2)[base, 0] > 1e-3).all()
+
+
+def test_a_converged_sliding_step_stays_in_equilibrium_after_its_commit():
+    """The stick points of the sliding nodes moved at the commit of a converged step leave
+    their friction forces as they were: the residual of the committed state, before any new
+    load, is still below the Newton tolerance (a stick point moved to z = 3 changed the
+    sliding force by 1 - tanh(3) = 0.5 %, a residual 1e4 times the tolerance here)."""
+    model, pair = _block_on_plane(0.2, 0.1)
+    after = []
+
+    def residual_after_commit(step):
+        ev = model.evaluate(step.u_f, step.lam)
+        after.append(ev.force_norm / ev.force_scale)
+
+    res = solve(model, LoadControl(1.0, 5), on_step=residual_after_commit)
+    assert res.status == "finished"
+    assert (pair.report()["status"] == 2).sum() >= 4  # sliding nodes, their stick points moved
+    assert max(after) <= NewtonOptions().tolerance
 
 
 def test_friction_sticking_nodes_do_not_slip():

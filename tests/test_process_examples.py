@@ -126,3 +126,29 @@ def test_preform_blown_into_the_mould():
     assert 0.7 < cavity.pressure_now < 0.9
     status = model.contacts[1].report()["status"]
     assert (status == 3).mean() > 0.9
+
+
+@pytest.mark.parametrize("element", ["q4", "sfr"])
+def test_coarse_straight_edged_preform_passes_the_pre_blow(element):
+    """The coarse preform in Q4 and SFR (4 + 15 elements, one through the wall) to t = 0.4,
+    past the start of the pre-blow (0.3), where the wall slid round the rod's tip, the chord
+    of the tip's element cut into the rod until the element inverted (t = 0.31): the
+    mid-point guard of the straight edges holds the edge's mid-point (eq. 3 for SFR) less
+    than half the preform's wall (3.5) inside the rod's tip (radius 5, centre at
+    z = 113 - 98 t)."""
+    model, res = run_case("stretch_blow_moulding", 0.4, "mesh.layers=1", f"mesh.element={element}",
+                          "mesh.profile=[{arc={center=[0.0,115.0],to=[9.0,115.0],divisions=4}},"
+                          "{line={to=[9.0,200.0],divisions=15}}]")
+    assert res.status == "finished"
+    rod = model.contacts[0]
+    a, b = rod.edges[:, 0], rod.edges[:, 1]
+    u = res.last.u.reshape(-1, model.dpn)[rod.nodes]
+    x = rod.X + u[:, :2]
+    mid = 0.5 * (x[a] + x[b])
+    if element == "sfr":
+        dX = rod.X[b] - rod.X[a]
+        mid += 0.25 * (u[a, 2] - u[b, 2])[:, None] * np.column_stack([-dX[:, 1], dX[:, 0]])
+    centre = np.array([0.0, 113.0 - 98.0 * 0.4])
+    on_tip = mid[:, 1] < centre[1]
+    depth = 5.0 - np.linalg.norm(mid[on_tip] - centre, axis=1)
+    assert on_tip.sum() >= 1 and depth.max() < 0.5 * 3.5

@@ -9,7 +9,10 @@
    its centre.  The rounded penalty law pushed nodes at g = 0 away and its zero-force point
    was a double root of the residual (Newton converged linearly, 10-20 iterations a step);
    a coarse sheet flush with its mould did not start.  The law now gives nothing at g >= 0:
-   15 steps, 48 iterations.
+   15 steps, 48 iterations; the first Newton correction, with no stiffness at g = 0, drove
+   the sheet into the mould (a residual 2e4 times the first) and the first step was cut.
+   With the penalty in the tangent of a step's first iteration for the resting nodes
+   (ContactPair.predicting): the 10 nominal steps, 35 iterations, 7 in the first.
 """
 
 from pathlib import Path
@@ -34,4 +37,5 @@ def test_volume_control_with_an_untouched_mould_keeps_full_newton_steps():
 def test_sheet_resting_on_its_mould():
     res = _run("sheet_resting_on_mould.toml")
     assert res.status == "finished", res.message
-    assert res.newton_iterations <= 5 * len(res.steps)
+    assert len(res.steps) == 10 and res.steps[0].iterations <= 8
+    assert res.newton_iterations <= 40

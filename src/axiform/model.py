@@ -224,6 +224,8 @@ class Model:
         mu = float(getattr(self.material, "shear_modulus", 1.0))
         self._noise_floor = 16 * np.finfo(float).eps * 2 * np.pi * mu * span**2 * np.sqrt(dm.nf)
         self._contact_edge_pos = [self.pattern.positions(c.edge_dofs(self.dpn)) for c in self.contacts]
+        self._guard_dofs = [c.guard_dofs(self.dpn) for c in self.contacts if c.guarded]
+        self._guard_pos = [self.pattern.positions(d) for d in self._guard_dofs]
         return self
 
     @property
@@ -316,7 +318,7 @@ class Model:
         r_full = f_int - f_ext
         dr_full = -df_ext  # dR/dt at fixed u
         # contact: R -= f_c, K -= df_c/dx; a moving surface adds dR/dt = (df_c/dx) velocity
-        contact_data = []
+        contact_data, guard_data = [], []
         u2 = u.reshape(-1, self.dpn)[:, :2]
         for pair, dofs in zip(self.contacts, self._contact_dofs):
             fc, Kc, _ = pair.evaluate(u2, t)
@@ -325,6 +327,12 @@ class Model:
             if velocity.any():
                 np.add.at(dr_full, dofs.ravel(), pair.rate(velocity).ravel())
             contact_data.append(-Kc)
+            if pair.guarded:  # the mid-points of straight edges (ContactPair.guard)
+                fg, Kg, rate = pair.guard(u.reshape(-1, self.dpn), t, velocity)
+                np.add.at(r_full, self._guard_dofs[len(guard_data)].ravel(), -fg.ravel())
+                if velocity.any():
+                    np.add.at(dr_full, self._guard_dofs[len(guard_data)].ravel(), rate.ravel())
+                guard_data.append(-Kg)
         # cavities: R -= p g, K -= p dg/du; under volume/gas control p is an unknown
         p_cav = self.cavity_pressures(u_f, t)
         g_eq, cav_data, constraints = [], [], []
@@ -354,6 +362,8 @@ class Model:
                 data -= dfext
             for pos, Kc in zip(self._contact_pos, contact_data):
                 data = self.pattern.accumulate(pos, Kc, data)
+            for pos, Kg in zip(self._guard_pos, guard_data):
+                data = self.pattern.accumulate(pos, Kg, data)
             for pos, Hc in zip(self._cavity_pos, cav_data):
                 data = self.pattern.accumulate(pos, Hc, data)
             for pos, pair in zip(self._contact_edge_pos, self.contacts):

@@ -557,6 +557,19 @@ def _newton_load(model, u_f, lam, opts, floor, guess=None):
     return _newton_load_from(model, u_f.copy(), lam, opts, floor)
 
 
+def _predictor_evaluate(model, u_f, lam):
+    """The evaluation at the start of a load step: with contact, nodes resting on a surface
+    get the penalty in this tangent only (ContactPair.predicting), so that the first
+    correction does not drive them through it."""
+    for pair in model.contacts:
+        pair.predicting = True
+    try:
+        return _evaluate(model, u_f, lam)
+    finally:
+        for pair in model.contacts:
+            pair.predicting = False
+
+
 def _newton_load_from(model, u_f, lam, opts, floor):
     """Newton at fixed lambda from u_f.  With contact, a correction that raises the residual
     is shortened (halved up to three times): the active set and the stick/slip states change
@@ -564,7 +577,7 @@ def _newton_load_from(model, u_f, lam, opts, floor):
     residual either, the full step is taken: creeping by eighths of Newton steps stalled
     sticky and frictional steps for 15 iterations at a residual that did not fall."""
     residuals: list[float] = []
-    ev = _evaluate(model, u_f, lam)
+    ev = _predictor_evaluate(model, u_f, lam)
     for it in range(opts.max_iterations + 1):
         if _check(ev, lam, opts, floor, residuals):
             return u_f, lam, it, residuals, ev

@@ -15,6 +15,12 @@ from .surfaces import RigidSurface
 
 STATUS = {0: "open", 1: "stick", 2: "slip", 3: "sticky"}  # slip: |ft| > tanh(1) mu fn
 PENALTY_FACTOR = 10.0  # default penalty: PENALTY_FACTOR E / h, h the current element height
+# a slip z = kt (s - s0) / (mu fn) beyond Z_SATURATED is the sliding force to 1e-10:
+# 1 - tanh(12) = 7.6e-11
+Z_SATURATED = 12.0
+# the mid-point of a straight slave edge is held this fraction of the reference wall height
+# behind the surface: a convex tool does not cut through the wall between two nodes
+GUARD_ALLOWANCE = 0.25
 
 
 def slave_edges(mesh: Mesh, nodes: np.ndarray) -> np.ndarray:
@@ -96,6 +102,16 @@ def _edge_heights(mesh: Mesh, edges: np.ndarray) -> np.ndarray:
     return area / chord
 
 
+def _normal_law(g: np.ndarray, touching: np.ndarray, kn, d: float):
+    """The normal law (eqs. 40-41) rounded over -d < g < 0: the force fn (n,) (>= 0, along
+    the normal) at gaps g (n,) where `touching` (and g < 0), and dfn/dg (n,)."""
+    contact = touching & (g < 0.0)
+    band = contact & (g > -d)
+    fn = np.where(contact, np.where(band, kn * g * g / (2 * d), -kn * (g + 0.5 * d)), 0.0)
+    dfn = np.where(contact, np.where(band, kn * g / d, -kn), 0.0)
+    return fn, dfn
+
+
 def outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Row-wise outer products (n, 2, 2) of a and b (n, 2)."""
     return a[:, :, None] * b[:, None, :]
@@ -134,6 +150,29 @@ class ContactPair:
     interpolated along its edges, f_0 = sum_j M_0j t_j (`pole_rows`), which is zero for a
     uniform traction as the consistent area is, but holds the pole against its neighbours:
     f_0 = M_00 (t_0 - t_1) on a straight Q8 edge.
+
+    A straight slave edge (Q4, SFR) touches the surface only at its ends, so a convex tool
+    (a stretch rod's tip) can cut into the wall between two nodes that slide round it: on a
+    coarse wall the chord of one element spanned 66 degrees of the rod's tip, the tip sank
+    into it by half the wall, and the wall snapped round the tip until the element inverted.
+    The mid-point of each straight edge is therefore guarded (`guard`): a frictionless
+    penalty (the mean of its nodes' penalties, over 2/3 of the edge's reference ring area,
+    Simpson's mid-point weight) that acts only where the mid-point is more than
+    GUARD_ALLOWANCE of the reference height of the element under the edge behind the
+    surface.  Where the penalty's penetration stays small (flat and concave moulds, fine
+    meshes) it never acts; it holds the wall's chord off the tool where it would cut through.
+
+    A node resting on the surface (0 <= g < smoothing: a sheet flush with its mould) feels
+    no force and no stiffness, so the first Newton correction of a step that presses it
+    drives it deep into the surface (the sheet on its mould: a residual 2e4 times the
+    first, 14 iterations).  While `predicting` (set by the solver for the tangent of a
+    step's first iteration only) such nodes get the penalty kn n n^T in the tangent, not in
+    the force: the first correction stops them at the surface; the later iterations have
+    the exact tangent, so the converged state and the convergence rate are unchanged.  Not
+    with friction: the first correction then leaves the nodes near g = 0, where the normal
+    force and so the friction limit are nearly zero, every slip saturates the friction and
+    Newton did not converge (a block pressed and pushed on a plane with mu = 2); the
+    penalty's overshoot gave them the normal force to stick with.
 
     History (updated at converged steps by `commit`): stick points, sticky nodes, and
     `first_contact` (n,): the load factor (process time t) of the step in which each node
@@ -180,6 +219,15 @@ class ContactPair:
         else:
             self.kn0 = np.full(len(self.nodes), float(penalty))
             self.thinning = 0.0
+        # the mid-point guards of straight edges (reference weight, penalty and allowance)
+        self.guarded = self.edges.shape[1] == 2
+        if self.guarded:
+            self.guard_weight = (2.0 / 3.0) * parts.sum(axis=1)
+            self.guard_kn = 0.5 * self.kn0[self.edges].sum(axis=1)
+            self.guard_allowance = GUARD_ALLOWANCE * _edge_heights(mesh, edges)
+            chord = mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]]
+            self.guard_arm = 0.25 * np.column_stack([-chord[:, 1], chord[:, 0]])  # SFR: d x_m / d theta_a
+            self.guard_force = np.zeros((len(edges), 2))
         self.kt0 = self.kn0 if tangential_penalty is None else np.full(len(self.nodes), float(tangential_penalty))
         self.mu = friction
         self.sticky = sticky
@@ -194,6 +242,7 @@ class ContactPair:
         self.first_contact = np.full(n, np.nan)
         self.coupling: np.ndarray | None = None
         self.last = None
+        self.predicting = False
 
     def dofs(self, dpn: int) -> np.ndarray:
         """Full dofs (ur, uz) of the slave nodes, (n, 2)."""
@@ -248,6 +297,41 @@ class ContactPair:
         C[self.pole_edge] = Cp
         return D
 
+    def guard_dofs(self, dpn: int) -> np.ndarray:
+        """Full dofs of the nodes of each guarded edge, node by node (m, 2 dpn): (ur, uz), and
+        for SFR the fibre rotation theta, which moves the edge's mid-point."""
+        return (self.nodes[self.edges][:, :, None] * dpn + np.arange(dpn)).reshape(len(self.edges), -1)
+
+    def guard(self, u: np.ndarray, lam: float, velocity: np.ndarray):
+        """The mid-point guards of the straight edges at node displacements u (n_nodes, dpn)
+        and load factor lam: the rounded normal law at the mid-point's gap plus its allowance.
+        The mid-point is x_m = (x_a + x_b) / 2, and for SFR (eq. 3) also
+        + (theta_a - theta_b) (-dZ, dR) / 4 with (dR, dZ) = X_b - X_a.
+
+        Returns per edge over `guard_dofs` the force on the body F (m, 2 dpn), its derivative
+        K = dF/du (m, 2 dpn, 2 dpn), and the rate K_x velocity (m, 2 dpn) of a surface moving
+        with velocity (2,) (the force depends on x_m - offset(lam))."""
+        e = self.edges
+        dpn = u.shape[1]
+        un = u[self.nodes]
+        mid = self.X[e].mean(axis=1) + un[e, :2].mean(axis=1) - self.surface.offset(lam)
+        P = np.zeros((len(e), 2, 2, dpn))  # d x_m / d (node, dof)
+        P[:, :, 0, :2] = P[:, :, 1, :2] = 0.5 * np.eye(2)
+        if dpn == 3:
+            mid += (un[e[:, 0], 2] - un[e[:, 1], 2])[:, None] * self.guard_arm
+            P[:, :, 0, 2], P[:, :, 1, 2] = self.guard_arm, -self.guard_arm
+        P = P.reshape(len(e), 2, 2 * dpn)
+        mid_prev = 0.5 * (self.x_prev[e[:, 0]] + self.x_prev[e[:, 1]])
+        proj = self.surface.local(mid, mid_prev, self.depth + self.guard_allowance.max(), self.search)
+        fn, dfn = _normal_law(proj.g + self.guard_allowance, proj.active, self.guard_kn, self.smoothing)
+        w = self.guard_weight
+        force = (w * fn)[:, None] * proj.n  # on the mid-point (m, 2)
+        Kx = ((w * dfn)[:, None, None] * outer(proj.n, proj.n)
+              + (w * fn * proj.kappa)[:, None, None] * outer(proj.t, proj.t))
+        self.guard_force = force
+        return (np.einsum("mdi,md->mi", P, force), np.einsum("mdi,mde,mej->mij", P, Kx, P),
+                np.einsum("mdi,mde,e->mi", P, Kx, velocity))
+
     def rate(self, velocity: np.ndarray) -> np.ndarray:
         """d f / d lambda at fixed u of the last evaluation divided by -1, per slave node
         (n, 2), for a surface moving with `velocity` (2,): the forces depend on the positions
@@ -272,10 +356,12 @@ class ContactPair:
         contact = proj.active & (g < 0.0) & ~self.stuck
         # normal law (eqs. 40-41): f = fn n, fn = -kn g, rounded over -d < g < 0 so that a node
         # touching the surface (g = 0) feels no force and the force has a continuous slope
-        band = contact & (g > -d)
-        fn = np.where(contact, np.where(band, kn * g * g / (2 * d), -kn * (g + 0.5 * d)), 0.0)
-        dfn = np.where(contact, np.where(band, kn * g / d, -kn), 0.0)  # dfn/dg
+        fn, dfn = _normal_law(g, contact, kn, d)
         nv, tv = proj.n, proj.t
+        if self.predicting and (self.mu == 0 or self.sticky):
+            # nodes resting on the surface (0 <= g < d) get the penalty in the tangent only
+            resting = proj.active & (g >= 0.0) & (g < d) & ~self.stuck
+            K -= (resting * kn)[:, None, None] * outer(nv, nv)
         f += fn[:, None] * nv
         K += dfn[:, None, None] * outer(nv, nv)
         K += (fn * proj.kappa)[:, None, None] * outer(tv, tv)  # fn dn/dx
@@ -317,10 +403,15 @@ class ContactPair:
         x, proj, _, status, _, lam, _ = self.last
         self.x_prev = x.copy()
         if self.mu > 0 and not self.sticky:
-            # slip beyond z = 3 (tanh = 0.995) is plastic: the stick point follows the node, so
-            # that a reversal of the slip finds the force at once
+            # slip beyond z = Z_SATURATED is plastic: the stick point follows the node, so that
+            # a reversal of the slip finds the opposite force after a slip of about
+            # Z_SATURATED mu fn / kt, not after the whole slide.  Only there, where the force
+            # is mu fn to 1e-10, so that the next step starts from the converged force (a
+            # stick point moved to z = 3 changed it by 0.5 %: the next step started out of
+            # equilibrium by that much, and on a wall sliding round a rod's tip Newton went
+            # off along the soft sliding mode)
             contact, s0, z, limit = self._slip_state
-            zc = np.clip(z, -3.0, 3.0)
+            zc = np.clip(z, -Z_SATURATED, Z_SATURATED)
             s_new = np.where(z != zc, proj.s - zc * limit / np.maximum(self.kt0, 1e-300), s0)
             self.s_stick = np.where(contact, s_new, np.nan)
         if self.sticky:
@@ -347,6 +438,7 @@ class ContactPair:
         pressure (normal force over the current ring area), status; and the totals (the
         contact area is that of the reference configuration)."""
         _, proj, f, status, a, _, traction = self.last
+        guard = self.guard_force if self.guarded else np.zeros((1, 2))
         in_contact = status > 0
         gap = np.where(proj.active, proj.g, np.nan)
         return {
@@ -358,8 +450,8 @@ class ContactPair:
             "area": self.area0,
             "current_area": a,
             "first_contact": self.first_contact,
-            "force_r": float(f[:, 0].sum()),
-            "force_z": float(f[:, 1].sum()),
+            "force_r": float(f[:, 0].sum() + guard[:, 0].sum()),
+            "force_z": float(f[:, 1].sum() + guard[:, 1].sum()),
             "contact_area": float(self.area0[in_contact].sum()),
             "penetration": float(max(0.0, -np.nanmin(np.where(in_contact, gap, np.nan)))
                                  if (in_contact & proj.active).any() else 0.0),
