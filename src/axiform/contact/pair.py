@@ -15,9 +15,9 @@ from .surfaces import RigidSurface
 
 STATUS = {0: "open", 1: "stick", 2: "slip", 3: "sticky"}  # slip: |ft| > tanh(1) mu fn
 PENALTY_FACTOR = 10.0  # default penalty: PENALTY_FACTOR E / h, h the current element height
-# a slip z = kt (s - s0) / (mu fn) beyond Z_SATURATED is the sliding force to 1e-10:
-# 1 - tanh(12) = 7.6e-11
-Z_SATURATED = 12.0
+# a slip z = kt (s - s0) / (mu fn) beyond Z_SATURATED moves the stick point at a commit
+# (the sliding force then changes by 1 - tanh(3) = 0.5 %; README "Friction at a converged step")
+Z_SATURATED = 3.0
 # the mid-point of a straight slave edge is held this fraction of the reference wall height
 # behind the surface: a convex tool does not cut through the wall between two nodes
 GUARD_ALLOWANCE = 0.25
@@ -408,11 +408,9 @@ class ContactPair:
         if self.mu > 0 and not self.sticky:
             # slip beyond z = Z_SATURATED is plastic: the stick point follows the node, so that
             # a reversal of the slip finds the opposite force after a slip of about
-            # Z_SATURATED mu fn / kt, not after the whole slide.  Only there, where the force
-            # is mu fn to 1e-10, so that the next step starts from the converged force (a
-            # stick point moved to z = 3 changed it by 0.5 %: the next step started out of
-            # equilibrium by that much, and on a wall sliding round a rod's tip Newton went
-            # off along the soft sliding mode)
+            # Z_SATURATED mu fn / kt, not after the whole slide (at 12, where the force is
+            # saturated to 1e-10, reversing nodes had next to no tangential stiffness and a
+            # frictional tube took twice the iterations and a cut)
             contact, s0, z, limit = self._slip_state
             zc = np.clip(z, -Z_SATURATED, Z_SATURATED)
             s_new = np.where(z != zc, proj.s - zc * limit / np.maximum(self.kt0, 1e-300), s0)
