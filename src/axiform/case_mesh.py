@@ -1,0 +1,115 @@
+"""The [mesh] table of the case file: a rectangle, a gmsh file or a layered wall along a profile
+of lines and arcs, with its element and formulation; and the mesh it makes."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import itertools
+from pathlib import Path
+from typing import Annotated, Literal
+
+from pydantic import Field, model_validator
+
+from .case_base import CaseError, PositiveFloat, Strict
+from .mesh import Mesh, MeshError, layered, read_gmsh, rectangle
+from .profile import Arc, Line, Profile, ProfileError
+
+
+class LinePiece(Strict):
+    to: tuple[float, float]
+    divisions: Annotated[int, Field(ge=1)]
+
+
+class ArcPiece(Strict):
+    center: tuple[float, float]
+    to: tuple[float, float]
+    divisions: Annotated[int, Field(ge=1)]
+    ccw: bool = True
+
+
+class PieceSpec(Strict):
+    """One piece of a profile: { line = {...} } or { arc = {...} }."""
+
+    line: LinePiece | None = None
+    arc: ArcPiece | None = None
+
+    @model_validator(mode="after")
+    def _one(self):
+        if (self.line is None) == (self.arc is None):
+            raise ValueError("a profile piece is either { line = ... } or { arc = ... }")
+        return self
+
+
+_GRID_KEYS = {"rectangle": ("r", "z", "divisions"), "gmsh": ("file",),
+              "layered": ("start", "profile", "thickness", "layers")}
+
+
+class MeshSpec(Strict):
+    kind: Literal["rectangle", "gmsh", "layered"] = "rectangle"
+    element: Literal["q4", "q8", "sfr"]
+    r: tuple[float, float] | None = None
+    z: tuple[float, float] | None = None
+    divisions: tuple[Annotated[int, Field(ge=1)], Annotated[int, Field(ge=1)]] | None = None
+    file: str | None = None
+    start: tuple[float, float] | None = None
+    profile: Annotated[list[PieceSpec], Field(min_length=1)] | None = None
+    thickness: PositiveFloat | Annotated[list[tuple[float, PositiveFloat]], Field(min_length=2)] | None = None
+    wall: Literal["r", "z"] | None = None  # rectangle: direction through the wall (thickness)
+    grading: tuple[PositiveFloat, PositiveFloat] | None = None  # rectangle: last element / first
+    layers: Annotated[int, Field(ge=1)] | None = None
+    sfr_edges: Literal["tie", "fix", "free"] = "tie"
+    formulation: Literal["mixed", "displacement"] = "mixed"
+
+    @model_validator(mode="after")
+    def _kind(self):
+        for kind, keys in _GRID_KEYS.items():
+            for key in keys:
+                given = getattr(self, key) is not None
+                if kind == self.kind and not given:
+                    raise ValueError(f"a {kind} mesh needs '{key}'")
+                if kind != self.kind and given and key not in _GRID_KEYS[self.kind]:
+                    raise ValueError(f"'{key}' belongs to kind = \"{kind}\"")
+        if self.wall is not None and self.kind != "rectangle":
+            raise ValueError("'wall' belongs to kind = \"rectangle\" (a layered wall knows its own)")
+        if self.grading is not None and self.kind != "rectangle":
+            raise ValueError("'grading' belongs to kind = \"rectangle\"")
+        if self.kind == "rectangle":
+            if not self.r[0] < self.r[1] or not self.z[0] < self.z[1]:
+                raise ValueError("r and z must be given as [min, max] with min < max")
+            if self.r[0] < 0:
+                raise ValueError("r must be >= 0 (the meridian plane)")
+        if self.kind == "layered" and isinstance(self.thickness, list):
+            s = [row[0] for row in self.thickness]
+            if any(b <= a for a, b in itertools.pairwise(s)):
+                raise ValueError("thickness table: arc lengths must increase")
+        return self
+
+    def build_profile(self):
+        pieces = tuple(Line(p.line.to, p.line.divisions) if p.line else
+                       Arc(p.arc.center, p.arc.to, p.arc.divisions, p.arc.ccw) for p in self.profile)
+        return Profile(self.start, pieces)
+
+
+def build_mesh(spec: MeshSpec, base: Path) -> Mesh:
+    """The mesh of a [mesh] table; a relative gmsh file is taken from the folder `base`."""
+    if spec.kind == "rectangle":
+        return rectangle(spec.r, spec.z, spec.divisions, spec.element, grading=spec.grading or (1.0, 1.0))
+    if spec.kind == "layered":
+        try:
+            return layered(spec.build_profile(), spec.thickness, spec.layers, spec.element)
+        except ProfileError as exc:
+            raise CaseError(f"mesh.profile: {exc}") from None
+    path = Path(spec.file)
+    path = path if path.is_absolute() else base / path
+    if not path.exists():
+        raise CaseError(f"mesh.file: no such file {path}")
+    said = io.StringIO()  # meshio prints its warnings and errors itself
+    try:
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            return read_gmsh(path, spec.element)
+    except MeshError as exc:
+        raise CaseError(f"mesh.file: {exc}") from None
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 - meshio raises anything (and calls sys.exit) on bad files
+        why = f"{type(exc).__name__}: {exc}" if not isinstance(exc, SystemExit) else said.getvalue().strip()
+        raise CaseError(f"mesh.file: cannot read {path} as a gmsh mesh ({' '.join(why.split())})") from None

@@ -1,0 +1,119 @@
+"""The [[monitor]] tables of the case file: named scalars read off each converged step (one
+dof, a sum of reactions, a quantity of a contact pair or of a cavity)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import Field, field_validator, model_validator
+
+from .case_base import CaseError, DofName, Selector, Strict, one_node
+from .cavity import Cavity
+from .contact.pair import ContactPair
+from .mesh import Mesh
+from .model import Model
+from .selectors import select_nodes
+
+HISTORY_COLUMNS = ("step", "load_factor", "iterations")  # history.csv's first columns
+
+
+class MonitorSpec(Strict):
+    """One node's displacement (at + dof), the reaction summed over nodes (reaction + dof), or
+    a quantity of a contact pair (contact = index of the [[contact]] table + quantity)."""
+
+    name: str
+    at: Selector | None = None
+    reaction: Selector | None = None
+    dof: DofName | None = None
+    contact: Annotated[int, Field(ge=0)] | None = None
+    cavity: str | None = None
+    quantity: Literal["force-r", "force-z", "area", "penetration", "pressure", "volume"] | None = None
+
+    @field_validator("name")
+    @classmethod
+    def _name(cls, name: str) -> str:
+        if not name.strip() or name in HISTORY_COLUMNS or name != name.strip():
+            raise ValueError(f"{name!r}: a monitor name must not be empty, begin or end with blanks, or be "
+                             f"one of the columns {', '.join(HISTORY_COLUMNS)}")
+        return name
+
+    @model_validator(mode="after")
+    def _one(self):
+        given = [k for k in ("at", "reaction", "contact", "cavity") if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise ValueError("a monitor needs exactly one of 'at', 'reaction', 'contact' or 'cavity'")
+        if self.cavity is not None:
+            if self.quantity not in ("pressure", "volume"):
+                raise ValueError("a cavity monitor needs quantity = \"pressure\" or \"volume\"")
+            if self.dof is not None:
+                raise ValueError("'dof' does not belong to a cavity monitor")
+            return self
+        if self.quantity in ("pressure", "volume"):
+            raise ValueError(f"quantity = \"{self.quantity}\" belongs to a cavity monitor")
+        if self.contact is None:
+            if self.dof is None:
+                raise ValueError(f"a monitor with '{given[0]}' needs 'dof'")
+            if self.quantity is not None:
+                raise ValueError("'quantity' belongs to a contact monitor")
+        else:
+            if self.quantity is None:
+                raise ValueError("a contact monitor needs 'quantity'")
+            if self.dof is not None:
+                raise ValueError("'dof' does not belong to a contact monitor")
+        return self
+
+
+_CONTACT_QUANTITY = {"force-r": "force_r", "force-z": "force_z", "area": "contact_area",
+                     "penetration": "penetration"}
+
+
+@dataclass
+class Monitor:
+    """A named scalar read off each converged step: one dof, a sum of reactions, a contact
+    pair's total force, contact area or penetration, or a cavity's pressure or volume."""
+
+    name: str
+    dofs: np.ndarray | None = None
+    reaction: bool = False
+    pair: object = None
+    quantity: str = ""
+    cavity: object = None
+
+    def value(self, step) -> float:
+        if self.cavity is not None:
+            return float(self.cavity.pressure_now if self.quantity == "pressure" else self.cavity.volume_now)
+        if self.pair is not None:
+            return float(self.pair.report()[_CONTACT_QUANTITY[self.quantity]])
+        if self.reaction:
+            return float(step.r_full[self.dofs].sum())
+        return float(step.u[self.dofs].sum())
+
+
+def build_monitors(model: Model, mesh: Mesh, specs: list[MonitorSpec], cavities: dict[str, Cavity],
+                   pairs: list[ContactPair], element: str) -> list[Monitor]:
+    """The monitors of the [[monitor]] tables, over the case's cavities (by name), contact pairs
+    (in [[contact]] order) and element (named in the error for a rotation it lacks)."""
+    monitors = []
+    for i, m in enumerate(specs):
+        if m.cavity is not None:
+            if m.cavity not in cavities:
+                raise CaseError(f"monitor[{i}].cavity: no [[cavity]] is named '{m.cavity}'")
+            monitors.append(Monitor(m.name, cavity=cavities[m.cavity], quantity=m.quantity))
+            continue
+        if m.contact is not None:
+            if m.contact >= len(pairs):
+                raise CaseError(f"monitor[{i}].contact: there are {len(pairs)} [[contact]] tables (from 0)")
+            monitors.append(Monitor(m.name, pair=pairs[m.contact], quantity=m.quantity))
+            continue
+        if m.dof == "rot" and model.dpn == 2:
+            raise CaseError(f"monitor[{i}].dof: element '{element}' has no rotation dof")
+        if m.at is not None:
+            nodes = np.array([one_node(mesh, m.at, f"monitor[{i}].at")])
+        else:
+            nodes = select_nodes(mesh, m.reaction.model_dump(), f"monitor[{i}].reaction")
+        monitors.append(Monitor(m.name, model.dof(nodes, m.dof), m.reaction is not None))
+    if len({m.name for m in monitors}) != len(monitors):
+        raise CaseError("monitor: names must be unique")
+    return monitors

@@ -1,0 +1,76 @@
+"""The [solver] table of the case file: the path-following control (load, displacement or arc
+length) and Newton's options; and the control it makes."""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import Field, model_validator
+
+from .case_base import CaseError, DofName, PositiveFloat, Selector, Strict, one_node
+from .mesh import Mesh
+from .model import Model
+from .solver import ArcLengthControl, DisplacementControl, LoadControl
+
+
+class DofRef(Strict):
+    at: Selector
+    dof: DofName
+
+
+class StopSpec(Strict):
+    at: Selector
+    dof: Literal["ur", "uz"]
+    value: float
+
+
+class SolverSpec(Strict):
+    control: Literal["load", "displacement", "arc-length"] = "load"
+    dof: DofRef | None = None
+    target: float | None = None
+    steps: Annotated[int, Field(ge=1)] = 10
+    arc_length: PositiveFloat | None = None
+    stop: StopSpec | None = None
+    max_steps: Annotated[int, Field(ge=1)] = 1000
+    max_iterations: Annotated[int, Field(ge=1)] = 20
+    tolerance: Annotated[float, Field(gt=0, lt=1)] = 1e-8
+    min_step: Annotated[float, Field(gt=0, le=1)] = 1e-4
+    growth: Annotated[float, Field(ge=1)] = 1.5
+
+    @model_validator(mode="after")
+    def _control(self):
+        if self.control == "displacement":
+            if self.dof is None or self.target is None:
+                raise ValueError("displacement control needs 'dof' and 'target'")
+        elif self.dof is not None:
+            raise ValueError("'dof' belongs to control = \"displacement\"")
+        if self.control != "arc-length":
+            for key in ("arc_length", "stop"):
+                if getattr(self, key) is not None:
+                    raise ValueError(f"'{key}' belongs to control = \"arc-length\"")
+        if self.target is not None and self.target == 0:
+            raise ValueError("target must not be 0")
+        return self
+
+
+def build_control(model: Model, mesh: Mesh, spec: SolverSpec) -> LoadControl | DisplacementControl | ArcLengthControl:
+    """The path-following control of the [solver] table, on the model with its [[fix]] tables
+    prescribed (a driven or stop dof that is also fixed is refused)."""
+    if spec.control == "displacement":
+        if spec.dof.dof == "rot":
+            raise CaseError("solver.dof.dof: drive a displacement (ur or uz), not a fibre rotation")
+        node = one_node(mesh, spec.dof.at, "solver.dof.at")
+        dof = int(model.dof(node, spec.dof.dof))
+        if dof in model.fixed:
+            raise CaseError("solver.dof: the driven dof is also fixed by a [[fix]] table")
+        return DisplacementControl(dof, spec.target, spec.steps)
+    if spec.control == "arc-length":
+        stop_dof = stop_value = None
+        if spec.stop is not None:
+            stop_dof = int(model.dof(one_node(mesh, spec.stop.at, "solver.stop.at"), spec.stop.dof))
+            if stop_dof in model.fixed:
+                raise CaseError("solver.stop: that dof is fixed by a [[fix]] table")
+            stop_value = spec.stop.value
+        return ArcLengthControl(1.0 if spec.target is None else spec.target, spec.steps, spec.arc_length,
+                                stop_dof, stop_value, spec.max_steps)
+    return LoadControl(1.0 if spec.target is None else spec.target, spec.steps)
