@@ -287,3 +287,30 @@ def factorize(K: sp.spmatrix) -> Solve:
     if lib is not None:
         return _factorize_pardiso(K, lib)
     return _factorize_superlu(K)
+
+
+def _permutation_parity(p: np.ndarray) -> int:
+    """+1 or -1: the sign of the permutation p (n,), (-1)^(n - its cycles); the cycles are
+    counted by labelling every index with the least of its cycle (pointer doubling)."""
+    n = p.size
+    label, step = np.arange(n), p.copy()
+    for _ in range(max(1, int(np.ceil(np.log2(max(n, 2))))) + 1):
+        label = np.minimum(label, label[step])
+        step = step[step]
+    cycles = np.count_nonzero(label == np.arange(n))
+    return -1 if (n - cycles) % 2 else 1
+
+
+def determinant_sign(K: sp.spmatrix) -> int:
+    """The sign of det K (+1, -1; 0 where a pivot is exactly zero), from SuperLU's LU with
+    partial pivoting: the signs of U's diagonal times those of the row and column
+    permutations.  Along a regular equilibrium path it changes at the limit points of the
+    load and at bifurcations only."""
+    from scipy.sparse.linalg import splu
+
+    try:
+        lu = splu(sp.csc_matrix(K), permc_spec="MMD_ATA")
+    except RuntimeError:  # "Factor is exactly singular"
+        return 0
+    d = lu.U.diagonal()
+    return int(np.prod(np.sign(d))) * _permutation_parity(lu.perm_r) * _permutation_parity(lu.perm_c)
