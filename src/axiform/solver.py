@@ -16,7 +16,7 @@ import numpy as np
 
 from .folds import folded_nodes
 from .guards import evaluation_fault
-from .linsolve import SingularTangentError, determinant_sign, factorize
+from .linsolve import SingularTangentError, factorize, factorize_signed
 from .materials import InvertedElementError
 from .model import Evaluation, Model
 
@@ -380,6 +380,7 @@ class _ArcLength(_Path):
         # cavity pressures (after the displacements) are not part of the arc
         self.weight = np.concatenate([np.where(rep < 2, 1.0, span**2), np.zeros(model.n_free - len(rep))])
         self.previous = None  # last converged increment, for the direction of the next one
+        self._tangent = (None, None, None)  # (u_f, du/dlambda and ||R|| there) from the check of the last step's end
         self.stop = None
         if control.stop_dof is not None:
             self.stop = int(model.dofmap.eq[control.stop_dof])
@@ -511,10 +512,13 @@ class _ArcLength(_Path):
         sign(t . du) sign(det K) there must be the path's own.  A step that lands on a
         nearby branch (the loaded branch, run backwards, next to a snap-back of a folding
         corner element) breaks it: a shorter arc stays on the path."""
-        det = determinant_sign(ev.K)
-        du = u_new - self.u_f
-        t = -_factorize(ev.K)(ev.dr_dlam)
-        orientation = int(np.sign(np.dot(self.weight * t, du))) * det
+        solve, det = factorize_signed(ev.K)
+        if det == 0:
+            return
+        t = -solve(ev.dr_dlam)
+        if not self.model.cavities:  # the next step's tangent, unless the commit changes K
+            self._tangent = (u_new, t, ev.force_norm)
+        orientation = int(np.sign(np.dot(self.weight * t, u_new - self.u_f))) * det
         if orientation == 0:
             return
         if self.orientation == 0:
@@ -525,8 +529,11 @@ class _ArcLength(_Path):
 
     def _arc_step(self, dl):
         model, opts, W = self.model, self.opts, self.weight
-        ev = _evaluate(model, self.u_f, self.lam)
-        t = -_factorize(ev.K)(ev.dr_dlam)  # du/dlambda along the tangent
+        at, t, start = self._tangent
+        if at is not self.u_f:
+            ev = _evaluate(model, self.u_f, self.lam)
+            t = -_factorize(ev.K)(ev.dr_dlam)  # du/dlambda along the tangent
+            start = ev.force_norm
         if not self._norm(t) > 0:
             # the structure does not respond to the load (only a tool moves, not touching yet)
             return self._load_step(dl)
@@ -536,7 +543,7 @@ class _ArcLength(_Path):
                 else np.sign(self.control.target))
         dlam = (sign or 1.0) * dl / max(self._norm(t), 1e-300)
         du = predictor = dlam * t
-        residuals = [ev.force_norm]
+        residuals = [start]
         for it in range(1, opts.max_iterations + 1):
             lam = self.lam + dlam
             ev = _evaluate(model, self.u_f + du, lam)
