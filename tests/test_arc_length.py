@@ -182,3 +182,44 @@ def test_a_tube_blown_onto_a_mould_takes_about_the_steps_asked_for():
     assert lam[-1] == 1.0
     assert np.abs(np.diff(lam)).max() <= 1.0 / 80 * (1 + 1e-12)
     assert 0.9 * 80 <= res.n_steps <= 1.5 * 80
+
+
+def test_the_displacement_q8_plate_follows_its_snap_back():
+    """The paper's displacement formulation, Q8 2 x 20, 20 steps: the pressure has a first
+    maximum, 38.560 psi, at w = 11.80, where the path snaps back (w falls to 11.496 at
+    38.137 psi) and then goes on up (arc_length = 0.1 in, 1282 steps, gives the same turn
+    and end of it to 1e-4 in).  Each step must stay on the path: its increment within 45
+    degrees of the tangent, and sign(d lambda / ds) sign(det K) unchanged at its end (a step
+    landing on the loaded branch nearby breaks it).  Measured: 65 steps to w = 23, the
+    maximum 41.34 psi at w = 19.7; before, the run stopped at w = 11.78 (20 steps), and with
+    400 steps ran back down the loaded branch through zero pressure to w = -3.6."""
+    from conftest import clamped_plate
+
+    model = clamped_plate("q8", "displacement")
+    w = plate_centre(model)
+    res = solve(model, ArcLengthControl(target=100.0, steps=20, stop_dof=w, stop_value=23.0))
+    assert res.status == "finished", res.message
+    d = np.array([s.u[w] for s in res.steps])
+    p = np.array([s.lam for s in res.steps])
+    back = np.flatnonzero(np.diff(d) < 0)
+    assert d[back[0]] == pytest.approx(11.799, abs=1e-3)  # the snap-back, and no other
+    assert d[back[-1] + 1] == pytest.approx(11.4958, abs=1e-3) and d[back].min() > 11.49
+    assert p.min() > 0 and 41.2 < p.max() < 41.5
+    assert d[-1] == pytest.approx(23.0, rel=1e-12)
+
+
+def test_a_path_run_back_to_zero_load_ends_the_run(monkeypatch):
+    """The same plate with 400 steps and the two checks of a step's end turned off: a step
+    lands on the loaded branch near the snap-back at w = 11.8 and the path runs back down it;
+    the run ends where lambda would cross zero, saying so (before: 1000 steps, to w = -3.6)."""
+    from axiform import solver as solver_module
+    from conftest import clamped_plate
+
+    monkeypatch.setattr(solver_module, "MAX_TURN", np.pi)
+    monkeypatch.setattr(solver_module._ArcLength, "_check_branch", lambda self, u_new, ev: None)
+    model = clamped_plate("q8", "displacement")
+    w = plate_centre(model)
+    res = solve(model, ArcLengthControl(target=100.0, steps=400, stop_dof=w, stop_value=23.0))
+    assert res.status == "stopped"
+    assert "the path came back to zero load" in res.message
+    assert 0 < res.last.lam < 0.1 and min(s.lam for s in res.steps) > 0

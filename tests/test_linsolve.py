@@ -122,3 +122,19 @@ def test_threads_by_size(monkeypatch):
     x0 = ls.factorize(K)(B)
     assert ls._STATE.pardiso.threads == 0
     assert np.abs(x1 - x0).max() <= 1e-12 * np.abs(x0).max()
+
+
+@pytest.mark.parametrize("n", [1, 2, 7, 60, 400])
+def test_signed_factorization_against_dense_determinant(n):
+    """sign(det K) from SuperLU's factors and permutations, against numpy's determinant, on
+    random sparse matrices (half of them of either sign)."""
+    rng = np.random.default_rng(n)
+    signs = []
+    for _ in range(10):
+        A = sp.random(n, n, density=min(1.0, 5.0 / n), random_state=rng) + sp.diags(rng.normal(size=n))
+        solve, sign = ls.factorize_signed(A)
+        assert sign == np.sign(np.linalg.slogdet(A.toarray())[0])
+        b = rng.normal(size=n)
+        assert A @ solve(b) == pytest.approx(b, abs=1e-8 * np.abs(b).max() * np.linalg.cond(A.toarray()))
+        signs.append(sign)
+    assert n == 1 or set(signs) == {-1, 1}

@@ -16,7 +16,7 @@ import numpy as np
 
 from .folds import folded_nodes
 from .guards import evaluation_fault
-from .linsolve import SingularTangentError, factorize
+from .linsolve import SingularTangentError, factorize, factorize_signed
 from .materials import InvertedElementError
 from .model import Evaluation, Model
 
@@ -54,7 +54,13 @@ class ArcLengthControl:
     step that would move lambda by more than target / steps (the displacements hardly
     moving: a wall pressed on a mould) is replaced by a load step of target / steps, as
     load control takes.  Cutbacks and the growth after easy steps act below the nominal arc.
-    A given `arc_length` is the nominal arc of every step instead, with no such load steps."""
+    A given `arc_length` is the nominal arc of every step instead, with no such load steps.
+
+    A converged arc step is refused (and cut back) where it left the path: its increment
+    more than 45 degrees from its predictor, or, where the path is smooth (no contact, no
+    tools or curves), sign(d lambda / ds) sign(det K) changed at its end (it landed on
+    another branch).  A step that takes lambda through zero with less than half the
+    largest way done left ends the run: the path has run back down the loaded branch."""
 
     target: float = 1.0
     steps: int = 10
@@ -118,6 +124,10 @@ class StepFailed(Exception):
     pass
 
 
+class PathEnded(Exception):
+    """The path cannot go on, whatever the step: the run stops with this message."""
+
+
 def _reference_force(ev: Evaluation, lam: float, floor: float) -> float:
     return max(ev.force_scale, floor)
 
@@ -163,6 +173,10 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
         trial = path.clip(size)  # shortened to land on a knot or the end; size is kept
         try:
             u_new, lam_new, its, res, ev = path.attempt(trial)
+        except PathEnded as exc:
+            result.status = "stopped"
+            result.message = f"step {first + result.n_steps}: {exc}" + path.diagnosis()
+            break
         except StepFailed as exc:
             size = trial / 2.0
             if abs(size) < opts.min_step * abs(path.nominal):
@@ -347,11 +361,12 @@ class _Displacement(_Path):
         self.reached += size
 
 
+MAX_TURN = np.radians(45.0)  # arc length: the most a step's increment may turn from its predictor
 RATE_GROWTH = 4.0  # arc length: the arc per 1 / steps of the way, at most this times its mean so far
 
 
 class _ArcLength(_Path):
-    _state_keys = ("u_f", "lam", "previous", "finished", "nominal", "travelled", "progress")
+    _state_keys = ("u_f", "lam", "previous", "finished", "nominal", "travelled", "progress", "orientation")
 
     def __init__(self, model, control: ArcLengthControl, opts):
         super().__init__(model, opts)
@@ -365,6 +380,7 @@ class _ArcLength(_Path):
         # cavity pressures (after the displacements) are not part of the arc
         self.weight = np.concatenate([np.where(rep < 2, 1.0, span**2), np.zeros(model.n_free - len(rep))])
         self.previous = None  # last converged increment, for the direction of the next one
+        self._tangent = (None, None, None)  # (u_f, du/dlambda and ||R|| there) from the check of the last step's end
         self.stop = None
         if control.stop_dof is not None:
             self.stop = int(model.dofmap.eq[control.stop_dof])
@@ -387,6 +403,9 @@ class _ArcLength(_Path):
         self.loaded = False  # the last attempt was a load step (`_load_step`)
         self.travelled = 0.0  # the arc length of the converged steps
         self.progress = 0.0  # the largest fraction of the way to the end reached so far
+        self.orientation = 0  # sign(d lambda / ds) sign(det K) along the path (`_check_branch`), 0: not yet known
+        # contact switches K between steps (a slave touching stiffens it): the path is not smooth there
+        self.smooth = not self.timed and not model.contacts
 
     def _fraction(self, u_f, lam) -> float:
         """How far (u_f, lambda) is on the way to the end: lambda / target, or u_stop /
@@ -416,6 +435,9 @@ class _ArcLength(_Path):
             u_new, lam_new, its, res, ev = _newton_load(self.model, self.u_f, self.lam + dlam, self.opts, self.floor, guess)
         if not self.loaded and self.previous is not None and np.dot(self.weight * (u_new - self.u_f), self.previous) < 0:
             raise StepFailed("the path turned back")
+        if not self.loaded and self.smooth and abs(lam_new - self.lam) <= self.load_step:
+            self._check_branch(u_new, ev)
+        self._check_not_unloaded(u_new, lam_new)
         if self.timed and (lam_new - self.lam) * np.sign(self.control.target) < 0:
             raise StepFailed("the load factor is the process time here (tools or curves follow it): it cannot "
                              "run backwards")
@@ -459,10 +481,59 @@ class _ArcLength(_Path):
         self.loaded = True
         return _newton_load(self.model, self.u_f, lam, self.opts, self.floor)
 
+    def _check_on_path(self, du, predictor):
+        """Fail a converged step whose increment du leaves the direction of its predictor (the
+        tangent) by more than MAX_TURN: Newton then converged on another part of the arc's
+        sphere, a point of another branch where the path turns sharply (a corner element
+        snapping from one shape to another), and ran on from there, even back down the
+        loaded branch through zero load.  A shorter arc follows the turn."""
+        cosine = np.dot(self.weight * du, predictor) / max(self._norm(du) * self._norm(predictor), 1e-300)
+        if cosine < np.cos(MAX_TURN):
+            angle = np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
+            raise StepFailed(f"the step left the path: its increment turned {angle:.0f} degrees from the tangent")
+
+    def _check_not_unloaded(self, u_new, lam_new):
+        """End the run on a step that takes lambda through zero, against the target, while
+        less than half the largest way done is left: the path has run back down the loaded
+        branch (after a step that jumped onto it), and would go on to the mirror image of the
+        loaded state."""
+        target = self.control.target
+        if self.lam * target > 0 and lam_new * target <= 0 and self._fraction(u_new, lam_new) < 0.5 * self.progress:
+            raise PathEnded(f"the path came back to zero load (lambda from {self.lam:.6g} to {lam_new:.6g}) "
+                            f"at {100 * self._fraction(u_new, lam_new):.3g} % of the way, having reached "
+                            f"{100 * self.progress:.3g} %: it has run back down the loaded branch, a step having "
+                            "landed on it from a branch close to it")
+
+    def _check_branch(self, u_new, ev):
+        """Fail a converged step that ends on another branch of equilibrium.  Along one
+        regular path sign(d lambda / ds) sign(det K) keeps its value (det K changes sign at
+        the limit points of the load, where d lambda / ds does); at the step's end the path
+        goes on along the tangent t = du/dlambda oriented by the step's increment du, so
+        sign(t . du) sign(det K) there must be the path's own.  A step that lands on a
+        nearby branch (the loaded branch, run backwards, next to a snap-back of a folding
+        corner element) breaks it: a shorter arc stays on the path."""
+        solve, det = factorize_signed(ev.K)
+        if det == 0:
+            return
+        t = -solve(ev.dr_dlam)
+        if not self.model.cavities:  # the next step's tangent, unless the commit changes K
+            self._tangent = (u_new, t, ev.force_norm)
+        orientation = int(np.sign(np.dot(self.weight * t, u_new - self.u_f))) * det
+        if orientation == 0:
+            return
+        if self.orientation == 0:
+            self.orientation = orientation
+        elif orientation != self.orientation:
+            raise StepFailed("the step ended on another branch of equilibrium (det K and the direction of the "
+                             "path disagree at its end)")
+
     def _arc_step(self, dl):
         model, opts, W = self.model, self.opts, self.weight
-        ev = _evaluate(model, self.u_f, self.lam)
-        t = -_factorize(ev.K)(ev.dr_dlam)  # du/dlambda along the tangent
+        at, t, start = self._tangent
+        if at is not self.u_f:
+            ev = _evaluate(model, self.u_f, self.lam)
+            t = -_factorize(ev.K)(ev.dr_dlam)  # du/dlambda along the tangent
+            start = ev.force_norm
         if not self._norm(t) > 0:
             # the structure does not respond to the load (only a tool moves, not touching yet)
             return self._load_step(dl)
@@ -471,12 +542,13 @@ class _ArcLength(_Path):
         sign = (np.sign(np.dot(W * t, self.previous)) if self.previous is not None and not self.timed
                 else np.sign(self.control.target))
         dlam = (sign or 1.0) * dl / max(self._norm(t), 1e-300)
-        du = dlam * t
-        residuals = [ev.force_norm]
+        du = predictor = dlam * t
+        residuals = [start]
         for it in range(1, opts.max_iterations + 1):
             lam = self.lam + dlam
             ev = _evaluate(model, self.u_f + du, lam)
             if _check(ev, lam, opts, self.floor, residuals):
+                self._check_on_path(du, predictor)
                 return self.u_f + du, lam, it, residuals, ev
             solve = _factorize(ev.K)
             ab = solve(np.column_stack([-ev.r, -ev.dr_dlam]))
