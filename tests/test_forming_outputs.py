@@ -288,3 +288,26 @@ def test_cavity_pressure_monitor_is_the_load_axis(tmp_path):
     x, y = ax.lines[0].get_data()
     assert np.array_equal(x, [12.0, 20.0]) and np.array_equal(y, [0.2, 0.3])  # no false origin
     assert FolderInfo.read(tmp_path).state(2, history(tmp_path)) == "step 2, bottle pressure = 0.300 MPa"
+
+
+def test_mould_pieces_are_named_in_summary_and_thickness_plot(tmp_path):
+    """A [[contact]] piece is named by its `name`, else by its DXF layer in lower case (the
+    cup: "plug", "mould"), else "contact[k]"; summary.json and the thickness plot's legend of
+    first contact times say those names."""
+    assert [p.name for p in build(load(EXAMPLES / "cup_thermoforming.toml"), EXAMPLES).model.contacts] == \
+        ["plug", "mould"]
+    named = load(EXAMPLES / "cup_thermoforming.toml", ['contact[1].name="cold mould"'])
+    assert [p.name for p in build(named, EXAMPLES).model.contacts] == ["plug", "cold mould"]
+    assert build(load(EXAMPLES / "toric_plate.toml"), EXAMPLES).model.contacts[0].name is None
+    with pytest.raises(CaseError, match=r"contact\[0\]\.name"):
+        load(EXAMPLES / "cup_thermoforming.toml", ['contact[0].name=""'])
+
+    table = {"s": np.array([0.0, 1.0]), "s_current": np.array([0.0, 1.2]), "r": np.zeros(2), "z": np.zeros(2),
+             "thickness": np.ones(2), "initial_thickness": np.ones(2), "ratio": np.ones(2),
+             "first_contact": np.array([0.5, 0.25]), "first_contact_0": np.array([0.5, np.nan]),
+             "first_contact_1": np.array([np.nan, 0.25])}
+    write_thickness_csv(tmp_path / "thickness.csv", table)
+    (tmp_path / "summary.json").write_text(json.dumps({"contact": [{"name": "plug"}, {"name": "mould"}]}))
+    fig = thickness_figure(tmp_path / "thickness.csv", FolderInfo.read(tmp_path))
+    labels = [t.get_text() for ax in fig.axes if ax.get_legend() for t in ax.get_legend().get_texts()]
+    assert "plug" in labels and "mould" in labels

@@ -92,6 +92,10 @@ class MotionSpec(CurveMixin):
 
 
 class ContactSpec(Strict):
+    """A [[contact]] table: one rigid mould piece; `name` labels it in plots and
+    summary.json (default: its DXF layer in lower case, else "contact[k]")."""
+
+    name: Annotated[str, Field(min_length=1)] | None = None
     surface: SurfaceSpec
     slaves: Selector
     penalty: PositiveFloat | None = None
@@ -184,8 +188,10 @@ def contact_pair(mesh: Mesh, model: Model, spec: ContactSpec, base: Path, where:
     surface.curve = spec.motion.build_curve()
     slaves = select_nodes(mesh, spec.slaves.model_dump(), f"{where}.slaves")
     try:
-        return ContactPair(mesh, surface, slaves, spec.penalty, friction=spec.friction, sticky=spec.sticky,
+        pair = ContactPair(mesh, surface, slaves, spec.penalty, friction=spec.friction, sticky=spec.sticky,
                            tangential_penalty=spec.tangential_penalty, depth=spec.depth, search=spec.search,
                            modulus=youngs_modulus(model.material))
     except ValueError as exc:
         raise CaseError(f"{where}.slaves: {exc}") from None
+    pair.name = spec.name or (spec.surface.layer.lower() if spec.surface.layer else None)
+    return pair

@@ -44,6 +44,7 @@ class FolderInfo:
     units: dict[str, str] = dc_field(default_factory=dict)
     load: dict[str, Any] | None = None
     monitor_quantities: dict[str, str] = dc_field(default_factory=dict)
+    contacts: list[str] = dc_field(default_factory=list)  # the mould pieces' names, pair by pair
 
     @classmethod
     def read(cls, folder: Path) -> "FolderInfo":
@@ -51,7 +52,13 @@ class FolderInfo:
         if not path.exists():
             return cls()
         s = json.loads(path.read_text())
-        return cls(s.get("title", ""), s.get("units") or {}, s.get("load"), s.get("monitor_quantities") or {})
+        contacts = [c.get("name", f"contact[{k}]") for k, c in enumerate(s.get("contact") or [])]
+        return cls(s.get("title", ""), s.get("units") or {}, s.get("load"), s.get("monitor_quantities") or {},
+                   contacts)
+
+    def contact_name(self, k: int) -> str:
+        """The name of mould piece k (pair k of contact.csv)."""
+        return self.contacts[k] if k < len(self.contacts) else f"contact[{k}]"
 
     def load_label(self) -> str:
         """The load axis: the loaded quantity with its unit, or the load factor."""
@@ -203,7 +210,7 @@ def thickness_figure(thickness: Path, info: FolderInfo, history: dict[str, np.nd
         per_piece = [n for n in t if n.startswith("first_contact_") and np.isfinite(t[n]).any()]
         for k, name in enumerate(per_piece):  # each piece, the earliest marked the largest
             a_c.plot(t["s_current"], t[name], "o", ms=6 - 2.5 * k / len(per_piece), color=f"C{3 + k}",
-                     label=f"contact[{name.rsplit('_', 1)[1]}]")
+                     label=info.contact_name(int(name.rsplit('_', 1)[1])))
         if per_piece:
             a_c.legend(fontsize=8)
         else:

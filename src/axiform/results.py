@@ -245,7 +245,8 @@ class ResultsWriter:
                                                   rep["first_contact"]):
                 first = "" if np.isnan(t) else repr(float(t))
                 lines.append(f"{k},{node},{r:.10g},{z:.10g},{g:.6g},{p:.6g},{STATUS[int(st)]},{first}")
-            totals.append({q: rep[q] for q in ("force_r", "force_z", "contact_area", "penetration")})
+            totals.append({"name": pair.name or f"contact[{k}]"}
+                          | {q: rep[q] for q in ("force_r", "force_z", "contact_area", "penetration")})
         write_atomic(self.out / "contact.csv", "\n".join(lines) + "\n")
         write_atomic(self.out / "surfaces.csv", mould_outlines(self.model.contacts, float(step.lam)))
         self.summary["contact"] = totals

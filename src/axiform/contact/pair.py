@@ -246,6 +246,7 @@ class ContactPair:
         self.coupling: np.ndarray | None = None
         self.last = None
         self.predicting = False
+        self.name: str | None = None  # a label for plots and summary.json (case file: [[contact]] name)
 
     def dofs(self, dpn: int) -> np.ndarray:
         """Full dofs (ur, uz) of the slave nodes, (n, 2)."""
