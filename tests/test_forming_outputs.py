@@ -4,6 +4,7 @@ readable deformed plots and the forming animation."""
 
 import csv
 import json
+import tomllib
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -220,7 +221,10 @@ def test_what_the_load_factor_scales():
     assert labels(fix=[{"at": {"r": 1.0}, "dofs": ["ur"], "value": 0.5}]) == \
         {"quantity": "displacement", "value": 0.5, "name": "fix[0] ur"}
     die = case_labels(load(EXAMPLES / "die_drawing.toml"))
-    assert die["load"] == {"quantity": "displacement", "value": -3.0, "name": "mould 0 displacement uz"}
+    assert die["load"] == {"quantity": "displacement", "value": -3.0, "name": "punch displacement uz"}
+    tree = tomllib.loads((EXAMPLES / "die_drawing.toml").read_text())
+    del tree["contact"][0]["name"]  # a piece without a name or a DXF layer: its index
+    assert case_labels(parse(tree))["load"]["name"] == "mould 0 displacement uz"
     assert die["units"]["force"] == "N" and die["monitor_quantities"]["punch_force"] == "force"
     assert labels(fix=[{"at": {"r": 1.0}, "dofs": ["ur"]}]) is None
 

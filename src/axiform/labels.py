@@ -74,7 +74,8 @@ def loaded_quantity(case: Any) -> dict[str, Any] | None:
         ur, uz = c.motion.ur, c.motion.uz
         if ur or uz:
             dof = "uz" if abs(uz) >= abs(ur) else "ur"
-            return _scaled("displacement", uz if dof == "uz" else ur, f"mould {i} displacement {dof}", _curve(c.motion))
+            piece = c.name or (c.surface.layer.lower() if c.surface.layer else f"mould {i}")
+            return _scaled("displacement", uz if dof == "uz" else ur, f"{piece} displacement {dof}", _curve(c.motion))
     return None
 
 

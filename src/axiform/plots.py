@@ -124,6 +124,7 @@ def load_curve_figure(history: Path, info: FolderInfo):
         ax.set_xlabel(with_unit(name, quantity, info.units))
         ax.set_ylabel(info.load_label())
         ax.ticklabel_format(useOffset=False)
+        ax.locator_params(axis="x", nbins=6)  # five-digit forces ran into each other at the default
         ax.grid(True, alpha=0.3)
     for ax in axes.flat[len(monitors):]:
         ax.set_visible(False)
