@@ -223,3 +223,17 @@ def test_a_path_run_back_to_zero_load_ends_the_run(monkeypatch):
     assert res.status == "stopped"
     assert "the path came back to zero load" in res.message
     assert 0 < res.last.lam < 0.1 and min(s.lam for s in res.steps) > 0
+
+
+def test_the_branch_check_is_left_to_systems_superlu_factorizes_cheaply(monkeypatch):
+    """The sign of det K comes from SuperLU, 8 to 13 times PARDISO's time at 1e5 unknowns: the
+    branch check runs on systems of up to BRANCH_CHECK_MAX unknowns only."""
+    from axiform import solver as solver_module
+    from conftest import clamped_plate
+
+    model = clamped_plate("q8", "displacement")
+    control = ArcLengthControl(target=100.0, steps=400, stop_dof=plate_centre(model), stop_value=23.0)
+    opts = solver_module.NewtonOptions()
+    assert solver_module._ArcLength(model, control, opts).branch_check
+    monkeypatch.setattr(solver_module, "BRANCH_CHECK_MAX", model.n_free - 1)
+    assert not solver_module._ArcLength(model, control, opts).branch_check

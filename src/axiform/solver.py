@@ -58,8 +58,8 @@ class ArcLengthControl:
 
     A converged arc step is refused (and cut back) where it left the path: its increment
     more than 45 degrees from its predictor, or, where the path is smooth (no contact, no
-    tools or curves), sign(d lambda / ds) sign(det K) changed at its end (it landed on
-    another branch).  A step that takes lambda through zero with less than half the
+    tools or curves) and the system has at most BRANCH_CHECK_MAX unknowns, sign(d lambda /
+    ds) sign(det K) changed at its end (it landed on another branch).  A step that takes lambda through zero with less than half the
     largest way done left ends the run: the path has run back down the loaded branch."""
 
     target: float = 1.0
@@ -363,6 +363,10 @@ class _Displacement(_Path):
 
 MAX_TURN = np.radians(45.0)  # arc length: the most a step's increment may turn from its predictor
 RATE_GROWTH = 4.0  # arc length: the arc per 1 / steps of the way, at most this times its mean so far
+# the branch check's sign of det K comes from SuperLU (PARDISO gives none for non-symmetric
+# K): 4 times PARDISO's factorization at 1e4 unknowns, 8 to 13 times at 1e5 (Q8, SFR), one
+# per arc step; above this size the angle check and the zero-load stop guard the path alone
+BRANCH_CHECK_MAX = 20_000
 
 
 class _ArcLength(_Path):
@@ -405,7 +409,7 @@ class _ArcLength(_Path):
         self.progress = 0.0  # the largest fraction of the way to the end reached so far
         self.orientation = 0  # sign(d lambda / ds) sign(det K) along the path (`_check_branch`), 0: not yet known
         # contact switches K between steps (a slave touching stiffens it): the path is not smooth there
-        self.smooth = not self.timed and not model.contacts
+        self.branch_check = not self.timed and not model.contacts and model.n_free <= BRANCH_CHECK_MAX
 
     def _fraction(self, u_f, lam) -> float:
         """How far (u_f, lambda) is on the way to the end: lambda / target, or u_stop /
@@ -435,7 +439,7 @@ class _ArcLength(_Path):
             u_new, lam_new, its, res, ev = _newton_load(self.model, self.u_f, self.lam + dlam, self.opts, self.floor, guess)
         if not self.loaded and self.previous is not None and np.dot(self.weight * (u_new - self.u_f), self.previous) < 0:
             raise StepFailed("the path turned back")
-        if not self.loaded and self.smooth and abs(lam_new - self.lam) <= self.load_step:
+        if not self.loaded and self.branch_check and abs(lam_new - self.lam) <= self.load_step:
             self._check_branch(u_new, ev)
         self._check_not_unloaded(u_new, lam_new)
         if self.timed and (lam_new - self.lam) * np.sign(self.control.target) < 0:
