@@ -142,7 +142,8 @@ class _Pardiso:
         return self._pardiso(phase, data, b, x)
 
     def _pardiso(self, phase: int, data: np.ndarray, b: np.ndarray | None, x: np.ndarray | None) -> int:
-        """One call of pardiso() with one right-hand side b (n,) (x: the solution, written)."""
+        """One call of pardiso(); b, x: the right-hand sides and the solutions (scalars[_NRHS]
+        columns, each contiguous)."""
         c = self.scalars
         c[_PHASE], c[_ERROR] = phase, 0
         at = self._at
@@ -184,12 +185,15 @@ class _Pardiso:
             raise SingularTangentError(f"PARDISO factorization failed (error {error})")
 
     def solve(self, data: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """Phase 33: K^-1 b for b (n,) or (n, k), one column at a time: a call with k
-        right-hand sides took 1.3 times as long as k calls at 1e3 unknowns (benchmarks/README.md
+        """Phase 33: K^-1 b for b (n,) or (n, k).  Below PARALLEL_MIN unknowns one column at a
+        time: a call with two right-hand sides took 1.4 times as long as two calls at 1e3
+        unknowns; above, all in one call, which reads the factors once (benchmarks/README.md
         § 3.7)."""
         columns = np.ascontiguousarray(b.T if b.ndim == 2 else b[None], dtype=float)  # (k, n)
         x = np.empty_like(columns)
-        for bk, xk in zip(columns, x):
+        blocks = zip(columns, x) if self.n < PARALLEL_MIN else ((columns, x),)
+        for bk, xk in blocks:
+            self.scalars[_NRHS] = 1 if bk.ndim == 1 else len(bk)
             error = self._call(33, data, bk, xk)
             if error:
                 raise SingularTangentError(f"PARDISO solve failed (error {error})")
