@@ -31,6 +31,7 @@ class SolidAssembly:
         self.dofs = element_dofs(mesh.cells, mesh.element.dofs_per_node)
         e, q, _, nd = self.G.shape
         self._G2 = self.G.reshape(e, q * 5, nd)  # g = G2 u_e, all points at once
+        self._identity = np.tile(deformation_gradient(np.zeros(5)), q)[:, None]  # (5q, 1)
         # G dV stored (e, 5q, nd) and used transposed: matmul runs G^T (A G) faster on it
         self._GdV = np.ascontiguousarray((self.G * self.dV[..., None, None]).reshape(e, q * 5, nd))
 
@@ -47,9 +48,9 @@ class SolidAssembly:
     @staticmethod
     def check_inverted(x: np.ndarray, offset: int = 0) -> None:
         J = x[..., 4] * (x[..., 0] * x[..., 3] - x[..., 1] * x[..., 2])
-        bad = ~(J > 0).all(axis=1)
-        if bad.any():
-            raise InvertedElementError(np.flatnonzero(bad) + offset)
+        if (J > 0).all():
+            return
+        raise InvertedElementError(np.flatnonzero(~(J > 0).all(axis=1)) + offset)
 
     def chunks(self, u_full: np.ndarray):
         """The elements in chunks: (slice of the elements, their gradients x (m, q, 5)), each
@@ -58,7 +59,9 @@ class SolidAssembly:
         for start in range(0, e, self.chunk):
             sl = slice(start, min(start + self.chunk, e))
             ue = u_full[self.dofs[sl]]
-            x = deformation_gradient(np.matmul(self._G2[sl], ue[:, :, None]).reshape(sl.stop - start, q, 5))
+            x = np.matmul(self._G2[sl], ue[:, :, None])  # the displacement gradient g (m, 5q, 1)
+            x += self._identity  # F = I + g (eq. 6)
+            x = x.reshape(sl.stop - start, q, 5)
             self.check_inverted(x, start)
             yield sl, x
 

@@ -88,6 +88,7 @@ def _mkl() -> ctypes.CDLL | None:
         try:
             lib = ctypes.CDLL(path)
             lib.pardiso.restype = None
+            lib.pardiso.argtypes = [ctypes.c_void_p] * 16  # addresses, passed as Python ints
             lib.MKL_Set_Num_Threads_Local.restype = ctypes.c_int
             lib.MKL_Set_Num_Threads_Local.argtypes = [ctypes.c_int]
             _MKL = lib
@@ -101,15 +102,17 @@ def _address(a: np.ndarray) -> tuple[int, int]:
     return a.__array_interface__["data"][0], a.size
 
 
-_i32p = ctypes.POINTER(ctypes.c_int32)
-_f64p = ctypes.POINTER(ctypes.c_double)
+# the scalar arguments of pardiso(), by their place in _Pardiso.scalars
+_MAXFCT, _MNUM, _MTYPE, _PHASE, _N, _NRHS, _MSGLVL, _ERROR = range(8)
 
 
 class _Pardiso:
     """One PARDISO handle (real non-symmetric, zero-based CSR): analyse() once per pattern,
-    factor() per matrix, solve() per right-hand side block.  Below PARALLEL_MIN unknowns
+    factor() per matrix, solve() per right-hand side.  Below PARALLEL_MIN unknowns
     every phase runs on one thread (MKL's threads gain nothing there: benchmarks/README.md
-    § 3.2); the number of threads is chosen at the analysis and kept for its phases."""
+    § 3.2); the number of threads is chosen at the analysis and kept for its phases.
+    The arguments are passed as addresses of arrays held here (scalars included), set once
+    per pattern: building ctypes pointers on every call cost 10 to 20 us a call."""
 
     def __init__(self, lib: ctypes.CDLL):
         self.lib = lib
@@ -122,33 +125,34 @@ class _Pardiso:
         self.iparm[10] = 1  # scaling and
         self.iparm[12] = 1  # weighted matching, for non-symmetric matrices
         self.iparm[34] = 1  # zero-based indices
+        self.scalars = np.array([1, 1, 11, 0, 0, 1, 0, 0], dtype=np.int32)
+        self._dummy = np.zeros(1)
         self.n = 0
         self.threads = 0  # 0: MKL's own setting
         self.indptr = self.indices = None
         self.token: object | None = None
 
-    def _call(self, phase: int, data, b=None, x=None, nrhs: int = 1) -> int:
+    def _call(self, phase: int, data: np.ndarray, b: np.ndarray | None = None, x: np.ndarray | None = None) -> int:
         if self.threads:
             before = self.lib.MKL_Set_Num_Threads_Local(self.threads)  # this thread only
             try:
-                return self._pardiso(phase, data, b, x, nrhs)
+                return self._pardiso(phase, data, b, x)
             finally:
                 self.lib.MKL_Set_Num_Threads_Local(before)
-        return self._pardiso(phase, data, b, x, nrhs)
+        return self._pardiso(phase, data, b, x)
 
-    def _pardiso(self, phase: int, data, b, x, nrhs: int) -> int:
-        error = ctypes.c_int32(0)
-        one = ctypes.c_int32(1)
-        dummy = np.zeros(1)
-        self.lib.pardiso(
-            self.pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)), ctypes.byref(one), ctypes.byref(one),
-            ctypes.byref(ctypes.c_int32(11)), ctypes.byref(ctypes.c_int32(phase)), ctypes.byref(ctypes.c_int32(self.n)),
-            data.ctypes.data_as(_f64p), self.indptr.ctypes.data_as(_i32p), self.indices.ctypes.data_as(_i32p),
-            None, ctypes.byref(ctypes.c_int32(nrhs)), self.iparm.ctypes.data_as(_i32p),
-            ctypes.byref(ctypes.c_int32(0)),
-            (dummy if b is None else b).ctypes.data_as(_f64p), (dummy if x is None else x).ctypes.data_as(_f64p),
-            ctypes.byref(error))
-        return error.value
+    def _pardiso(self, phase: int, data: np.ndarray, b: np.ndarray | None, x: np.ndarray | None) -> int:
+        """One call of pardiso(); b, x: the right-hand sides and the solutions (scalars[_NRHS]
+        columns, each contiguous)."""
+        c = self.scalars
+        c[_PHASE], c[_ERROR] = phase, 0
+        at = self._at
+        self.lib.pardiso(at[0], at[1] + 4 * _MAXFCT, at[1] + 4 * _MNUM, at[1] + 4 * _MTYPE,
+                         at[1] + 4 * _PHASE, at[1] + 4 * _N, data.ctypes.data, at[2], at[3], None,
+                         at[1] + 4 * _NRHS, at[4], at[1] + 4 * _MSGLVL,
+                         (self._dummy if b is None else b).ctypes.data,
+                         (self._dummy if x is None else x).ctypes.data, at[1] + 4 * _ERROR)
+        return int(c[_ERROR])
 
     def same_pattern(self, K: sp.csr_matrix) -> bool:
         if self.indptr is None or K.shape[0] != self.n:
@@ -166,6 +170,8 @@ class _Pardiso:
         self._src_indptr, self._src_indices = K.indptr, K.indices
         self.indptr = np.ascontiguousarray(K.indptr, dtype=np.int32)
         self.indices = np.ascontiguousarray(K.indices, dtype=np.int32)
+        self.scalars[_N] = self.n
+        self._at = [a.ctypes.data for a in (self.pt, self.scalars, self.indptr, self.indices, self.iparm)]
         error = self._call(11, np.ascontiguousarray(K.data, dtype=float))
         if error:
             self.indptr = None
@@ -179,18 +185,24 @@ class _Pardiso:
             raise SingularTangentError(f"PARDISO factorization failed (error {error})")
 
     def solve(self, data: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """Phase 33: K^-1 b for b (n,) or (n, k)."""
-        bf = np.asfortranarray(b, dtype=float)
-        x = np.empty_like(bf)
-        error = self._call(33, data, bf, x, 1 if b.ndim == 1 else b.shape[1])
-        if error:
-            raise SingularTangentError(f"PARDISO solve failed (error {error})")
-        return np.ascontiguousarray(x)
+        """Phase 33: K^-1 b for b (n,) or (n, k).  Below PARALLEL_MIN unknowns one column at a
+        time: a call with two right-hand sides took 1.4 times as long as two calls at 1e3
+        unknowns; above, all in one call, which reads the factors once (benchmarks/README.md
+        § 3.7)."""
+        columns = np.ascontiguousarray(b.T if b.ndim == 2 else b[None], dtype=float)  # (k, n)
+        x = np.empty_like(columns)
+        blocks = zip(columns, x) if self.n < PARALLEL_MIN else ((columns, x),)
+        for bk, xk in blocks:
+            self.scalars[_NRHS] = 1 if bk.ndim == 1 else len(bk)
+            error = self._call(33, data, bk, xk)
+            if error:
+                raise SingularTangentError(f"PARDISO solve failed (error {error})")
+        return np.ascontiguousarray(x.T) if b.ndim == 2 else x[0]
 
     def release(self) -> None:
         """Phase -1: free PARDISO's memory of this handle."""
         if self.indptr is not None:
-            self._call(-1, np.zeros(1))
+            self._call(-1, self._dummy)
             self.indptr = None
         self.token = None
 

@@ -85,9 +85,9 @@ class MooneyRivlin(InvariantLaw):
         W2J = -4.0 / 3.0 * W2 * iJ
         WJJ = (10.0 / 9.0 * W1I1 + 28.0 / 9.0 * W2I2) * (iJ * iJ) + k
         v = (2.0 * W1J) * xt + W2J * dI2 + (0.5 * WJJ) * dJ
-        A = v[:, None] * dJ[None]  # (5, 5, n)
-        A += A.transpose(1, 0, 2).copy()
-        A += (2.0 * W2 * dj2)[:, None] * dj2[None]
+        T = v[:, None] * dJ[None]  # (5, 5, n); dj2 is zero in the hoop row
+        T[:4, :4] += (W2 * dj2[:4])[:, None] * dj2[None, :4]
+        A = T + T.transpose(1, 0, 2)  # T + T^T, without a copy of T^T
         diag = 2.0 * W1 + 2.0 * W2 * ff  # 2 W1 I + W2 f^2 d2s on the meridian block
         for i in range(4):
             A[i, i] += diag
