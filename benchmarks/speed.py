@@ -77,19 +77,24 @@ for p in np.loadtxt(sys.argv[2]):
 print(f"FELUPE w {field[0].values[centre, 0]:.6f} iterations {its}")
 '''
 
-# one Newton iteration, run in a subprocess on a given source tree (works on both APIs)
-NEWTON_SCRIPT = r'''
-import json, sys, time
+# the opening of the scripts run in a subprocess on a given source tree (argv[1]): the
+# imports, and the allocator setting `axiform run` makes (after issue 9; none before)
+SCRIPT_PRELUDE = r'''
+import json, resource, sys, time
 sys.path.insert(0, sys.argv[1])
 import numpy as np
 import axiform as af
-from axiform.linsolve import factorize
 from axiform.mesh import edges_on_nodes
 try:
-    from axiform.malloc import keep_freed_memory  # what axiform run does (after issue 9)
+    from axiform.malloc import keep_freed_memory
     keep_freed_memory()
 except ImportError:
     pass
+'''
+
+# one Newton iteration (works on both APIs)
+NEWTON_SCRIPT = SCRIPT_PRELUDE + r'''
+from axiform.linsolve import factorize
 element, formulation, n = sys.argv[2], sys.argv[3], int(sys.argv[4])
 mesh = af.rectangle((1.0, 2.0), (0.0, 1.0), (n, n), element)
 model = af.Model(mesh, af.MooneyRivlin(80.0, 20.0, 1e4), formulation=formulation)
@@ -126,17 +131,8 @@ out["residual"] = float(np.linalg.norm(ev.K @ x[:, 0] + ev.r) / np.linalg.norm(e
 print("NEWTON " + json.dumps(out))
 '''
 
-MEMORY_SCRIPT = r'''
-import json, resource, sys
-sys.path.insert(0, sys.argv[1])
-import numpy as np
-import axiform as af
-from axiform.mesh import edges_on_nodes
-try:
-    from axiform.malloc import keep_freed_memory
-    keep_freed_memory()
-except ImportError:
-    pass
+# the resident memory of 10 load steps of the SFR ring
+MEMORY_SCRIPT = SCRIPT_PRELUDE + r'''
 def rss():
     with open("/proc/self/statm") as f:
         return int(f.read().split()[1]) * resource.getpagesize() / 2**20
