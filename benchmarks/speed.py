@@ -16,7 +16,8 @@ Sections (each a table in benchmarks/results/speed.md):
 - newton: one Newton iteration (evaluate + factorize + solve with two right-hand sides) at
   about 1e3 and 1e5 dofs, Q4, SFR and Q8, displacement and mixed formulation, on the ring of
   _perf_common.py, before / after (the same code run in a subprocess on each source tree).
-- memory: RSS after each of 10 steps and the peak, SFR at 1e5 dofs, before / after.
+- memory: RSS after steps 1, 5, 10, 50 and the last (`--memory-steps`, default 10) and the peak, SFR
+  at 1e5 dofs, before / after.
 - sweep: 8 plate cases (Q8 4x40, C1 and the target varied) by `axiform run` one after another
   and by `axiform sweep --workers 1 / 2`.
 All libraries run on one thread per process (OMP/MKL/OpenBLAS_NUM_THREADS=1) unless said.
@@ -131,12 +132,12 @@ out["residual"] = float(np.linalg.norm(ev.K @ x[:, 0] + ev.r) / np.linalg.norm(e
 print("NEWTON " + json.dumps(out))
 '''
 
-# the resident memory of 10 load steps of the SFR ring
+# the resident memory of `steps` load steps of the SFR ring
 MEMORY_SCRIPT = SCRIPT_PRELUDE + r'''
 def rss():
     with open("/proc/self/statm") as f:
         return int(f.read().split()[1]) * resource.getpagesize() / 2**20
-n = int(sys.argv[2])
+n, steps = int(sys.argv[2]), int(sys.argv[3])
 mesh = af.rectangle((1.0, 2.0), (0.0, 1.0), (n, n), "sfr")
 model = af.Model(mesh, af.MooneyRivlin(80.0, 20.0, 1e4), formulation="displacement")
 model.fix(mesh.node_sets["bottom"], ["uz"])
@@ -144,7 +145,8 @@ model.pressure(edges_on_nodes(mesh, mesh.node_sets["left"]), 20.0)
 model.finalize()
 rows = [rss()]
 kw = {"keep": 1} if "keep" in af.solve.__code__.co_varnames else {}
-res = af.solve(model, af.LoadControl(1.0, 10), af.NewtonOptions(growth=1.0), on_step=lambda s: rows.append(rss()), **kw)
+res = af.solve(model, af.LoadControl(1.0, steps), af.NewtonOptions(growth=1.0), on_step=lambda s: rows.append(rss()),
+               **kw)
 print("MEMORY " + json.dumps({"dofs": int(model.n_free), "rss": rows, "steps": len(rows) - 1,
                               "peak": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
 '''
@@ -297,18 +299,23 @@ def section_newton(trees: dict[str, Path], sizes: dict[str, list[int]], repeat: 
 
 
 # ---- memory -------------------------------------------------------------------------------
-def section_memory(trees: dict[str, Path], n: int, tmp: Path) -> str:
+def section_memory(trees: dict[str, Path], n: int, steps: int, tmp: Path) -> str:
+    """RSS after finalize, after steps 1, 5, 10 and 50 (those the run has) and the last; the
+    growth from step 50 (or 1) to the last, in MB a step and in per cent."""
     script = tmp / "memory.py"
     script.write_text(MEMORY_SCRIPT)
+    marks = [k for k in (1, 5, 10, 50) if k < steps] + [steps]
     rows = []
     for name, src in trees.items():
-        _, _, out = timed([sys.executable, str(script), str(src), str(n)], env_for(src))
+        _, _, out = timed([sys.executable, str(script), str(src), str(n), str(steps)], env_for(src))
         r = json.loads(out[out.index("MEMORY ") + 7:].split("\n")[0])
         rss = r["rss"]
-        rows.append([name, r["dofs"], f"{rss[0]:.0f}", f"{rss[1]:.0f}", f"{rss[5]:.0f}", f"{rss[-1]:.0f}",
-                     f"{r['peak']:.0f}", f"{(rss[-1] - rss[1]) / (len(rss) - 2):.1f}"])
-    return md_table(["code", "free dofs", "RSS MB after finalize", "after step 1", "after step 5", "after step 10",
-                     "peak RSS MB", "growth MB / step (2-10)"], rows)
+        since = 50 if steps > 50 else 1
+        rows.append([name, r["dofs"], f"{rss[0]:.0f}", *(f"{rss[k]:.0f}" for k in marks), f"{r['peak']:.0f}",
+                     f"{(rss[-1] - rss[since]) / (steps - since):.2f}",
+                     f"{100 * (rss[-1] - rss[since]) / rss[since]:.1f}"])
+    return md_table(["code", "free dofs", "RSS MB after finalize", *(f"after step {k}" for k in marks), "peak RSS MB",
+                     f"growth MB / step ({since + 1}-{steps})", f"growth % (step {since} to {steps})"], rows)
 
 
 # ---- sweep --------------------------------------------------------------------------------
@@ -347,6 +354,7 @@ def main(argv=None) -> int:
     ap.add_argument("--only", nargs="*", default=["process", "newton", "memory", "sweep"])
     ap.add_argument("--repeat", type=int, default=5, help="repeats of the process runs (interleaved)")
     ap.add_argument("--big", type=int, default=223, help="ring divisions for the 1e5-dof rows (223: Q4 1e5 dofs)")
+    ap.add_argument("--memory-steps", type=int, default=10, help="load steps of the memory run (SFR ring, 1e5 dofs)")
     ap.add_argument("--out", default="speed", help="results file name (benchmarks/results/NAME.md)")
     args = ap.parse_args(argv)
     trees = {"before": Path(args.before).resolve()} if args.before else {}
@@ -363,7 +371,8 @@ def main(argv=None) -> int:
             parts += ["## One Newton iteration (CPU ms, one thread)\n", section_newton(trees, sizes, 200, tmp), ""]
             print(parts[-2], flush=True)
         if "memory" in args.only:
-            parts += ["## Memory: SFR ring at 1e5 dofs, 10 load steps\n", section_memory(trees, 182, tmp), ""]
+            parts += [f"## Memory: SFR ring at 1e5 dofs, {args.memory_steps} load steps\n",
+                      section_memory(trees, 182, args.memory_steps, tmp), ""]
             print(parts[-2], flush=True)
         if "sweep" in args.only:
             parts += ["## Sweep: 8 plate cases on this machine\n", section_sweep(tmp), ""]
