@@ -32,6 +32,13 @@ def test_a_run_plots_in_a_second_process(tmp_path):
     assert all((out / png).exists() for png in PNGS)
 
 
+def test_a_case_without_plots_ends_the_plot_process_started_for_it(tmp_path):
+    out = tmp_path / "plate"
+    assert run(str(EXAMPLES / "hughes_carnoy_plate.toml"), str(out), quiet=True,
+               overrides=["solver.steps=2", "solver.target=0.5", "output.plots=false"], plot_process=True) == 0
+    assert (out / "summary.json").exists() and not list(out.glob("*.png"))
+
+
 def test_the_command_plots(tmp_path):
     """`axiform run` from a shell: the plots come from a second process when a core is idle
     (idle_cores), from this one otherwise: the same files, no process left behind."""
@@ -54,6 +61,9 @@ def test_an_unused_plot_process_ends_with_its_block():
     with PlotProcess() as plotter:
         pass
     assert plotter.proc.returncode is not None
+    with PlotProcess() as plotter:
+        plotter.close()
+        assert plotter.proc.returncode is not None
     with pytest.raises(subprocess.TimeoutExpired):  # nothing else: it waits for its folder
         with PlotProcess() as waiting:
             waiting.proc.wait(timeout=0.2)

@@ -1,10 +1,11 @@
-"""The PNG plots of `axiform run` drawn by a second Python process, started before the model
-is built when a core is idle (`idle_cores`): it imports matplotlib (0.3 to 0.5 s, half of what the plots cost) on the other core
-while this one builds and solves, then waits for the results folder and draws its plots
-(`plots.plot_jobs`) when the run ends, on as many cores as other processes left idle while
-it waited (`free_cores`: the run waits for its plots, its core is free; `draw_in_parallel`).
-While it waits it draws a small figure to memory (fonts loaded, caches filled: the plots
-then take 0.1 to 0.25 s less).
+"""The PNG plots of `axiform run` drawn by a second Python process, started first thing when
+other processes leave about two cores idle (`cores_left_idle` over the run's first imports,
+`PLOT_PROCESS_MIN_IDLE`): it imports matplotlib (0.3 to 0.5 s, half of what the plots cost)
+on the other core while this one imports the case's modules, builds and solves, then waits
+for the results folder and draws its plots (`plots.plot_jobs`) when the run ends, on as many
+cores as other processes left idle while it waited (the run waits for its plots, its core is
+free; `drawing_workers`, `draw_in_parallel`).  While it waits it draws a small figure to
+memory (fonts loaded, caches filled: the plots then take 0.1 to 0.25 s less).
 
 The second process ignores SIGINT (a Ctrl-C reaches the whole process group; the run winds
 up and still asks for its plots) and leaves without drawing when its input closes unasked,
@@ -18,12 +19,16 @@ import signal
 import subprocess
 import sys
 import time
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Self
+from typing import Callable, NamedTuple, Self
 
 # the folder containing the axiform package: the second process imports this same code
 _ROOT = str(Path(__file__).resolve().parent.parent)
+
+
+# a plot process is started when other processes leave this many cores idle: one for the
+# run, most of one for the plot process's imports and warm-up (CpuSample's ticks are 10 ms)
+PLOT_PROCESS_MIN_IDLE = 1.5
 
 
 def idle_cores() -> float:
@@ -38,8 +43,7 @@ def idle_cores() -> float:
         return 0.0
 
 
-@dataclass(frozen=True)
-class CpuSample:
+class CpuSample(NamedTuple):
     """CPU counters at one moment (Linux): the busy seconds of the cores this process may run
     on (/proc/stat), the CPU seconds of the run (this process, and process `also` if given:
     the run that a plot process serves), and the monotonic clock."""
@@ -115,10 +119,15 @@ class PlotProcess:
     def __enter__(self) -> Self:
         return self
 
-    def __exit__(self, *exc) -> None:
-        if self.proc.returncode is None:  # never asked (an invalid case, a failed start)
+    def close(self) -> None:
+        """End the process if it was never asked (an invalid case, a failed start, a case
+        without plots)."""
+        if self.proc.returncode is None:
             self.proc.kill()
             self.proc.communicate()
+
+    def __exit__(self, *exc) -> None:
+        self.close()
 
 
 def _warm_up() -> None:
