@@ -40,8 +40,9 @@ def test_a_case_without_plots_ends_the_plot_process_started_for_it(tmp_path):
 
 
 def test_the_command_plots(tmp_path):
-    """`axiform run` from a shell: the plots come from a second process when a core is idle
-    (idle_cores), from this one otherwise: the same files, no process left behind."""
+    """`axiform run` from a shell: the plots come from a second process when cores are idle
+    (cores_left_idle), from this one otherwise: the same files, no process left behind, the
+    exit code and the last line as from main()."""
     out = tmp_path / "plate"
     env = {**os.environ, "PYTHONPATH": str(SRC)}
     proc = subprocess.run([sys.executable, "-m", "axiform.cli", "run", str(EXAMPLES / "hughes_carnoy_plate.toml"),
@@ -49,6 +50,11 @@ def test_the_command_plots(tmp_path):
                           env=env, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert all((out / png).exists() for png in PNGS)
+    assert "axiform: finished after 2 steps" in proc.stderr  # flushed before the exit without teardown
+    bad = subprocess.run([sys.executable, "-m", "axiform.cli", "run", str(EXAMPLES / "hughes_carnoy_plate.toml"),
+                          "--out", str(tmp_path / "bad"), "-q", "--set", "solver.steps=-1"],
+                         env=env, capture_output=True, text=True, timeout=120)
+    assert bad.returncode == 2 and "solver.steps" in bad.stderr
 
 
 def test_a_failed_plot_raises_with_its_reason(tmp_path):

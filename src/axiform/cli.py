@@ -489,5 +489,20 @@ def main(argv: list[str] | None = None) -> int:
         return 130
 
 
+def entry() -> None:
+    """The `axiform` command: exits with main()'s code.  After `axiform run` the process ends
+    without tearing down its interpreter (0.1 to 0.15 s with NumPy, SciPy, pydantic and the
+    model loaded, after the last file was closed): the output streams and logging flushed
+    first, and only with no other thread to wait for."""
+    code = main()
+    if sys.argv[1:2] == ["run"] and threading.active_count() == 1:
+        if "logging" in sys.modules:
+            sys.modules["logging"].shutdown()
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    sys.exit(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    entry()
