@@ -460,12 +460,35 @@ def animate(folder: Path, out: Path, info: FolderInfo | None = None, fps: float 
     return out
 
 
+DPI = 110
+
+
 def _save(fig, out: Path) -> Path | None:
+    """Write `fig` as a PNG at DPI and close it; None for no figure.  The same picture as
+    `fig.savefig(out, dpi=DPI)`, drawn once: savefig draws a figure with a layout engine
+    twice (once to lay it out, once to render), a draw lays it out and renders."""
     if fig is None:
         return None
-    fig.savefig(out, dpi=110)
+    fig.set_dpi(DPI)
+    fig.canvas.draw()
+    _write_png(fig, out)
     _pyplot().close(fig)
     return out
+
+
+def _write_png(fig, out: Path) -> None:
+    """The drawn canvas of `fig` as a PNG with matplotlib's metadata, its colours without the
+    alpha channel (the figures' background is opaque: every pixel's alpha is 255) at zlib's
+    fastest level: the plate's three encoded in 30 ms instead of savefig's 51 ms, the files
+    5 % smaller to 6 % larger (NOTES-plots.md)."""
+    import matplotlib
+    from PIL import Image, PngImagePlugin
+
+    size = fig.canvas.get_width_height(physical=True)
+    rgb = Image.frombuffer("RGBA", size, fig.canvas.buffer_rgba(), "raw", "RGBA", 0, 1).convert("RGB")
+    info = PngImagePlugin.PngInfo()
+    info.add_text("Software", f"Matplotlib version{matplotlib.__version__}, https://matplotlib.org/")
+    rgb.save(out, format="png", dpi=(DPI, DPI), pnginfo=info, compress_level=1)
 
 
 def plot_jobs(folder: str | Path, field: str = "von_mises", animation: bool = False) -> list[Callable[[], Path | None]]:
