@@ -127,6 +127,8 @@ def test_the_counters_take_this_process_as_the_run():
     while time.monotonic() < end:
         pass
     now = CpuSample.now()
-    assert now.ours_s - started.ours_s == pytest.approx(0.3, abs=0.05)  # this loop: ours, not load
+    # this loop: ours, not load (in seconds, not clock ticks); at most its wall time, less on a
+    # machine where other jobs take turns on this core
+    assert 0.15 <= now.ours_s - started.ours_s <= 0.33
     assert now.busy_s - started.busy_s >= now.ours_s - started.ours_s - 0.05
     assert cores_left_idle(started) <= len(os.sched_getaffinity(0))
