@@ -11,7 +11,7 @@ from typing import NamedTuple
 import numpy as np
 
 from axiform import Model, MooneyRivlin, rectangle
-from axiform.mesh import edges_on_nodes
+from axiform.fem.mesh import edges_on_nodes
 
 RESULTS = Path(__file__).resolve().parent / "results"
 MATERIAL = MooneyRivlin(80.0, 20.0, 1e4)

@@ -55,8 +55,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _perf_common import (Timing, build_model, deformed_state, divisions_for_elements,  # noqa: E402
                           load_average, machine, table, write_result)
 
-from axiform.assembly import SolidAssembly  # noqa: E402
-from axiform.constraints import SparsePattern  # noqa: E402
+from axiform.fem.assembly import SolidAssembly  # noqa: E402
+from axiform.fem.constraints import SparsePattern  # noqa: E402
 from axiform.materials import deformation_gradient  # noqa: E402
 
 SOLID_PIECES = ["F", "J>0", "P,A", "AG", "GᵀAG", "GᵀP"]
@@ -135,8 +135,8 @@ def timed_once(fn):
 def timed_finalize(model) -> dict:
     """CPU s of model.finalize() and of its main parts, timed inside that one call: the
     SolidAssembly and SparsePattern constructors and SparsePattern.positions (subclasses with
-    timers, put in axiform.model's namespace for the call)."""
-    import axiform.model as am
+    timers, put in axiform.model.model's namespace for the call)."""
+    import axiform.model.model as am
 
     t = dict(solid=0.0, pattern=0.0, pos=0.0)
     clock = time.process_time

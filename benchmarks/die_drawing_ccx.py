@@ -41,8 +41,8 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(ROOT / "src"))
 
-from axiform.case import build, load, youngs_modulus  # noqa: E402 (after the sys.path line)
-from axiform.solver import solve  # noqa: E402
+from axiform.case.schema import build, load, youngs_modulus  # noqa: E402 (after the sys.path line)
+from axiform.solve.solver import solve  # noqa: E402
 
 RESULTS = HERE / "results"
 WORK = RESULTS / "die_drawing_ccx"

@@ -21,9 +21,9 @@ Runs (Python API, each timed from building the model to the last step, CPU time 
 process with time.process_time and wall time; BLAS/OpenMP threads limited to 1):
 - every element on every mesh with the same 40 nominal displacement steps, repeated
   (--repeat, default 2; the minimum CPU time is reported), with two sparse factorizations:
-  "shipped", axiform.linsolve.factorize as found in the tree, and "colamd", SuperLU with the
+  "shipped", axiform.solve.linsolve.factorize as found in the tree, and "colamd", SuperLU with the
   COLAMD ordering, swapped in by this script only (the package is not changed); once more
-  (one repeat) with "mmd_at_plus_a", the factorization of axiform.linsolve as committed in
+  (one repeat) with "mmd_at_plus_a", the factorization of axiform.solve.linsolve as committed in
   5d22fce (SuperLU, MMD on K^T + K, partial pivoting), which loses its fill-reducing ordering
   on the Q8 and SFR plate matrices (see the report; --no-committed skips it).  The load
   curves are identical with all of them (checked).
@@ -159,7 +159,7 @@ def pc(v, spec="+.2f"):
 
 def fill_study(element: str, nr: int, nz: int) -> list[dict]:
     """Fill and time of one factorization of the tangent with SuperLU and three column
-    orderings (MMD_AT_PLUS_A, as the committed axiform.linsolve; MMD_ATA; COLAMD), at u = 0 and
+    orderings (MMD_AT_PLUS_A, as the committed axiform.solve.linsolve; MMD_ATA; COLAMD), at u = 0 and
     at the last converged state (w = 8)."""
     import scipy.sparse.linalg as sla
 
@@ -232,8 +232,8 @@ def figure12(table, mesh_order, mesh_labels, path: Path) -> None:
     import matplotlib.pyplot as plt
     import matplotlib.ticker  # noqa: F401
 
-    panels = [("shipped", "axiform.linsolve as found in the tree"),
-              ("mmd_at_plus_a", "SuperLU MMD_AT_PLUS_A\n(axiform.linsolve as committed, 5d22fce)"),
+    panels = [("shipped", "axiform.solve.linsolve as found in the tree"),
+              ("mmd_at_plus_a", "SuperLU MMD_AT_PLUS_A\n(axiform.solve.linsolve as committed, 5d22fce)"),
               ("colamd", "SuperLU COLAMD swapped in (benchmark only)")]
     panels = [pn for pn in panels if any(f"cpu_{pn[0]}" in r for r in table.values())]
     fig, axes = plt.subplots(1, len(panels), figsize=(6.5 * len(panels), 5.2), sharey=True)
@@ -279,7 +279,7 @@ def main(argv=None) -> int:
     ap.add_argument("--same-target", default="q8:4x40",
                     help="the 'same' meshes get about as many free dofs as this element:mesh (default q8:4x40)")
     ap.add_argument("--no-committed", action="store_true",
-                    help="skip the runs with the committed axiform.linsolve factorization (MMD_AT_PLUS_A)")
+                    help="skip the runs with the committed axiform.solve.linsolve factorization (MMD_AT_PLUS_A)")
     ap.add_argument("--out", default=str(RESULTS))
     args = ap.parse_args(argv)
     out = Path(args.out)
@@ -388,8 +388,8 @@ def main(argv=None) -> int:
     L += [f"Times: CPU time of the process (time.process_time, one BLAS thread) from building the model to the "
           f"last step, minimum over {repeat} repeat(s); wall time likewise. \"shipped\": axiform's own factorization "
           f"as found in the tree ({linsolve_identity()}); \"COLAMD\": scipy.sparse.linalg.splu(K, "
-          "permc_spec=\"COLAMD\") swapped in for axiform.solver.factorize by this script only; \"committed\" (one "
-          "repeat): splu(K, permc_spec=\"MMD_AT_PLUS_A\"), the factorization of axiform.linsolve as committed in "
+          "permc_spec=\"COLAMD\") swapped in for axiform.solve.solver.factorize by this script only; \"committed\" (one "
+          "repeat): splu(K, permc_spec=\"MMD_AT_PLUS_A\"), the factorization of axiform.solve.linsolve as committed in "
           "5d22fce, swapped in likewise. Same curves with all (max relative difference of p over the path given "
           "below).", ""]
 
@@ -553,8 +553,8 @@ def main(argv=None) -> int:
              f"Q8 {q['cpu_colamd']:.2f} s, SFR {s['cpu_colamd']:.2f} s; shipped Q4 {f4['cpu_shipped']:.2f} s, "
              f"Q8 {q['cpu_shipped']:.2f} s, SFR {s['cpu_shipped']:.2f} s.")
     L.append("")
-    L += ["## 4. The sparse factorization: why the committed axiform.linsolve makes Q8 and SFR slow", "",
-          "axiform.linsolve as committed in 5d22fce factorizes with SuperLU, permc_spec=\"MMD_AT_PLUS_A\" and SciPy's "
+    L += ["## 4. The sparse factorization: why the committed axiform.solve.linsolve makes Q8 and SFR slow", "",
+          "axiform.solve.linsolve as committed in 5d22fce factorizes with SuperLU, permc_spec=\"MMD_AT_PLUS_A\" and SciPy's "
           "default diag_pivot_thresh = 1.0 (partial pivoting). MMD on K^T + K is a symmetric ordering that assumes "
           "the pivots stay on the diagonal; on these tangents (kappa / mu = 50) SuperLU pivots off the diagonal, the "
           "ordering is lost and the fill grows. MMD_ATA and COLAMD order the columns for any row pivoting. One "

@@ -26,8 +26,8 @@ from oracles import SphereBVP  # noqa: E402
 
 from axiform import (DisplacementControl, LoadControl, Model, MooneyRivlin, rectangle,  # noqa: E402
                      select_edges, select_nodes, solve)
-from axiform.mesh import layered  # noqa: E402
-from axiform.profile import Arc, Profile  # noqa: E402
+from axiform.fem.mesh import layered  # noqa: E402
+from axiform.fem.profile import Arc, Profile  # noqa: E402
 
 OUT = Path(__file__).parent / "results" / "mixed_study.md"
 A, B, C1, C2, P = 1.0, 1.5, 0.4, 0.1, 0.35

@@ -9,7 +9,7 @@ to 1e5): a follower pressure on part of the inner face (K_ff non-symmetric, its 
 symmetric) and a prescribed top displacement, in a deformed state.
 
 Solvers, side by side on the same matrices (what is not installed is skipped):
-  src                    axiform.linsolve.factorize as it is in src/ now: PARDISO (type 11)
+  src                    axiform.solve.linsolve.factorize as it is in src/ now: PARDISO (type 11)
                          where pypardiso is installed, otherwise SuperLU with MMD_ATA
   superlu-<PERMC>        scipy.sparse.linalg.splu(K, permc_spec=PERMC), SciPy's defaults
                          otherwise (partial pivoting, diag_pivot_thresh=1);
@@ -60,7 +60,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _perf_common import (Timing, build_model, deformed_state, divisions_for_dofs,  # noqa: E402
                      load_average, machine, table, write_result)
 
-from axiform import linsolve  # noqa: E402
+from axiform.solve import linsolve  # noqa: E402
 
 # --------------------------------------------------------------------------------------------
 # Solvers: K (CSR) -> (solve(B) for B (n, k), nnz of the factors or None)
@@ -79,7 +79,7 @@ def _src(K):
 
 
 def src_solver() -> str:
-    """What axiform.linsolve.factorize uses on this machine."""
+    """What axiform.solve.linsolve.factorize uses on this machine."""
     if linsolve._mkl() is None:
         return "SciPy SuperLU, permc_spec MMD_ATA (MKL is not installed)"
     return ("MKL PARDISO, matrix type 11, through ctypes (analysis kept per pattern; minimum degree "
@@ -382,7 +382,7 @@ def main(argv=None) -> int:
          f"at the end: {load_average()}.", "",
          f"Times in s, {what}, minimum over {args.repeat} interleaved repeats (1 above 150,000 "
          "dofs). Iteration = evaluate + factorize + solve. fill = non-zeros of L + U. residual "
-         "= ||K X - B|| / ||B||. src = axiform.linsolve.factorize as it is now: "
+         "= ||K X - B|| / ||B||. src = axiform.solve.linsolve.factorize as it is now: "
          f"{src_solver()}; evaluate = `model.evaluate` as it is now.", ""]
         + sections + [f"Total run time {time.perf_counter() - t_start:.0f} s.", ""])
     print()

@@ -64,8 +64,8 @@ import scipy.sparse.linalg as sla  # noqa: E402
 from scipy.interpolate import CubicSpline  # noqa: E402
 
 import axiform as af  # noqa: E402
-import axiform.solver as _solver  # noqa: E402
-from axiform.linsolve import SingularTangentError  # noqa: E402
+import axiform.solve.solver as _solver  # noqa: E402
+from axiform.solve.linsolve import SingularTangentError  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 RESULTS = HERE / "results"
@@ -171,7 +171,7 @@ def umfpack_available() -> bool:
 
 
 def _superlu_mmd_at_plus_a(K):
-    """The factorization of axiform.linsolve as committed in 5d22fce: SuperLU, MMD on K^T + K,
+    """The factorization of axiform.solve.linsolve as committed in 5d22fce: SuperLU, MMD on K^T + K,
     SciPy's default partial pivoting (diag_pivot_thresh = 1)."""
     try:
         lu = sla.splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A")
@@ -181,19 +181,19 @@ def _superlu_mmd_at_plus_a(K):
 
 
 LINEAR_SOLVERS = {
-    "shipped": None,  # axiform.linsolve.factorize as found in the tree
+    "shipped": None,  # axiform.solve.linsolve.factorize as found in the tree
     "colamd": _superlu_colamd,  # SuperLU with COLAMD column ordering (partial pivoting safe)
-    "mmd_at_plus_a": _superlu_mmd_at_plus_a,  # axiform.linsolve as committed in 5d22fce
+    "mmd_at_plus_a": _superlu_mmd_at_plus_a,  # axiform.solve.linsolve as committed in 5d22fce
     "umfpack": _umfpack,
 }
 
 
 def linsolve_identity() -> str:
-    """What axiform.linsolve.factorize does in this tree, in a few words, and the git state of
+    """What axiform.solve.linsolve.factorize does in this tree, in a few words, and the git state of
     the file (the module changes while people work on it)."""
     import inspect
 
-    import axiform.linsolve as ls
+    import axiform.solve.linsolve as ls
 
     src = inspect.getsource(ls)
     specs = sorted(set(re.findall(r'permc_spec="([A-Z_]+)"', src)))
@@ -215,15 +215,15 @@ def linsolve_identity() -> str:
         state = f"; src/axiform/linsolve.py at commit {rev or '?'}{' with uncommitted changes' if dirty else ''}"
     except Exception:  # noqa: BLE001
         pass
-    return (", else ".join(parts) if parts else "see axiform.linsolve") + state
+    return (", else ".join(parts) if parts else "see axiform.solve.linsolve") + state
 
 
 @contextlib.contextmanager
 def linear_solver(name: str):
     """Run axiform with another sparse factorization (benchmark-local; the package is not
-    changed): 'shipped' keeps axiform.linsolve.factorize."""
+    changed): 'shipped' keeps axiform.solve.linsolve.factorize."""
     if not hasattr(_solver, "factorize"):
-        raise RuntimeError("axiform.solver no longer calls a module-level 'factorize': update linear_solver()")
+        raise RuntimeError("axiform.solve.solver no longer calls a module-level 'factorize': update linear_solver()")
     original = _solver.factorize
     if LINEAR_SOLVERS[name] is not None:
         _solver.factorize = LINEAR_SOLVERS[name]
@@ -731,7 +731,7 @@ def main(argv=None) -> int:
              "default tolerances, what a user gets), for the timing; its curve is also compared. "
              "'axiform': its factorization as found in the tree (" + linsolve_identity() + "). "
              "'axiform-colamd': SuperLU/COLAMD swapped in for it by this script (the factorization of the committed "
-             "axiform.linsolve, MMD_AT_PLUS_A with partial pivoting, loses its ordering on Q8 and SFR tangents, see "
+             "axiform.solve.linsolve, MMD_AT_PLUS_A with partial pivoting, loses its ordering on Q8 and SFR tangents, see "
              "element_study.md); same curve to round-off. The wall ratio is against 'axiform'.")
     L.append("")
     # acceptance

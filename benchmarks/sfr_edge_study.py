@@ -25,7 +25,7 @@ A mesh-convergence study against fine Q8 (DESIGN.md 3, "Things to know about SFR
 Run:  python benchmarks/sfr_edge_study.py            (full, writes results/sfr_edge_study.md)
       python benchmarks/sfr_edge_study.py --quick    (smoke run: coarser meshes and reference)
 
-Linear solver: axiform.linsolve factorizes with SuperLU, permc_spec="MMD_AT_PLUS_A" and the
+Linear solver: axiform.solve.linsolve factorizes with SuperLU, permc_spec="MMD_AT_PLUS_A" and the
 default partial pivoting (diag_pivot_thresh = 1), which discards the symmetric ordering and
 fills L+U 15x more than needed on these meshes (8x80 SFR: 2.2e6 vs 1.4e5 nonzeros, 0.37 s vs
 0.01 s per factorization).  So that the study runs in minutes, this script replaces the
@@ -47,10 +47,10 @@ from pathlib import Path
 import numpy as np
 from scipy.sparse.linalg import splu
 
-import axiform.solver
+import axiform.solve.solver
 from axiform import (DisplacementControl, Model, MooneyRivlin, rectangle, select_edges,
                      select_nodes, solve)
-from axiform.linsolve import SingularTangentError
+from axiform.solve.linsolve import SingularTangentError
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "tests"))
@@ -69,7 +69,7 @@ RULES = ("tie", "fix", "free")
 
 
 # ------------------------------------------------------------------------ linear solver
-_stock_factorize = axiform.solver.factorize
+_stock_factorize = axiform.solve.solver.factorize
 
 
 def symmetric_mode_factorize(K):
@@ -90,7 +90,7 @@ def symmetric_mode_factorize(K):
 
 
 def use_factorization(fast: bool) -> None:
-    axiform.solver.factorize = symmetric_mode_factorize if fast else _stock_factorize
+    axiform.solve.solver.factorize = symmetric_mode_factorize if fast else _stock_factorize
 
 
 # ------------------------------------------------------------------------------ helpers
@@ -244,12 +244,12 @@ def main() -> int:
         use_factorization(True)
         fast = plate("sfr", 4, 40, "tie")
         dp = np.abs(fast["p"] - slow["p"]).max() / np.abs(slow["p"]).max()
-        emit("axiform.linsolve (SuperLU, MMD_AT_PLUS_A, default partial pivoting) replaced by "
+        emit("axiform.solve.linsolve (SuperLU, MMD_AT_PLUS_A, default partial pivoting) replaced by "
              "SuperLU, MMD_AT_PLUS_A, diag_pivot_thresh = 0.01, SymmetricMode (see the module "
              "docstring).  Same run (SFR tie 4x40 plate, to w = 8), side by side:")
         emit()
         emit(table(["factorization", "Newton its", "wall [s]"],
-                   [["axiform.linsolve (stock)", str(slow["iterations"]), f"{slow['wall']:.2f}"],
+                   [["axiform.solve.linsolve (stock)", str(slow["iterations"]), f"{slow['wall']:.2f}"],
                     ["symmetric mode", str(fast["iterations"]), f"{fast['wall']:.2f}"]]))
         emit()
         emit(f"Speed-up {slow['wall'] / fast['wall']:.1f}x; max |p difference| over the path "

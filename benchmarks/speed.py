@@ -85,9 +85,9 @@ import json, resource, sys, time
 sys.path.insert(0, sys.argv[1])
 import numpy as np
 import axiform as af
-from axiform.mesh import edges_on_nodes
+from axiform.fem.mesh import edges_on_nodes
 try:
-    from axiform.malloc import keep_freed_memory
+    from axiform.solve.malloc import keep_freed_memory
     keep_freed_memory()
 except ImportError:
     pass
@@ -95,7 +95,7 @@ except ImportError:
 
 # one Newton iteration (works on both APIs)
 NEWTON_SCRIPT = SCRIPT_PRELUDE + r'''
-from axiform.linsolve import factorize
+from axiform.solve.linsolve import factorize
 element, formulation, n = sys.argv[2], sys.argv[3], int(sys.argv[4])
 mesh = af.rectangle((1.0, 2.0), (0.0, 1.0), (n, n), element)
 model = af.Model(mesh, af.MooneyRivlin(80.0, 20.0, 1e4), formulation=formulation)

@@ -45,8 +45,8 @@ def run_axiform(src: Path) -> dict:
     code = f"""
 import json, sys
 sys.path.insert(0, {str(src)!r})
-from axiform.case import build, load
-from axiform.solver import solve
+from axiform.case.schema import build, load
+from axiform.solve.solver import solve
 b = build(load({str(CASE)!r}, {SETS!r}), {str(CASE.parent)!r})
 w, p = [], []
 dof = int(b.model.dof(int(__import__('numpy').flatnonzero((abs(b.model.mesh.points[:, 0]) < 1e-9)

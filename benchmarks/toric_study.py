@@ -15,14 +15,14 @@ as in the paper:
   Q4 4x113, SFR 4x75);
 * reference: Q8 8x80 (full run) or Q8 4x40 (--quick).
 
-Each run goes through the Python API exactly as `axiform run` does (axiform.case.load /
-build, axiform.solver.solve, axiform.results.ResultsWriter with vtu and plots off): the run
+Each run goes through the Python API exactly as `axiform run` does (axiform.case.schema.load /
+build, axiform.solve.solver.solve, axiform.io.results.ResultsWriter with vtu and plots off): the run
 folders (history.csv, summary.json, thickness.csv, contact.csv) go to --runs (a temporary
 folder unless given).  Measured per run: wall time and CPU time (time.process_time, all
 threads) of the solve minus the time spent writing results, Newton iterations, steps (60
 nominal; more means cut-backs), and the split of the time between element assembly,
-contact, and the linear solver (SuperLU, axiform.linsolve: factorization + solves), taken by
-wrapping Model.evaluate, ContactPair.evaluate and axiform.solver._factorize (the library is
+contact, and the linear solver (SuperLU, axiform.solve.linsolve: factorization + solves), taken by
+wrapping Model.evaluate, ContactPair.evaluate and axiform.solve.solver._factorize (the library is
 not changed).  Times are medians of --repeat runs (3; 1 for runs over 20 s and with --quick),
 all runs of a repeat done one after the other, round robin.
 
@@ -65,12 +65,12 @@ ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 from _common import RESULTS, machine, table  # noqa: E402
 
-import axiform.solver as solver_mod  # noqa: E402
-from axiform.case import build, load  # noqa: E402
+import axiform.solve.solver as solver_mod  # noqa: E402
+from axiform.case.schema import build, load  # noqa: E402
 from axiform.contact.pair import ContactPair  # noqa: E402
-from axiform.model import Model  # noqa: E402
-from axiform.linsolve import SingularTangentError  # noqa: E402
-from axiform.results import ResultsWriter  # noqa: E402
+from axiform.model.model import Model  # noqa: E402
+from axiform.solve.linsolve import SingularTangentError  # noqa: E402
+from axiform.io.results import ResultsWriter  # noqa: E402
 from scipy.sparse.linalg import splu  # noqa: E402
 
 CASE = ROOT / "examples" / "toric_plate.toml"
@@ -129,7 +129,7 @@ _stock_factorize = solver_mod.factorize
 
 def symmetric_factorize(K):
     """SuperLU keeping the minimum-degree ordering on K^T + K (threshold pivoting, symmetric
-    mode) instead of axiform.linsolve's partial pivoting, which discards it and fills L + U
+    mode) instead of axiform.solve.linsolve's partial pivoting, which discards it and fills L + U
     far more (see benchmarks/sfr_edge_study.py)."""
     try:
         lu = splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.01,
@@ -366,7 +366,7 @@ def report(summary, symmetric, runs, ref_key, repeat, total, args, runs_dir):
         "",
         "wall / CPU: the solve (CPU = process time, all threads).  Split of the wall time: "
         "assembly (Model.evaluate without contact), contact (ContactPair.evaluate: local search "
-        "and law), linear (axiform.linsolve: SuperLU factorization + solves).  Steps: 60 nominal, "
+        "and law), linear (axiform.solve.linsolve: SuperLU factorization + solves).  Steps: 60 nominal, "
         "more means cut-backs.  CPU / Q8: against Q8 on the same mesh (same elements) or on the "
         "mesh whose dof count was matched."
         + ("  The 8x80 meshes were not run with the library's factorization (`--skip-stock-fine`): "
@@ -400,7 +400,7 @@ def report(summary, symmetric, runs, ref_key, repeat, total, args, runs_dir):
 
     if symmetric:
         lines += ["## Cost with a better-ordered factorization", "",
-                  "axiform.linsolve factorizes with SuperLU, MMD_AT_PLUS_A ordering and the default "
+                  "axiform.solve.linsolve factorizes with SuperLU, MMD_AT_PLUS_A ordering and the default "
                   "partial pivoting (diag_pivot_thresh = 1), which throws away the fill-reducing "
                   "symmetric ordering; on the finer meshes the linear solver then dominates (table "
                   "above).  The same-element runs again with SuperLU in symmetric mode "
@@ -594,7 +594,7 @@ def plots(summary, symmetric, acc, keys, runs, ref_key, hist, thick, out):
     fig, ax = plt.subplots(1, 2, figsize=(14, 4.8))
     xs = np.arange(len(keys))
     ax[0].bar([i - 0.2 for i, k in enumerate(keys) if k in summary], [summary[k]["cpu"] for k in keys if k in summary],
-              0.4, color=[color[k[0]] for k in keys if k in summary], label="axiform.linsolve (stock)")
+              0.4, color=[color[k[0]] for k in keys if k in summary], label="axiform.solve.linsolve (stock)")
     if symmetric:
         ax[0].bar([i + 0.2 for i, k in enumerate(keys) if k in symmetric], [symmetric[k]["cpu"] for k in keys if k in symmetric],
                   0.4, color=[color[k[0]] for k in keys if k in symmetric], alpha=0.45, hatch="//",

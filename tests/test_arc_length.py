@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from axiform import Model, MooneyRivlin
-from axiform.mesh import layered
-from axiform.profile import Arc, Profile
-from axiform.solver import ArcLengthControl, LoadControl, solve
+from axiform.fem.mesh import layered
+from axiform.fem.profile import Arc, Profile
+from axiform.solve.solver import ArcLengthControl, LoadControl, solve
 
 R0, H0, C1, C2 = 1.0, 0.01, 1.0, 0.1
 
@@ -121,7 +121,7 @@ def test_the_uniform_mixed_sfr_plate_turns_back_at_its_clamp():
     steps (measured: the turn at 20.46, 20.45, 20.45), and det K changes sign only at the
     maxima and the minimum of the pressure along it (limit points, no bifurcation)."""
     from axiform import select_nodes
-    from axiform.solver import DisplacementControl
+    from axiform.solve.solver import DisplacementControl
     from conftest import clamped_plate
 
     model = clamped_plate("sfr")
@@ -212,7 +212,7 @@ def test_a_path_run_back_to_zero_load_ends_the_run(monkeypatch):
     """The same plate with 400 steps and the two checks of a step's end turned off: a step
     lands on the loaded branch near the snap-back at w = 11.8 and the path runs back down it;
     the run ends where lambda would cross zero, saying so (before: 1000 steps, to w = -3.6)."""
-    from axiform import solver as solver_module
+    from axiform.solve import solver as solver_module
     from conftest import clamped_plate
 
     monkeypatch.setattr(solver_module, "MAX_TURN", np.pi)
@@ -228,7 +228,7 @@ def test_a_path_run_back_to_zero_load_ends_the_run(monkeypatch):
 def test_the_branch_check_is_left_to_systems_superlu_factorizes_cheaply(monkeypatch):
     """The sign of det K comes from SuperLU, 8 to 13 times PARDISO's time at 1e5 unknowns: the
     branch check runs on systems of up to BRANCH_CHECK_MAX unknowns only."""
-    from axiform import solver as solver_module
+    from axiform.solve import solver as solver_module
     from conftest import clamped_plate
 
     model = clamped_plate("q8", "displacement")

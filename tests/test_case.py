@@ -154,7 +154,7 @@ def test_overrides_from_the_command_line(tmp_path):
                  "--set", "solver.target=1.0", "--set", "solver.steps=2"]) == 0
     summary = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert summary["element"] == "q8" and summary["steps"] == 2
-    from axiform.case import CaseError, override
+    from axiform.case.schema import CaseError, override
     data = {"contact": [{"friction": 0.1}, {"friction": 0.3}]}
     override(data, "contact[1].friction=0.0")
     assert data["contact"][1]["friction"] == 0.0

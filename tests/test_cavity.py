@@ -10,9 +10,9 @@ import pytest
 
 from axiform import LoadControl, Model, MooneyRivlin, rectangle, select_edges, select_nodes, solve
 from axiform.cli import main
-from axiform.curves import Curve
-from axiform.mesh import layered
-from axiform.profile import Arc, Profile
+from axiform.fem.curves import Curve
+from axiform.fem.mesh import layered
+from axiform.fem.profile import Arc, Profile
 from conftest import difference_tangent, distorted_rectangle
 
 R0, H0, C1, C2 = 1.0, 0.01, 1.0, 0.1

@@ -292,7 +292,7 @@ def test_no_node_ends_a_step_deeper_than_the_reported_penetration(element, tmp_p
     """The toric plate (paper 4.2): at every converged step, every slave node's exact signed
     distance to the torus (Q8: mid-side nodes too) is above minus the penetration reported
     for that step."""
-    from axiform.case import build, load
+    from axiform.case.schema import build, load
     from pathlib import Path
     case = load(Path(__file__).resolve().parents[1] / "examples" / "toric_plate.toml",
                 [f"mesh.element={element}", "mesh.divisions=[20,2]", "solver.target=4.0", "solver.steps=16"])

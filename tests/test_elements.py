@@ -7,7 +7,7 @@ import pytest
 
 from axiform import DisplacementControl, Model, MooneyRivlin, rectangle, select_edges, select_nodes, solve
 from axiform.materials import InvertedElementError
-from axiform.solver import LoadControl, NewtonOptions
+from axiform.solve.solver import LoadControl, NewtonOptions
 from conftest import clamped_plate, difference_tangent, distorted_rectangle
 
 LAW = MooneyRivlin(0.4, 0.1, 5.0)
@@ -133,7 +133,7 @@ def test_inverted_state_is_refused():
 def test_sfr_zero_mode_removed_on_every_body():
     """Two separate SFR bodies: each has its own uniform-theta mode; the model fixes one theta
     on each, and the supported tangent is regular."""
-    from axiform.mesh import Mesh
+    from axiform.fem.mesh import Mesh
     a = rectangle((0.0, 1.0), (0.0, 1.0), (2, 2), "sfr")
     b = rectangle((2.0, 3.0), (0.0, 1.0), (2, 2), "sfr")
     mesh = Mesh(np.vstack([a.points, b.points]), np.vstack([a.cells, b.cells + a.n_nodes]), a.element)

@@ -11,9 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from axiform.case_material import MaterialSpec
+from axiform.case.material import MaterialSpec
 from axiform.cli import main
-from axiform.fit import MODES, STABILITY_STRETCHES, Data, drucker_stable, fit, kinematics, nominal_stress, stable_range
+from axiform.app.fit import MODES, STABILITY_STRETCHES, Data, drucker_stable, fit, kinematics, nominal_stress, stable_range
 from axiform.materials import ArrudaBoyce, Gent, MooneyRivlin, Ogden, Yeoh
 from axiform.materials.arruda_boyce import SERIES
 

@@ -7,9 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from axiform.case import build, load
-from axiform.results import ResultsWriter
-from axiform.solver import solve
+from axiform.case.schema import build, load
+from axiform.io.results import ResultsWriter
+from axiform.solve.solver import solve
 
 PLATE = Path(__file__).resolve().parents[1] / "examples" / "hughes_carnoy_plate.toml"
 
@@ -75,7 +75,7 @@ def test_fields_pvd_lists_only_vtu_files_written(tmp_path):
 def test_a_vtu_file_that_cannot_be_written_fails_the_run_keeping_the_steps_before(tmp_path, monkeypatch, capsys, bad):
     """Found at a later step or by `finish` (the thread writes it while the run goes on):
     status "failed", exit 3, the message says why, fields.pvd lists the files written."""
-    from axiform import results
+    from axiform.io import results
     from axiform.cli import main
 
     write_vtu = results._write_vtu

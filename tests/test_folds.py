@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from axiform import rectangle
-from axiform.folds import folded_nodes
+from axiform.fem.folds import folded_nodes
 
 
 @pytest.mark.parametrize("element", ["q4", "sfr"])
@@ -32,7 +32,7 @@ def test_the_q8_plate_stop_names_the_element_folded_at_the_clamp_corner():
     smoothly); the element at the clamp's upper corner has been folded at that corner node
     since w = 8.5, and the message says so."""
     from axiform import select_nodes
-    from axiform.solver import ArcLengthControl, solve
+    from axiform.solve.solver import ArcLengthControl, solve
     from conftest import clamped_plate
 
     model = clamped_plate("q8", divisions=(40, 4))

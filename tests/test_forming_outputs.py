@@ -14,13 +14,13 @@ import pytest
 from PIL import Image
 
 from axiform import rectangle
-from axiform.case import CaseError, build, load, parse
+from axiform.case.schema import CaseError, build, load, parse
 from axiform.cli import main
-from axiform.fields import point_fields
-from axiform.labels import case_labels, short
-from axiform.plots import (FolderInfo, deformed_figure, field_values, load_curve_figure, read_history,
+from axiform.post.fields import point_fields
+from axiform.post.labels import case_labels, short
+from axiform.post.plots import (FolderInfo, deformed_figure, field_values, load_curve_figure, read_history,
                            thickness_figure, written_steps)
-from axiform.thickness import COLUMNS, thickness_table, write_thickness_csv
+from axiform.post.thickness import COLUMNS, thickness_table, write_thickness_csv
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 

@@ -7,8 +7,8 @@ import copy
 import numpy as np
 import pytest
 
-from axiform.case import build, parse
-from axiform.solver import solve
+from axiform.case.schema import build, parse
+from axiform.solve.solver import solve
 
 SHEET = {
     "title": "sheet into a cup",

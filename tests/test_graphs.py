@@ -1,4 +1,4 @@
-"""axiform.graphs.connected_components against SciPy's, on random graphs and a mesh."""
+"""axiform.fem.graphs.connected_components against SciPy's, on random graphs and a mesh."""
 
 import numpy as np
 import pytest
@@ -6,7 +6,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components as scipy_components
 
 from axiform import rectangle
-from axiform.graphs import connected_components
+from axiform.fem.graphs import connected_components
 
 
 @pytest.mark.parametrize("seed", range(6))

@@ -8,14 +8,14 @@ import numpy as np
 import pytest
 
 from axiform import LoadControl, Model, select_edges, select_nodes, solve
-from axiform.case import CaseError, parse
-from axiform.case_material import SHEAR_KEY
+from axiform.case.schema import CaseError, parse
+from axiform.case.material import SHEAR_KEY
 from axiform.materials import (ArrudaBoyce, Gent, InvariantLaw, MooneyRivlin, NeoHooke, Ogden,
                                Yeoh, cauchy_stress)
 from axiform.materials.arruda_boyce import SERIES
 from axiform.materials.ogden import _SERIES_LIMIT, _power_sums
-from axiform.mesh import layered
-from axiform.profile import Arc, Profile
+from axiform.fem.mesh import layered
+from axiform.fem.profile import Arc, Profile
 from oracles import SphereBVP
 
 LAWS = {

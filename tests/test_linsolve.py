@@ -1,4 +1,4 @@
-"""axiform.linsolve: dense LAPACK, PARDISO (analysis kept per pattern) and SuperLU (ordering
+"""axiform.solve.linsolve: dense LAPACK, PARDISO (analysis kept per pattern) and SuperLU (ordering
 kept per pattern) give the same solutions; a new pattern is analysed anew; an old solve
 function refuses after a new factorization; threads keep their own factorizations."""
 
@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-import axiform.linsolve as ls
+import axiform.solve.linsolve as ls
 from axiform import Model, MooneyRivlin, rectangle
-from axiform.mesh import edges_on_nodes
+from axiform.fem.mesh import edges_on_nodes
 
 
 def _tangent(element: str, divisions, seed: int = 0):

@@ -7,8 +7,8 @@ import tracemalloc
 import numpy as np
 
 from axiform import LoadControl, Model, MooneyRivlin, NewtonOptions, rectangle, solve
-from axiform.mesh import edges_on_nodes
-from axiform.solver import Step
+from axiform.fem.mesh import edges_on_nodes
+from axiform.solve.solver import Step
 
 
 def _ring(steps_target: float = 2.0):

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from axiform import read_gmsh, rectangle, select_edges, select_nodes
-from axiform.mesh import MeshError
-from axiform.selectors import SelectorError
+from axiform.fem.mesh import MeshError
+from axiform.fem.selectors import SelectorError
 
 
 @pytest.mark.parametrize("element, nodes", [("q4", 4 * 3), ("sfr", 4 * 3), ("q8", 4 * 3 + 3 * 3 + 4 * 2)])
@@ -18,7 +18,7 @@ def test_rectangle_counts_and_sets(element, nodes):
     assert np.allclose(mesh.points[mesh.node_sets["right"], 0], 3.0)
     mesh.check()
     # areas: sum of |detJ| w equals the rectangle area (through the axisymmetric volume)
-    from axiform.elements import gradient_operator
+    from axiform.fem.elements import gradient_operator
     _, dV = gradient_operator(mesh.element, mesh.points[mesh.cells])
     assert dV.sum() == pytest.approx(np.pi * 3.0**2 * 2.0)
 
@@ -107,7 +107,7 @@ def test_gmsh_import_with_physical_groups(tmp_path, order, element):
     assert len(mesh.edge_sets["bottom"]) > 0
     e = mesh.boundary_edges[mesh.edge_sets["bottom"]]
     assert np.allclose(mesh.points[e, 1], 0.0)
-    from axiform.elements import gradient_operator
+    from axiform.fem.elements import gradient_operator
     _, dV = gradient_operator(mesh.element, mesh.points[mesh.cells])
     assert dV.sum() == pytest.approx(np.pi * 7.5**2 * 0.5, rel=1e-10)
 

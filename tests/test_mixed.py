@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from axiform import LoadControl, Model, MooneyRivlin, select_edges, select_nodes, solve
-from axiform.fields import point_fields
-from axiform.mesh import layered
-from axiform.profile import Arc, Profile
+from axiform.post.fields import point_fields
+from axiform.fem.mesh import layered
+from axiform.fem.profile import Arc, Profile
 from conftest import difference_tangent, distorted_rectangle
 from oracles import SphereBVP
 

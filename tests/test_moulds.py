@@ -24,7 +24,7 @@ from axiform.cli import main
 from axiform.contact.dxf import DxfError, read_dxf
 from axiform.contact.pair import ContactPair, ring_areas, slave_edges
 from axiform.contact.surfaces import Polyline
-from axiform.solver import ArcLengthControl
+from axiform.solve.solver import ArcLengthControl
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 

@@ -11,9 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from axiform.case import load
+from axiform.case.schema import load
 from axiform.cli import main
-from axiform.optimize import Objective, read_target, toml_text, TargetError
+from axiform.app.optimize import Objective, read_target, toml_text, TargetError
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -99,7 +99,7 @@ def test_fixed_point_baseline_needs_more_forward_solves(runs):
 def test_every_element_reaches_the_uniform_target_in_3_forward_solves(tmp_path, element, formulation):
     """The free tube of the fixture (Q4 mixed) with the other elements and formulations, with
     the default settings: within 1 % in 3 forward solves (measured 0.36 % to 0.45 %)."""
-    from axiform.optimize import ThicknessDesign, optimize
+    from axiform.app.optimize import ThicknessDesign, optimize
 
     tree = copy.deepcopy(TUBE)
     tree["mesh"].update(element=element, formulation=formulation)
@@ -179,7 +179,7 @@ def test_bottle_example_is_a_design_case():
     """examples/parison_bottle.toml is valid for `axiform optimize` (its run is measured in the
     README): a layered mesh, 21 design variables, load control, a target over the whole wall
     but the pinch-off's element."""
-    from axiform.optimize import ThicknessDesign
+    from axiform.app.optimize import ThicknessDesign
 
     design = ThicknessDesign.from_case(EXAMPLES / "parison_bottle.toml")
     assert design.initial.tolist() == [2.0] * 21
@@ -194,7 +194,7 @@ def test_bottle_whole_wall_within_5_percent_in_fewer_forward_solves_than_the_rul
     """The bottle example on a coarser mesh (16 Q8 elements, 10 steps, a knot every 8 mm and at
     s = 68): the whole wall but the pinch-off's element, neck included, within 5 % of a uniform
     target; the gradient method needs 3 forward solves, the fixed-point rule 5."""
-    from axiform.optimize import ThicknessDesign, optimize
+    from axiform.app.optimize import ThicknessDesign, optimize
 
     tree = tomllib.loads((EXAMPLES / "parison_bottle.toml").read_text())
     for piece, n in zip(tree["mesh"]["profile"], (2, 2, 12)):

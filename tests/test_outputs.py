@@ -11,9 +11,9 @@ import pytest
 
 from axiform import rectangle
 from axiform.cli import main
-from axiform.mesh import layered
-from axiform.profile import Arc, Line, Profile
-from axiform.thickness import thickness_table
+from axiform.fem.mesh import layered
+from axiform.fem.profile import Arc, Line, Profile
+from axiform.post.thickness import thickness_table
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -35,7 +35,7 @@ def test_layered_profile_geometry():
     mesh.check()
     assert prof.length() == pytest.approx(2.0 + np.pi / 2)
     # meridian area: wall 0.1 thick along the mid-surface
-    from axiform.elements import gauss_quad, jacobian
+    from axiform.fem.elements import gauss_quad, jacobian
     xi, w = gauss_quad(3)
     _, _, detJ, _ = jacobian(mesh.element, mesh.points[mesh.cells], xi)
     assert (detJ * w).sum() == pytest.approx(0.1 * (2.0 + np.pi / 2), rel=1e-4)

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from axiform import plot_process
+from axiform.post import plot_process
 from axiform.cli import run
-from axiform.plot_process import (CpuSample, PlotProcess, cores_left_idle, draw_in_parallel, drawing_workers,
+from axiform.post.plot_process import (CpuSample, PlotProcess, cores_left_idle, draw_in_parallel, drawing_workers,
                                   free_cores, idle_cores)
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

@@ -10,11 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from axiform.assembly import element_dofs
-from axiform.case import build, parse, read
+from axiform.fem.assembly import element_dofs
+from axiform.case.schema import build, parse, read
 from axiform.cli import main
-from axiform.elements import gradient_operator
-from axiform.solver import LoadControl, solve
+from axiform.fem.elements import gradient_operator
+from axiform.solve.solver import LoadControl, solve
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 QUIET = ["--set", "output.plots=false", "--set", "output.vtu=false", "-q"]

@@ -17,8 +17,8 @@
 
 from pathlib import Path
 
-from axiform.case import build, load
-from axiform.solver import solve
+from axiform.case.schema import build, load
+from axiform.solve.solver import solve
 
 DATA = Path(__file__).parent / "data"
 

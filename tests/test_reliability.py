@@ -18,10 +18,10 @@ import numpy as np
 import pytest
 
 from axiform import rectangle
-from axiform.case import build, load
+from axiform.case.schema import build, load
 from axiform.cli import main
-from axiform.guards import boundary_crossing, chain_crossing, evaluation_fault
-from axiform.solver import solve
+from axiform.model.guards import boundary_crossing, chain_crossing, evaluation_fault
+from axiform.solve.solver import solve
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 SRC = Path(__file__).resolve().parents[1] / "src"
@@ -98,7 +98,7 @@ def test_kill_9_leaves_files_that_parse(tmp_path):
 
 
 def test_an_unexpected_error_sets_failed_and_exit_3(tmp_path, monkeypatch, capsys):
-    from axiform import model as model_module
+    from axiform.model import model as model_module
 
     calls = {"n": 0}
     evaluate = model_module.Model.evaluate
@@ -406,7 +406,7 @@ def test_non_finite_residual_names_node_and_element():
 def test_a_step_with_nan_is_stopped_not_written(tmp_path, monkeypatch, capsys):
     """A converged step whose displacements hold NaN (an overflow that slipped past Newton)
     is refused by the results writer: exit 1, the node named, nothing of it written."""
-    from axiform import solver as solver_module
+    from axiform.solve import solver as solver_module
 
     expand = solver_module.Model.expand
     count = {"n": 0}

@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 
 import axiform.cli as cli
-import axiform.solver as solver
-from axiform.case import build, parse
-from axiform.checkpoint import load as load_checkpoint
-from axiform.checkpoint import save as save_checkpoint
-from axiform.solver import solve
+import axiform.solve.solver as solver
+from axiform.case.schema import build, parse
+from axiform.io.checkpoint import load as load_checkpoint
+from axiform.io.checkpoint import save as save_checkpoint
+from axiform.solve.solver import solve
 
 PUNCH = {
     "title": "punch on a disc, sticky",

@@ -1,4 +1,4 @@
-"""Sensitivities by direct differentiation along the load path (axiform.sensitivity) against
+"""Sensitivities by direct differentiation along the load path (axiform.app.sensitivity) against
 central differences of whole forward solves: a free tube blown by a cavity under volume
 control, and tubes blown against a conical mould with sticky contact (mixed) and with
 Coulomb friction (mixed and displacement); nodes touch at different steps, so the history
@@ -9,10 +9,10 @@ import copy
 import numpy as np
 import pytest
 
-from axiform.case import build, parse
-from axiform.sensitivity import DesignError, sensitivity
-from axiform.solver import ArcLengthControl, NewtonOptions, solve
-from axiform.thickness import thickness_table
+from axiform.case.schema import build, parse
+from axiform.app.sensitivity import DesignError, sensitivity
+from axiform.solve.solver import ArcLengthControl, NewtonOptions, solve
+from axiform.post.thickness import thickness_table
 
 TUBE = {
     "title": "tube",

@@ -32,7 +32,7 @@ import numpy as np
 import pytest
 
 from axiform import Mesh, Model, MooneyRivlin, SFR, rectangle, select_edges, select_nodes
-from axiform.assembly import SolidAssembly
+from axiform.fem.assembly import SolidAssembly
 from conftest import distorted_rectangle
 
 MATERIAL = MooneyRivlin(80.0, 20.0, 1.0e4)

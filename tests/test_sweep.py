@@ -9,7 +9,7 @@ import tomllib
 import pytest
 
 from axiform.cli import main
-from axiform.sweep import load_sweep, toml_value
+from axiform.app.sweep import load_sweep, toml_value
 
 PLATE = """
 title = "small plate"

@@ -7,14 +7,14 @@ load NumPy, SciPy and the element code before a command needs them.
 from importlib import import_module
 
 _WHERE = {
-    "ELEMENTS": "elements", "Q4": "elements", "Q8": "elements", "SFR": "elements",
+    "ELEMENTS": "fem.elements", "Q4": "fem.elements", "Q8": "fem.elements", "SFR": "fem.elements",
     "ArrudaBoyce": "materials", "Gent": "materials", "MooneyRivlin": "materials", "NeoHooke": "materials",
     "Ogden": "materials", "Yeoh": "materials",
-    "Mesh": "mesh", "read_gmsh": "mesh", "rectangle": "mesh",
-    "Model": "model",
-    "select_edges": "selectors", "select_nodes": "selectors",
-    "Sensitivity": "sensitivity", "sensitivity": "sensitivity",
-    "DisplacementControl": "solver", "LoadControl": "solver", "NewtonOptions": "solver", "solve": "solver",
+    "Mesh": "fem.mesh", "read_gmsh": "fem.mesh", "rectangle": "fem.mesh",
+    "Model": "model.model",
+    "select_edges": "fem.selectors", "select_nodes": "fem.selectors",
+    "Sensitivity": "app.sensitivity", "sensitivity": "app.sensitivity",
+    "DisplacementControl": "solve.solver", "LoadControl": "solve.solver", "NewtonOptions": "solve.solver",
 }
 
 __all__ = [
@@ -26,6 +26,8 @@ __version__ = "0.1.0"
 
 
 def __getattr__(name: str):
+    if name == "solve":  # the package solve/, callable as the function solve.solver.solve
+        return import_module(".solve", __name__)
     if name in _WHERE:
         value = getattr(import_module(f".{_WHERE[name]}", __name__), name)
         globals()[name] = value

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Self
 from . import __version__
 
 if TYPE_CHECKING:
-    from .plot_process import PlotProcess
+    from .post.plot_process import PlotProcess
 
 EXIT = {"finished": 0, "stopped": 1, "failed": 3}
 # history.csv, summary.json, thickness.csv and fields.pvd are rewritten at most every half
@@ -162,8 +162,8 @@ FROZEN_ON_RESUME = ("mesh", "material")
 def _resume_state(folder: Path, data: dict) -> dict:
     """The checkpoint of a results folder to resume, after checking that the case's mesh and
     material are the ones it was made with; CaseError (exit 2) otherwise."""
-    from .case import CaseError, fingerprint
-    from .checkpoint import load as load_checkpoint
+    from .case.schema import CaseError, fingerprint
+    from .io.checkpoint import load as load_checkpoint
 
     if not folder.is_dir():
         raise CaseError(f"--resume: {folder} is not a results folder")
@@ -186,7 +186,7 @@ def run(case_path: str, out: str | None, quiet: bool = False, overrides: list[st
     with Stops() as stops, ExitStack() as stack:
         plots_by = None
         if plot_process:  # first: its imports overlap this process's imports of the case's modules
-            from .plot_process import PlotProcess
+            from .post.plot_process import PlotProcess
 
             plots_by = stack.enter_context(PlotProcess())
         try:
@@ -198,10 +198,10 @@ def run(case_path: str, out: str | None, quiet: bool = False, overrides: list[st
 
 def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], stops: Stops,
          resume: str | None = None, plots_by: PlotProcess | None = None) -> int:
-    from .case import CaseError, build, fingerprint, parse, read
-    from .labels import case_labels
-    from .results import NonFiniteResult, ResultsWriter
-    from .solver import StepFailed, solve
+    from .case.schema import CaseError, build, fingerprint, parse, read
+    from .post.labels import case_labels
+    from .io.results import NonFiniteResult, ResultsWriter
+    from .solve.solver import StepFailed, solve
 
     state = plotter = None
     try:
@@ -318,7 +318,7 @@ def _failed(exc: Exception, what: str) -> int:
 
 def check(case_path: str, overrides: list[str] = ()) -> int:
     """Validate a case and build its model, without solving; returns the exit code."""
-    from .case import CaseError, build, parse, read
+    from .case.schema import CaseError, build, parse, read
 
     case_file = Path(case_path)
     try:
@@ -337,7 +337,7 @@ def _fields_of(folder: Path) -> set[str] | None:
     """The nodal fields of the last VTU file of a results folder (None: no VTU file)."""
     from xml.etree import ElementTree as ET
 
-    from .plots import last_vtu
+    from .post.plots import last_vtu
 
     vtu = last_vtu(folder)
     if vtu is None or not vtu.exists():
@@ -348,7 +348,7 @@ def _fields_of(folder: Path) -> set[str] | None:
 
 def plot(folder: str, field: str, animate: bool = False) -> int:
     """(Re)write the PNG plots of a results folder; returns the exit code."""
-    from .plots import FieldError, plot_folder, read_history
+    from .post.plots import FieldError, plot_folder, read_history
 
     path = Path(folder)
     if not (path / "history.csv").is_file():
@@ -445,38 +445,38 @@ def main(argv: list[str] | None = None) -> int:
     p_sweep.add_argument("--workers", type=int, help="worker processes of the LocalCluster (default: the cores)")
     args = parser.parse_args(argv)
     if args.command == "run":
-        from .plot_process import CpuSample
+        from .post.plot_process import CpuSample
 
         started = CpuSample.now()  # the load over the imports below decides on a plot process
     if args.command == "fit":
-        from .case_material import KEYS
+        from .case.material import KEYS
 
         if args.model not in KEYS:
             p_fit.error(f"argument --model: invalid choice: {args.model!r} (choose from {', '.join(KEYS)})")
     import numpy as np
 
-    from .malloc import keep_freed_memory
+    from .solve.malloc import keep_freed_memory
 
     keep_freed_memory()  # the same temporaries are allocated on every Newton iteration
     try:
         with np.errstate(all="ignore"):  # overflow and NaN are caught by the guards, not printed
             if args.command == "fit":
-                from .fit import run as fit
+                from .app.fit import run as fit
 
                 return fit(args.data, args.model, args.terms, args.out, args.kappa)
             if args.command == "optimize":
-                from .optimize import run as optimize
+                from .app.optimize import run as optimize
 
                 return optimize(args.case, args.target, args.out, args.max_iter, args.method, args.tolerance,
                                 args.smoothness, args.quiet)
             if args.command == "sweep":
-                from .sweep import run_sweep
+                from .app.sweep import run_sweep
 
                 return run_sweep(args.sweep, args.out, args.scheduler, args.workers)
             if args.command == "plot":
                 return plot(args.folder, args.field, args.animate)
             if args.command == "run":
-                from .plot_process import PLOT_PROCESS_MIN_IDLE, cores_left_idle
+                from .post.plot_process import PLOT_PROCESS_MIN_IDLE, cores_left_idle
 
                 # a second process pays when this one would have to import matplotlib for the
                 # plots and other processes leave a core idle (besides this one's) to do it on

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..elements import edge_shape, gauss_1d
-from ..mesh import Mesh
+from ..fem.elements import edge_shape, gauss_1d
+from ..fem.mesh import Mesh
 from .surfaces import RigidSurface
 
 STATUS = {0: "open", 1: "stick", 2: "slip", 3: "sticky"}  # slip: |ft| > tanh(1) mu fn

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..curves import PROPORTIONAL, Curve
+from ..fem.curves import PROPORTIONAL, Curve
 from . import search
 
 
@@ -156,8 +156,8 @@ class Polyline(RigidSurface):
 
     @classmethod
     def from_profile(cls, profile, motion=(0.0, 0.0)) -> Polyline:
-        """The exact pieces of an axiform.profile.Profile (lines and arcs)."""
-        from ..profile import Arc
+        """The exact pieces of an axiform.fem.profile.Profile (lines and arcs)."""
+        from ..fem.profile import Arc
 
         points = [profile.start] + [p.to for p in profile.pieces]
         centers = [p.center if isinstance(p, Arc) else None for p in profile.pieces]

@@ -20,9 +20,9 @@ from typing import Any
 import numpy as np
 from pydantic import ValidationError
 
-from .case_base import CaseError, CurveKnots, CurveMixin, DofName, PositiveFloat, Selector, Strict
-from .case_cavity import CavitySpec, build_cavities
-from .case_contact import (
+from .base import CaseError, CurveKnots, CurveMixin, DofName, PositiveFloat, Selector, Strict
+from .cavity import CavitySpec, build_cavities
+from .contact import (
     CircleSpec,
     ContactSpec,
     MotionSpec,
@@ -34,18 +34,18 @@ from .case_contact import (
     contact_pair,
     youngs_modulus,
 )
-from .case_loads import FixSpec, PointLoadSpec, PressureSpec, apply_loads, prescribe_fixes
-from .case_material import MaterialSpec
-from .case_mesh import ArcPiece, LinePiece, MeshSpec, PieceSpec, build_mesh
-from .case_monitor import HISTORY_COLUMNS, Monitor, MonitorSpec, build_monitors
-from .case_output import OutputSpec, RestartSpec, Unit, UnitsSpec
-from .case_solver import DofRef, SolverSpec, StopSpec, build_control
-from .guards import boundary_crossing, free_to_slide, not_numbers
-from .mesh import MeshError
-from .model import Model
-from .selectors import SelectorError
-from .solver import ArcLengthControl, DisplacementControl, LoadControl, NewtonOptions
-from .thickness import default_wall
+from .loads import FixSpec, PointLoadSpec, PressureSpec, apply_loads, prescribe_fixes
+from .material import MaterialSpec
+from .mesh import ArcPiece, LinePiece, MeshSpec, PieceSpec, build_mesh
+from .monitor import HISTORY_COLUMNS, Monitor, MonitorSpec, build_monitors
+from .output import OutputSpec, RestartSpec, Unit, UnitsSpec
+from .solver import DofRef, SolverSpec, StopSpec, build_control
+from ..model.guards import boundary_crossing, free_to_slide, not_numbers
+from ..fem.mesh import MeshError
+from ..model.model import Model
+from ..fem.selectors import SelectorError
+from ..solve.solver import ArcLengthControl, DisplacementControl, LoadControl, NewtonOptions
+from ..post.thickness import default_wall
 
 __all__ = [
     "CaseError", "Strict", "Selector", "DofName", "PositiveFloat", "CurveKnots", "CurveMixin", "LinePiece",

@@ -18,7 +18,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .mesh import Mesh
+from ..fem.mesh import Mesh
 
 COLUMNS = ("s", "r", "z", "thickness", "initial_thickness", "ratio", "first_contact", "s_current")
 

@@ -12,7 +12,7 @@ sum of its squared second differences relative to its initial mean.
 Methods:
 - "gradient": SciPy's bound-constrained trust-region reflective least squares
   (`scipy.optimize.least_squares`, method "trf") over ln t_k, with the Jacobian of the final
-  thickness to the design from direct differentiation along the load path (axiform.sensitivity): a
+  thickness to the design from direct differentiation along the load path (axiform.app.sensitivity): a
   Gauss-Newton method, which needs few forward solves because the whole Jacobian (stations x
   design) comes with each solve;
 - "fixed-point": the plain rule, each t_k scaled by target / achieved at its station s_k.
@@ -35,11 +35,11 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .case import Built, CaseError, build, parse, read
-from .model import Model
+from ..case.schema import Built, CaseError, build, parse, read
+from ..model.model import Model
 from .sensitivity import sensitivity
-from .solver import LoadControl, solve
-from .thickness import thickness_table
+from ..solve.solver import LoadControl, solve
+from ..post.thickness import thickness_table
 
 BOUNDS = (0.2, 5.0)  # design bounds, times the initial thickness
 METHODS = ("gradient", "fixed-point")
@@ -406,7 +406,7 @@ def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], met
 def write_outputs(out: Path, design: ThicknessDesign, result: OptimizeResult,
                   target: tuple[np.ndarray, np.ndarray], final: Path | None) -> None:
     """optimized.toml, optimize.csv, optimize.json and optimize.png in `out`."""
-    from .results import write_atomic
+    from ..io.results import write_atomic
 
     write_atomic(out / "optimized.toml", toml_text(design.case_tree(result.best.design)))
     buf = ["iteration,objective,max_rel_deviation,forward_solves"]
@@ -432,7 +432,7 @@ def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResul
     +-t/2 about the mid-surface against s, the same way), the final thickness of both against
     the target (the stations outside the target's range shaded), and the objective and the max
     deviation of each iteration against the forward solves spent."""
-    from .plots import _pyplot, _save
+    from ..post.plots import _pyplot, _save
 
     plt = _pyplot()
     units = design.built.case.units
@@ -513,8 +513,8 @@ def run(case_path: str, target_path: str, out: str, max_iter: int = 20, method: 
     """`axiform optimize`: returns the exit code (0 finished, 1 stopped short, 2 invalid input)."""
     import sys
 
-    from .cli import _prepare, _say
-    from .cli import run as run_case
+    from ..cli import _prepare, _say
+    from ..cli import run as run_case
 
     case_file = Path(case_path)
     try:
@@ -551,7 +551,7 @@ def run(case_path: str, target_path: str, out: str, max_iter: int = 20, method: 
         result = optimize(design, target, method, max_iter, tolerance, smoothness, report)
     final = None
     if result.best.finished:
-        from .results import write_atomic
+        from ..io.results import write_atomic
 
         case_out = out_dir / "optimized.toml"
         write_atomic(case_out, toml_text(design.case_tree(result.best.design)))

@@ -34,10 +34,10 @@ from typing import Callable
 
 import numpy as np
 
-from .linsolve import factorize
-from .model import Model
-from .solver import LoadControl, NewtonOptions, SolveResult, Step, solve
-from .thickness import thickness_table
+from ..solve.linsolve import factorize
+from ..model.model import Model
+from ..solve.solver import LoadControl, NewtonOptions, SolveResult, Step, solve
+from ..post.thickness import thickness_table
 
 RELATIVE_STEP = 1e-6  # the difference step of the semi-analytic residual, relative to |s_k|
 

@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from .assembly import SolidAssembly
-from .materials.kinematics import from_rows, to_rows
+from ..materials.kinematics import from_rows, to_rows
 
 PRESSURE_SPACES = ("p0", "p1")
 

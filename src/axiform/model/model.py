@@ -13,14 +13,14 @@ from typing import Iterable, Sequence
 import numpy as np
 import scipy.sparse as sp
 
-from .assembly import SolidAssembly
-from .constraints import DofMap, SparsePattern
-from .cavity import Cavity
-from .curves import PROPORTIONAL, Curve
-from .graphs import connected_components
-from .loads import FollowerPressure
-from .mixed import MixedAssembly
-from .mesh import Mesh
+from ..fem.assembly import SolidAssembly
+from ..fem.constraints import DofMap, SparsePattern
+from ..fem.cavity import Cavity
+from ..fem.curves import PROPORTIONAL, Curve
+from ..fem.graphs import connected_components
+from ..fem.loads import FollowerPressure
+from ..fem.mixed import MixedAssembly
+from ..fem.mesh import Mesh
 
 DOF_NAMES = {"ur": 0, "uz": 1, "rot": 2}
 SFR_EDGE_RULES = ("tie", "fix", "free")
@@ -71,7 +71,7 @@ class Model:
     """Build a model step by step (fix, prescribe, pressure, point_load), then `finalize`.
 
     formulation: "mixed" (default): the three-field u-p-J_bar element, pressure and dilatation
-    condensed on each element (axiform.mixed), free of volumetric locking; "displacement":
+    condensed on each element (axiform.fem.mixed), free of volumetric locking; "displacement":
     the plain displacement element of the paper, which locks as kappa/mu grows.
     pressure_space: "p0" or "p1" for the mixed element (default: PRESSURE_SPACE).
 
@@ -136,7 +136,7 @@ class Model:
 
     def cavity(self, edges: np.ndarray, name: str, control: str = "pressure", value: float = 0.0,
                ambient: float = 0.0, curve: Curve = PROPORTIONAL) -> Cavity:
-        """A gas cavity bounded by boundary edges (axiform.cavity): control "pressure" (value:
+        """A gas cavity bounded by boundary edges (axiform.fem.cavity): control "pressure" (value:
         the gauge pressure), "volume" (value: the volume at f = 1) or "gas" (value: the
         content p_abs V at f = 1, ambient: the absolute ambient pressure).  Add the supports
         first: an open end of the boundary off the axis must have its uz held."""

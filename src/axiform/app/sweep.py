@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .case import CaseError, fingerprint, parse, read
+from ..case.schema import CaseError, fingerprint, parse, read
 
 SWEEP_KEYS = ("case", "vary", "cases", "report")
 FIXED_COLUMNS = ("status", "exit_code", "steps", "wall_time_s", "message")
@@ -142,8 +142,8 @@ def run_case(case_file: str, overrides: list[str], out: str) -> dict[str, Any]:
     of sweep.csv from the exit code and OUT/summary.json."""
     import numpy as np
 
-    from .cli import run
-    from .malloc import keep_freed_memory
+    from ..cli import run
+    from ..solve.malloc import keep_freed_memory
 
     keep_freed_memory()
     t0 = time.perf_counter()
@@ -208,7 +208,7 @@ class SweepProgress:
 
 def write_table(path: Path, sweep: Sweep, rows: list[dict | None]) -> None:
     """sweep.csv: one row per case (status "pending" for those not done yet), atomically."""
-    from .results import write_atomic
+    from ..io.results import write_atomic
 
     text = io.StringIO()
     w = csv.writer(text, lineterminator="\n")
@@ -266,7 +266,7 @@ def plot_sweep(path: Path, sweep: Sweep, rows: list[dict | None]) -> bool:
     ax.grid(True, alpha=0.3)
     if others and groups:
         ax.legend(fontsize=8)
-    from .results import atomic
+    from ..io.results import atomic
 
     with atomic(path) as tmp:
         fig.savefig(tmp, dpi=120, format="png")

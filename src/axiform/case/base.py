@@ -7,9 +7,9 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from .curves import PROPORTIONAL, Curve
-from .mesh import Mesh
-from .selectors import select_nodes
+from ..fem.curves import PROPORTIONAL, Curve
+from ..fem.mesh import Mesh
+from ..fem.selectors import select_nodes
 
 DofName = Literal["ur", "uz", "rot"]
 PositiveFloat = Annotated[float, Field(gt=0)]

@@ -3,7 +3,7 @@
 sequence (forming.gif).  `axiform plot DIR` calls `plot_folder`; a run calls it at its end.
 
 Everything is drawn from the folder alone: summary.json says the units, what the load factor
-lambda scales and what each monitor measures (axiform.labels), so that every axis and colour
+lambda scales and what each monitor measures (axiform.post.labels), so that every axis and colour
 bar names its quantity and unit.
 """
 

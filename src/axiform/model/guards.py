@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from .graphs import connected_components
+from ..fem.graphs import connected_components
 
 
 def key_path(parts: list[str | int]) -> str:

@@ -8,10 +8,10 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field
 
-from .case_base import CaseError, CurveMixin, DofName, Selector
-from .mesh import Mesh
-from .model import Model
-from .selectors import select_edges, select_nodes
+from .base import CaseError, CurveMixin, DofName, Selector
+from ..fem.mesh import Mesh
+from ..model.model import Model
+from ..fem.selectors import select_edges, select_nodes
 
 
 class FixSpec(CurveMixin):

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .materials import cauchy_stress
+from ..materials import cauchy_stress
 from .thickness import contact_times, nodal_thickness, pieces, thickness_table
 
 

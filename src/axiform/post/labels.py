@@ -20,7 +20,7 @@ QUANTITY_UNIT = {"pressure": "pressure", "stress": "pressure", "force": "force",
 
 
 def case_labels(case: Any) -> dict[str, Any]:
-    """units, load and monitor_quantities of a validated case (axiform.case.Case)."""
+    """units, load and monitor_quantities of a validated case (axiform.case.schema.Case)."""
     return {"units": {k: v for k, v in case.units.model_dump().items() if v},
             "load": loaded_quantity(case),
             "monitor_quantities": {m.name: monitor_quantity(m) for m in case.monitor}}

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from .elements import gradient_operator
-from .materials import InvertedElementError, deformation_gradient
+from ..materials import InvertedElementError, deformation_gradient
 from .mesh import Mesh
 
 

@@ -11,16 +11,16 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from .case_base import CaseError, CurveMixin, PositiveFloat, Selector, Strict
-from .contact.dxf import DxfError, read_dxf
-from .contact.pair import ContactPair
-from .contact.surfaces import Circle, Polyline
-from .guards import chain_crossing
-from .materials import Hyperelastic
-from .mesh import Mesh
-from .model import Model
-from .profile import Arc, Line, Profile, ProfileError
-from .selectors import select_nodes
+from .base import CaseError, CurveMixin, PositiveFloat, Selector, Strict
+from ..contact.dxf import DxfError, read_dxf
+from ..contact.pair import ContactPair
+from ..contact.surfaces import Circle, Polyline
+from ..model.guards import chain_crossing
+from ..materials import Hyperelastic
+from ..fem.mesh import Mesh
+from ..model.model import Model
+from ..fem.profile import Arc, Line, Profile, ProfileError
+from ..fem.selectors import select_nodes
 
 
 class CircleSpec(Strict):

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Callable, NamedTuple, Self
 
 # the folder containing the axiform package: the second process imports this same code
-_ROOT = str(Path(__file__).resolve().parent.parent)
+_ROOT = str(Path(__file__).resolve().parents[2])
 
 
 # a plot process is started when other processes leave this many cores idle: one for the
@@ -103,7 +103,7 @@ class PlotProcess:
     end ends it)."""
 
     def __init__(self):
-        code = f"import sys; sys.path.insert(0, {_ROOT!r}); from axiform.plot_process import serve; serve()"
+        code = f"import sys; sys.path.insert(0, {_ROOT!r}); from axiform.post.plot_process import serve; serve()"
         self.proc = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE,
                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 

@@ -11,9 +11,9 @@ from typing import Annotated, Literal
 
 from pydantic import Field, model_validator
 
-from .case_base import CaseError, PositiveFloat, Strict
-from .mesh import Mesh, MeshError, layered, read_gmsh, rectangle
-from .profile import Arc, Line, Profile, ProfileError
+from .base import CaseError, PositiveFloat, Strict
+from ..fem.mesh import Mesh, MeshError, layered, read_gmsh, rectangle
+from ..fem.profile import Arc, Line, Profile, ProfileError
 
 
 class LinePiece(Strict):

@@ -7,10 +7,10 @@ from typing import Annotated, Literal
 
 from pydantic import Field, model_validator
 
-from .case_base import CaseError, DofName, PositiveFloat, Selector, Strict, one_node
-from .mesh import Mesh
-from .model import Model
-from .solver import ArcLengthControl, DisplacementControl, LoadControl
+from .base import CaseError, DofName, PositiveFloat, Selector, Strict, one_node
+from ..fem.mesh import Mesh
+from ..model.model import Model
+from ..solve.solver import ArcLengthControl, DisplacementControl, LoadControl
 
 
 class DofRef(Strict):

@@ -26,8 +26,8 @@ from xml.etree import ElementTree as ET
 import numpy as np
 
 from . import gid
-from .fields import point_fields
-from .thickness import thickness_table, write_thickness_csv
+from ..post.fields import point_fields
+from ..post.thickness import thickness_table, write_thickness_csv
 
 
 @contextmanager
@@ -251,7 +251,7 @@ class ResultsWriter:
 
     def _write_contact(self, step):
         """contact.csv: every slave node of every pair at this step; totals in the summary."""
-        from .contact.pair import STATUS
+        from ..contact.pair import STATUS
 
         lines = ["pair,node,r,z,gap,pressure,status,first_contact"]  # header first (DESIGN 10.12)
         totals = []
@@ -352,7 +352,7 @@ class ResultsWriter:
             self._vtu_writer = None
         if self.plots and self.steps:
             if self.plotter is None:
-                from .plots import plot_folder
+                from ..post.plots import plot_folder
 
                 self.plotter = plot_folder
             self.plotter(self.out)

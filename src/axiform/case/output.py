@@ -7,7 +7,7 @@ from typing import Annotated
 
 from pydantic import Field
 
-from .case_base import Strict
+from .base import Strict
 
 
 class OutputSpec(Strict):

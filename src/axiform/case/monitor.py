@@ -9,12 +9,12 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field, field_validator, model_validator
 
-from .case_base import CaseError, DofName, Selector, Strict, one_node
-from .cavity import Cavity
-from .contact.pair import ContactPair
-from .mesh import Mesh
-from .model import Model
-from .selectors import select_nodes
+from .base import CaseError, DofName, Selector, Strict, one_node
+from ..fem.cavity import Cavity
+from ..contact.pair import ContactPair
+from ..fem.mesh import Mesh
+from ..model.model import Model
+from ..fem.selectors import select_nodes
 
 HISTORY_COLUMNS = ("step", "load_factor", "iterations")  # history.csv's first columns
 

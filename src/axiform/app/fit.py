@@ -38,8 +38,8 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import least_squares, lsq_linear
 
-from .case_material import KEYS, MAX_OGDEN_TERMS, MaterialSpec
-from .materials import ArrudaBoyce, Gent, Hyperelastic, MooneyRivlin, Ogden, Yeoh
+from ..case.material import KEYS, MAX_OGDEN_TERMS, MaterialSpec
+from ..materials import ArrudaBoyce, Gent, Hyperelastic, MooneyRivlin, Ogden, Yeoh
 
 MODES = ("uniaxial", "equibiaxial", "planar")
 STABILITY_STRETCHES = 10.0 ** np.linspace(-1.0, 1.0, 401)  # 0.1 to 10, 1 in the middle

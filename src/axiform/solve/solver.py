@@ -14,11 +14,11 @@ from typing import Callable
 
 import numpy as np
 
-from .folds import folded_nodes
-from .guards import evaluation_fault
+from ..fem.folds import folded_nodes
+from ..model.guards import evaluation_fault
 from .linsolve import SingularTangentError, factorize, factorize_signed
-from .materials import InvertedElementError
-from .model import Evaluation, Model
+from ..materials import InvertedElementError
+from ..model.model import Evaluation, Model
 
 
 @dataclass

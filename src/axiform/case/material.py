@@ -14,7 +14,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, ValidationInfo, field_validator, model_validator
 
-from .materials import ArrudaBoyce, Gent, Hyperelastic, MooneyRivlin, Ogden, Yeoh
+from ..materials import ArrudaBoyce, Gent, Hyperelastic, MooneyRivlin, Ogden, Yeoh
 
 Model = Literal["neo-hooke", "mooney-rivlin", "yeoh", "ogden", "gent", "arruda-boyce"]
 

@@ -1,0 +1,1 @@
+"""The commands behind the CLI: run, sweep, fit, optimize and its sensitivities."""

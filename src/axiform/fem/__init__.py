@@ -1,0 +1,1 @@
+"""Finite elements: mesh, elements, assembly, loads, cavities, curves, dof numbering."""

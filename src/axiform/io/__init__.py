@@ -1,0 +1,1 @@
+"""The results folder: writer, checkpoints, VTU, GiD and revolved files."""

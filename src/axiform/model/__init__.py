@@ -1,0 +1,1 @@
+"""The model: its terms, their evaluation and state, and the checks on it."""
