@@ -237,12 +237,12 @@ def run_axiform(friction: bool, penalty: float, element: str) -> dict:
     def record(step):
         t.append(step.lam)
         uz.append(step.u[centre])
-        fz.append(punch.report()["force_z"])
+        fz.append(punch.report(step.state.contacts[0])["force_z"])
 
     res = solve(built.model, built.control, built.options, on_step=record)
     top = np.flatnonzero(np.abs(built.model.mesh.points[:, 1] - 0.3) < 1e-9)
     x = built.model.mesh.points[top] + res.last.u.reshape(-1, built.model.dpn)[top, :2]
-    rep = punch.report()
+    rep = punch.report(res.last.state.contacts[0])
     return {"t": np.array(t), "uz": np.array(uz), "fz": np.array(fz), "x_top": x[np.argsort(x[:, 0])],
             "status": res.status, "steps": len(res.steps), "iterations": res.newton_iterations,
             "open": int((rep["status"] == 0).sum()), "slaves": len(rep["status"]), "built": built}

@@ -27,15 +27,17 @@ def element(request):
     return request.param
 
 
-def difference_tangent(model, u_f, lam, h):
-    """Central differences of the residual of a finalized model: dR/du (n, n) and dR/dlambda."""
+def difference_tangent(model, u_f, lam, h, state=None):
+    """Central differences of the residual of a finalized model from the committed history
+    `state` (None: the initial one): dR/du (n, n) and dR/dlambda."""
     n = model.n_free
     num = np.empty((n, n))
     for j in range(n):
         e = np.zeros(n)
         e[j] = h
-        num[:, j] = (model.evaluate(u_f + e, lam, tangent=False).r - model.evaluate(u_f - e, lam, tangent=False).r) / (2 * h)
-    dl = (model.evaluate(u_f, lam + h, tangent=False).r - model.evaluate(u_f, lam - h, tangent=False).r) / (2 * h)
+        num[:, j] = (model.evaluate(u_f + e, lam, state, tangent=False).r
+                     - model.evaluate(u_f - e, lam, state, tangent=False).r) / (2 * h)
+    dl = (model.evaluate(u_f, lam + h, state, tangent=False).r - model.evaluate(u_f, lam - h, state, tangent=False).r) / (2 * h)
     return num, dl
 
 

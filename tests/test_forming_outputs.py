@@ -9,6 +9,8 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import meshio
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from PIL import Image
@@ -116,15 +118,15 @@ def test_vtu_fields_thickness_and_first_contact():
     built = build(load(EXAMPLES / "toric_plate.toml"), EXAMPLES)
     model = built.model
     pair = model.contacts[0]
-    pair.first_contact = np.where(np.arange(len(pair.nodes)) % 3 == 0, 0.5, np.nan)
-    fields = point_fields(model, np.zeros(model.n_full))
+    start = model.initial_state()
+    held = replace(start.contacts[0], first_contact=np.where(np.arange(len(pair.nodes)) % 3 == 0, 0.5, np.nan))
+    fields = point_fields(model, np.zeros(model.n_full), replace(start, contacts=(held,)))
     expect = np.full(model.mesh.n_nodes, -1.0)
-    expect[pair.nodes] = np.nan_to_num(pair.first_contact, nan=-1.0)
+    expect[pair.nodes] = np.nan_to_num(held.first_contact, nan=-1.0)
     assert np.array_equal(fields["first_contact"], expect)
     assert np.allclose(fields["thickness"], 0.5)
     assert "first_contact_0" not in fields  # one piece
-    del pair.first_contact  # before the contact branch: no field
-    assert "first_contact" not in point_fields(model, np.zeros(model.n_full))
+    assert (point_fields(model, np.zeros(model.n_full))["first_contact"] == -1).all()  # the initial state
 
 
 def test_vtu_fields_first_contact_per_piece():
@@ -133,10 +135,11 @@ def test_vtu_fields_first_contact_per_piece():
     built = build(load(EXAMPLES / "cup_thermoforming.toml"), EXAMPLES)
     model = built.model
     plug, mould = model.contacts
-    plug.first_contact = np.where(np.arange(len(plug.nodes)) % 2 == 0, 0.5, np.nan)
-    mould.first_contact = np.where(np.arange(len(mould.nodes)) % 3 == 0, 1.5, np.nan)
-    fields = point_fields(model, np.zeros(model.n_full))
-    for k, pair in enumerate((plug, mould)):
+    start = model.initial_state()
+    held = (replace(start.contacts[0], first_contact=np.where(np.arange(len(plug.nodes)) % 2 == 0, 0.5, np.nan)),
+            replace(start.contacts[1], first_contact=np.where(np.arange(len(mould.nodes)) % 3 == 0, 1.5, np.nan)))
+    fields = point_fields(model, np.zeros(model.n_full), replace(start, contacts=held))
+    for k, pair in enumerate(held):
         expect = np.full(model.mesh.n_nodes, -1.0)
         expect[pair.nodes] = np.nan_to_num(pair.first_contact, nan=-1.0)
         assert np.array_equal(fields[f"first_contact_{k}"], expect)

@@ -51,7 +51,8 @@ def test_steps_hold_results_not_the_tangent():
     result = solve(model, LoadControl(1.0, 4))
     assert result.n_steps == len(result.steps) == 4
     held = {f.name for f in Step.__dataclass_fields__.values()}
-    assert held == {"number", "lam", "iterations", "residuals", "u_f", "u", "r_full", "checkpoint"}
+    # state: the committed history (per slave node and cavity), not the tangent
+    assert held == {"number", "lam", "iterations", "residuals", "u_f", "u", "r_full", "checkpoint", "state"}
 
     def arrays(value):  # the checkpoint (restart state) holds vectors and scalars, no matrix
         if isinstance(value, dict):

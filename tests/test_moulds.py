@@ -96,7 +96,7 @@ def test_penetration_stays_a_small_fraction_of_a_wall_thinned_five_times():
     inner = select_nodes(mesh, {"r": 0.2})
     t = 1.0 - (0.2 + u[inner, 0].mean())  # current wall: from the bore to the mould
     assert t / 0.02 < 0.22  # thinned about five times
-    rep = pair.report()
+    rep = pair.report(res.last.state.contacts[0])
     assert (rep["status"] > 0).all()
     pen = -rep["gap"]
     assert pen.max() > 0
@@ -320,8 +320,9 @@ def test_three_mould_pieces_with_their_own_motions_compress_a_cylinder_homogeneo
     s_rr = 2 * C1 * J ** (-5 / 3) * (lam_r**2 - I1 / 3) + kappa * (J - 1)
     assert abs(s_rr) < 1e-7 * abs(s_zz)
     force = s_zz * np.pi * lam_r**2  # on the current section
-    f_lower, f_plug, f_ring = (p.report()["force_z"] for p in (lower, plug, ring))
+    rep_lower, rep_plug, rep_ring = (p.report(s) for p, s in zip((lower, plug, ring), res.last.state.contacts))
+    f_lower, f_plug, f_ring = (r["force_z"] for r in (rep_lower, rep_plug, rep_ring))
     assert f_lower == pytest.approx(-force, rel=1e-7)
     assert f_plug + f_ring == pytest.approx(force, rel=1e-7)
     assert f_plug < 0 and f_ring < 0  # both pieces push down
-    assert plug.report()["status"][plug.X[:, 0] < 0.45].all() and ring.report()["status"][ring.X[:, 0] > 0.55].all()
+    assert rep_plug["status"][plug.X[:, 0] < 0.45].all() and rep_ring["status"][ring.X[:, 0] > 0.55].all()

@@ -103,11 +103,11 @@ def test_an_unexpected_error_sets_failed_and_exit_3(tmp_path, monkeypatch, capsy
     calls = {"n": 0}
     evaluate = model_module.Model.evaluate
 
-    def crash_later(self, u_f, lam, tangent=True):
+    def crash_later(self, *args, **kwargs):
         calls["n"] += 1
         if calls["n"] > 12:
             raise RuntimeError("a fault in the law")
-        return evaluate(self, u_f, lam, tangent)
+        return evaluate(self, *args, **kwargs)
 
     monkeypatch.setattr(model_module.Model, "evaluate", crash_later)
     out = tmp_path / "out"

@@ -112,7 +112,6 @@ def sensitivity(build: Callable[[np.ndarray], Model], design: np.ndarray, contro
         return model.finalize() if model.dofmap is None else model
 
     model = built(s)
-    lagging = built(s)  # the base model one commit behind: the tangent K_n with the history h_{n-1}
     shadows = []
     for k in range(m):
         e = np.zeros(m)
@@ -126,19 +125,23 @@ def sensitivity(build: Callable[[np.ndarray], Model], design: np.ndarray, contro
     dm = model.dofmap
     out = Sensitivity(SolveResult("running"), model, s, dx_ds)
 
+    lag_state = model.initial_state()  # the history h_{n-1}: the tangent K_n is taken with it
+    shadow_states = [[plus.initial_state(), minus.initial_state()] for plus, minus in shadows]
+
     def differentiate(step: Step) -> None:
+        nonlocal lag_state
         u_f, lam = step.u_f, step.lam
-        ev = lagging.evaluate(u_f, lam)
-        lagging.commit()
+        ev = model.evaluate(u_f, lam, lag_state)
+        lag_state = ev.trial
         dR = np.empty((model.n_free, m))
-        for k, (plus, minus) in enumerate(shadows):
-            dR[:, k] = (plus.evaluate(u_f, lam, tangent=False).r - minus.evaluate(u_f, lam, tangent=False).r) / (2 * h[k])
+        for k, ((plus, minus), (s_plus, s_minus)) in enumerate(zip(shadows, shadow_states)):
+            dR[:, k] = (plus.evaluate(u_f, lam, s_plus, tangent=False).r
+                        - minus.evaluate(u_f, lam, s_minus, tangent=False).r) / (2 * h[k])
         du_f = -np.asarray(factorize(ev.K)(dR)).reshape(model.n_free, m)
         if history:
-            for k, (plus, minus) in enumerate(shadows):
-                for shadow, sign in ((plus, 1.0), (minus, -1.0)):
-                    shadow.evaluate(u_f + sign * h[k] * du_f[:, k], lam, tangent=False)
-                    shadow.commit()
+            for k, (pair, states) in enumerate(zip(shadows, shadow_states)):
+                for j, (shadow, sign) in enumerate(zip(pair, (1.0, -1.0))):
+                    states[j] = shadow.evaluate(u_f + sign * h[k] * du_f[:, k], lam, states[j], tangent=False).trial
         du = np.concatenate([du_f[: dm.nf], np.zeros((dm.np, m))])[dm.eq]  # (n_full, m)
         if not keep_steps:
             out.du_ds.clear()
@@ -152,7 +155,7 @@ def sensitivity(build: Callable[[np.ndarray], Model], design: np.ndarray, contro
     last = out.solve.last
     if last is not None:
         u2 = last.u.reshape(-1, model.dpn)[:, :2]
-        out.thickness = thickness_table(model.mesh, u2, model.contacts)
+        out.thickness = thickness_table(model.mesh, u2, last.state.contacts)
         if out.thickness is not None:
             out.dthickness_ds = thickness_derivative(model, u2, out.dx_final_ds())
     return out

@@ -80,12 +80,16 @@ class Monitor:
     pair: object = None
     quantity: str = ""
     cavity: object = None
+    index: int = 0  # of the pair or cavity in the model (the state's order)
 
     def value(self, step) -> float:
+        """The monitored scalar at a converged step (solve.solver.Step), read off its
+        displacements, reactions or committed state."""
         if self.cavity is not None:
-            return float(self.cavity.pressure_now if self.quantity == "pressure" else self.cavity.volume_now)
+            held = step.state.cavities[self.index]
+            return float(held.pressure if self.quantity == "pressure" else held.volume)
         if self.pair is not None:
-            return float(self.pair.report()[_CONTACT_QUANTITY[self.quantity]])
+            return float(self.pair.report(step.state.contacts[self.index])[_CONTACT_QUANTITY[self.quantity]])
         if self.reaction:
             return float(step.r_full[self.dofs].sum())
         return float(step.u[self.dofs].sum())
@@ -100,12 +104,14 @@ def build_monitors(model: Model, mesh: Mesh, specs: list[MonitorSpec], cavities:
         if m.cavity is not None:
             if m.cavity not in cavities:
                 raise CaseError(f"monitor[{i}].cavity: no [[cavity]] is named '{m.cavity}'")
-            monitors.append(Monitor(m.name, cavity=cavities[m.cavity], quantity=m.quantity))
+            cavity = cavities[m.cavity]
+            monitors.append(Monitor(m.name, cavity=cavity, quantity=m.quantity, index=model.cavities.index(cavity)))
             continue
         if m.contact is not None:
             if m.contact >= len(pairs):
                 raise CaseError(f"monitor[{i}].contact: there are {len(pairs)} [[contact]] tables (from 0)")
-            monitors.append(Monitor(m.name, pair=pairs[m.contact], quantity=m.quantity))
+            monitors.append(Monitor(m.name, pair=pairs[m.contact], quantity=m.quantity,
+                                    index=model.contacts.index(pairs[m.contact])))
             continue
         if m.dof == "rot" and model.dpn == 2:
             raise CaseError(f"monitor[{i}].dof: element '{element}' has no rotation dof")

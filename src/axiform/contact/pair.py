@@ -7,6 +7,8 @@ times the current ring area of each node (the consistent area, integral of 2 pi 
 
 from __future__ import annotations
 
+from dataclasses import dataclass, replace
+
 import numpy as np
 
 from ..fem.elements import edge_shape, gauss_1d
@@ -112,6 +114,70 @@ def _normal_law(g: np.ndarray, touching: np.ndarray, kn, d: float):
     return fn, dfn
 
 
+@dataclass(frozen=True)
+class ContactSeen:
+    """What an evaluation of a pair found, per slave node (n,): current positions relative to
+    the surface x (n, 2), the projection `proj`, the forces f (n, 2), status, current ring
+    areas a, the traction per unit current area (n, 2), and the forces of the mid-point
+    guards (m, 2) (zeros where none)."""
+
+    x: np.ndarray
+    proj: object
+    f: np.ndarray
+    status: np.ndarray
+    a: np.ndarray
+    traction: np.ndarray
+    guard_force: np.ndarray
+
+
+@dataclass(frozen=True)
+class ContactState:
+    """The history of a pair, per slave node (n,), as of one converged step: positions for
+    the crossing test x_prev (n, 2) (surface frame), friction stick points s_stick (NaN:
+    none), sticky nodes and their points, the time of first contact (NaN: never); and what
+    the step's evaluation found (`seen`, None before the first step and after a restart).
+    Immutable: an evaluation returns a new (trial) state, the solver keeps the committed one."""
+
+    nodes: np.ndarray
+    x_prev: np.ndarray
+    s_stick: np.ndarray
+    stuck: np.ndarray
+    stuck_point: np.ndarray
+    first_contact: np.ndarray
+    seen: ContactSeen | None = None
+
+    HISTORY = ("x_prev", "s_stick", "stuck", "stuck_point", "first_contact")
+
+    def to_dict(self) -> dict[str, np.ndarray]:
+        """The history arrays (a checkpoint)."""
+        return {k: getattr(self, k).copy() for k in self.HISTORY}
+
+    def from_dict(self, saved: dict[str, np.ndarray]) -> "ContactState":
+        """This state with the history arrays of `saved` (ContactState.to_dict), checked."""
+        values = {}
+        for k in self.HISTORY:
+            v = np.asarray(saved[k])
+            ref = getattr(self, k)
+            if v.shape != ref.shape:
+                raise ValueError(f"contact state '{k}' has shape {v.shape}, not {ref.shape}")
+            values[k] = v.astype(ref.dtype, copy=True)
+        return replace(self, seen=None, **values)
+
+
+@dataclass(frozen=True)
+class ContactTrial:
+    """One evaluation of a pair: its forces on the slave nodes f (n, 2), their derivative K
+    (n, 2, 2) with respect to the positions relative to the surface, the coupling through the
+    current ring areas (m, 2k, 2k), the poles' rate blocks (or None), and the state the pair
+    would have if this evaluation were accepted (`state`)."""
+
+    f: np.ndarray
+    K: np.ndarray
+    coupling: np.ndarray
+    pole_rate: np.ndarray | None
+    state: ContactState
+
+
 def outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Row-wise outer products (n, 2, 2) of a and b (n, 2)."""
     return a[:, :, None] * b[:, None, :]
@@ -177,9 +243,11 @@ class ContactPair:
     coarse blown bottle's final wall (misfit to a uniform wall 0.0580 against 0.0575) and made
     the optimisation of its parison take 5 forward solves instead of 3.
 
-    History (updated at converged steps by `commit`): stick points, sticky nodes, and
-    `first_contact` (n,): the load factor (process time t) of the step in which each node
-    first touched (for sticky contact: froze), NaN where it never did."""
+    The pair keeps nothing between calls: its history (`ContactState`: stick points, sticky
+    nodes, and `first_contact` (n,): the process time t of the step in which each node first
+    touched (for sticky contact: froze), NaN where it never did) is handed to `evaluate`,
+    which returns the state the pair would have if the evaluation were accepted.  The solver
+    holds the committed state and commits the trial of the accepted evaluation only."""
 
     def __init__(self, mesh: Mesh, surface: RigidSurface, slaves: np.ndarray, penalty: float | None = None,
                  friction: float = 0.0, sticky: bool = False, tangential_penalty: float | None = None,
@@ -230,23 +298,19 @@ class ContactPair:
             self.guard_allowance = GUARD_ALLOWANCE * _edge_heights(mesh, edges)
             chord = mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]]
             self.guard_arm = 0.25 * np.column_stack([-chord[:, 1], chord[:, 0]])  # SFR: d x_m / d theta_a
-            self.guard_force = np.zeros((len(edges), 2))
         self.kt0 = self.kn0 if tangential_penalty is None else np.full(len(self.nodes), float(tangential_penalty))
         self.mu = friction
         self.sticky = sticky
         self.depth = depth if depth is not None else 0.5 * mesh.size()
         self.smoothing = smoothing if smoothing is not None else 1e-3 * mesh.size()
         self.search = search
-        # history, updated only at converged steps
-        self.x_prev = self.X.copy()  # surface-frame positions at the last converged step
-        self.s_stick = np.full(n, np.nan)  # friction: surface coordinate where a node sticks
-        self.stuck = np.zeros(n, bool)  # sticky: tied nodes, at stuck_point (surface frame)
-        self.stuck_point = np.zeros((n, 2))
-        self.first_contact = np.full(n, np.nan)
-        self.coupling: np.ndarray | None = None
-        self.last = None
-        self.predicting = False
         self.name: str | None = None  # a label for plots and summary.json (case file: [[contact]] name)
+
+    def initial_state(self) -> ContactState:
+        """The history before the first step: no node touched, positions at the reference."""
+        n = len(self.nodes)
+        return ContactState(self.nodes, self.X.copy(), np.full(n, np.nan), np.zeros(n, bool), np.zeros((n, 2)),
+                            np.full(n, np.nan))
 
     def dofs(self, dpn: int) -> np.ndarray:
         """Full dofs (ur, uz) of the slave nodes, (n, 2)."""
@@ -257,30 +321,30 @@ class ContactPair:
         blocks of `coupling`."""
         return (self.nodes[self.edges][:, :, None] * dpn + np.arange(2)).reshape(len(self.edges), -1)
 
-    def evaluate(self, u: np.ndarray, lam: float):
-        """Forces on the slave nodes f (n, 2), their derivative K (n, 2, 2) with respect to the
-        node positions relative to the surface, and the state of each node, at displacements
-        u (n_nodes, 2) and load factor lam.  Also sets `coupling` (m, 2k, 2k): the derivative
-        of the forces through the current ring areas, over the nodes of each slave edge."""
+    def evaluate(self, u: np.ndarray, lam: float, state: ContactState, predicting: bool = False,
+                 guard_force: np.ndarray | None = None) -> ContactTrial:
+        """The pair at displacements u (n_nodes, 2) and process time lam, from the committed
+        history `state`: forces on the slave nodes, their derivatives (`ContactTrial`) and the
+        trial state.  predicting: the tangent of a step's first iteration (nodes resting on
+        the surface get the penalty in it, see the class).  guard_force: the mid-point guards'
+        forces (m, 2) of the same state (`guard`), for the report."""
         xa = self.X + u[self.nodes]
         parts, dparts = ring_areas(xa, self.edges, derivative=True)
         a = np.bincount(self.edges.ravel(), parts.ravel(), len(self.nodes))
         # f = w(a) t: w = a (a / a0)^thinning, the area times the thinning of the penalty
         ratio = np.where(self.on_axis, 1.0, a / np.where(self.on_axis, 1.0, self.area0)) ** self.thinning
         w, dw = a * ratio, np.where(self.on_axis, 1.0, (1.0 + self.thinning) * ratio)
-        t, dt, status, proj, x = self._traction(xa - self.surface.offset(lam))
+        t, dt, status, proj, x, slip = self._traction(xa - self.surface.offset(lam), state, predicting)
         f = w[:, None] * t
         K = w[:, None, None] * dt
         e = self.edges
         m, k = e.shape
         C = np.einsum("mi,mid,mije->midje", dw[e], t[e], dparts)  # d f_i / d x_j through a_i
-        self._rate = None
-        if self.pole_edge.size:
-            self._rate = self._poles(xa, t, dt, f, C)
-        self.coupling = C.reshape(m, 2 * k, 2 * k)
-        self.last = (x, proj, f, status, a, lam, ratio[:, None] * t)
-        self._K = K
-        return f, K, status
+        pole_rate = self._poles(xa, t, dt, f, C) if self.pole_edge.size else None
+        if guard_force is None:
+            guard_force = np.zeros((len(e) if self.guarded else 1, 2))
+        seen = ContactSeen(x, proj, f, status, a, ratio[:, None] * t, guard_force)
+        return ContactTrial(f, K, C.reshape(m, 2 * k, 2 * k), pole_rate, self._next(state, seen, slip, lam))
 
     def _poles(self, x, t, dt, f, C):
         """Add to the forces f (n, 2) and to the coupling C (m, k, 2, k, 2), in place, the
@@ -306,15 +370,16 @@ class ContactPair:
         for SFR the fibre rotation theta, which moves the edge's mid-point."""
         return (self.nodes[self.edges][:, :, None] * dpn + np.arange(dpn)).reshape(len(self.edges), -1)
 
-    def guard(self, u: np.ndarray, lam: float, velocity: np.ndarray):
+    def guard(self, u: np.ndarray, lam: float, velocity: np.ndarray, state: ContactState):
         """The mid-point guards of the straight edges at node displacements u (n_nodes, dpn)
-        and load factor lam: the rounded normal law at the mid-point's gap plus its allowance.
+        and load factor lam, from the committed history `state`: the rounded normal law at the mid-point's gap plus its allowance.
         The mid-point is x_m = (x_a + x_b) / 2, and for SFR (eq. 3) also
         + (theta_a - theta_b) (-dZ, dR) / 4 with (dR, dZ) = X_b - X_a.
 
         Returns per edge over `guard_dofs` the force on the body F (m, 2 dpn), its derivative
-        K = dF/du (m, 2 dpn, 2 dpn), and the rate K_x velocity (m, 2 dpn) of a surface moving
-        with velocity (2,) (the force depends on x_m - offset(lam))."""
+        K = dF/du (m, 2 dpn, 2 dpn), the rate K_x velocity (m, 2 dpn) of a surface moving
+        with velocity (2,) (the force depends on x_m - offset(lam)), and the force on each
+        mid-point (m, 2)."""
         e = self.edges
         dpn = u.shape[1]
         un = u[self.nodes]
@@ -325,31 +390,32 @@ class ContactPair:
             mid += (un[e[:, 0], 2] - un[e[:, 1], 2])[:, None] * self.guard_arm
             P[:, :, 0, 2], P[:, :, 1, 2] = self.guard_arm, -self.guard_arm
         P = P.reshape(len(e), 2, 2 * dpn)
-        mid_prev = 0.5 * (self.x_prev[e[:, 0]] + self.x_prev[e[:, 1]])
+        mid_prev = 0.5 * (state.x_prev[e[:, 0]] + state.x_prev[e[:, 1]])
         proj = self.surface.local(mid, mid_prev, self.depth + self.guard_allowance.max(), self.search)
         fn, dfn = _normal_law(proj.g + self.guard_allowance, proj.active, self.guard_kn, self.smoothing)
         w = self.guard_weight
         force = (w * fn)[:, None] * proj.n  # on the mid-point (m, 2)
         Kx = ((w * dfn)[:, None, None] * outer(proj.n, proj.n)
               + (w * fn * proj.kappa)[:, None, None] * outer(proj.t, proj.t))
-        self.guard_force = force
         return (np.einsum("mdi,md->mi", P, force), np.einsum("mdi,mde,mej->mij", P, Kx, P),
-                np.einsum("mdi,mde,e->mi", P, Kx, velocity))
+                np.einsum("mdi,mde,e->mi", P, Kx, velocity), force)
 
-    def rate(self, velocity: np.ndarray) -> np.ndarray:
-        """d f / d lambda at fixed u of the last evaluation divided by -1, per slave node
+    def rate(self, trial: ContactTrial, velocity: np.ndarray) -> np.ndarray:
+        """d f / d lambda at fixed u of the evaluation `trial` divided by -1, per slave node
         (n, 2), for a surface moving with `velocity` (2,): the forces depend on the positions
         relative to the surface, x - offset(lambda)."""
-        out = self._K @ velocity
-        if self._rate is not None:
+        out = trial.K @ velocity
+        if trial.pole_rate is not None:
             q = np.arange(self.pole_edge.size)
-            np.add.at(out, self.edges[self.pole_edge][q, self.pole_corner], np.einsum("qlde,e->qd", self._rate, velocity))
+            np.add.at(out, self.edges[self.pole_edge][q, self.pole_corner],
+                      np.einsum("qlde,e->qd", trial.pole_rate, velocity))
         return out
 
-    def _traction(self, x: np.ndarray):
+    def _traction(self, x: np.ndarray, state: ContactState, predicting: bool):
         """The contact law per unit of w (pressure per unit gap kn0, kt0): traction t (n, 2),
-        dt/dx (n, 2, 2), status, at positions x relative to the surface."""
-        proj = self.surface.local(x, self.x_prev, self.depth, self.search)
+        dt/dx (n, 2, 2), status, the projection, x, and the slip state (friction: contact,
+        s0, z, limit; else None), at positions x relative to the surface."""
+        proj = self.surface.local(x, state.x_prev, self.depth, self.search)
         n = len(x)
         f = np.zeros((n, 2))
         K = np.zeros((n, 2, 2))  # d f / d x
@@ -357,19 +423,21 @@ class ContactPair:
         kn, kt = self.kn0, self.kt0
         d = self.smoothing
         g = proj.g
-        contact = proj.active & (g < 0.0) & ~self.stuck
+        stuck = state.stuck
+        contact = proj.active & (g < 0.0) & ~stuck
         # normal law (eqs. 40-41): f = fn n, fn = -kn g, rounded over -d < g < 0 so that a node
         # touching the surface (g = 0) feels no force and the force has a continuous slope
         fn, dfn = _normal_law(g, contact, kn, d)
         nv, tv = proj.n, proj.t
-        if self.predicting and self.mu == 0 and not self.sticky:
+        if predicting and self.mu == 0 and not self.sticky:
             # nodes resting on the surface (0 <= g < d) get the penalty in the tangent only
-            resting = proj.active & (g >= 0.0) & (g < d) & ~self.stuck
+            resting = proj.active & (g >= 0.0) & (g < d) & ~stuck
             K -= (resting * kn)[:, None, None] * outer(nv, nv)
         f += fn[:, None] * nv
         K += dfn[:, None, None] * outer(nv, nv)
         K += (fn * proj.kappa)[:, None, None] * outer(tv, tv)  # fn dn/dx
         status[contact] = 1
+        slip_state = None
         if self.mu > 0 and not self.sticky:
             # Coulomb friction (eqs. 42-45) with the stick/slip corner rounded:
             # ft = -mu fn tanh(z), z = kt (s - s0) / (mu fn).  For small slips it is the
@@ -377,8 +445,8 @@ class ContactPair:
             # The sharp law makes Newton cycle between stick and slip from one iteration to
             # the next; this one is smooth.  A node touching for the first time sticks where it
             # was at the last converged step.
-            fresh = contact & np.isnan(self.s_stick)
-            s0 = np.where(fresh, proj.s_prev, self.s_stick)
+            fresh = contact & np.isnan(state.s_stick)
+            s0 = np.where(fresh, proj.s_prev, state.s_stick)
             slip = np.where(contact, proj.s - s0, 0.0)
             limit = self.mu * fn  # eq. 42
             rub = contact & (limit > 0)
@@ -393,54 +461,46 @@ class ContactPair:
             K -= (ft * proj.kappa)[:, None, None] * outer(nv, tv)  # ft dt/dx
             sliding = rub & (np.abs(z) > 1.0)
             status[sliding] = 2
-            self._slip_state = (contact, s0, z, limit)
+            slip_state = (contact, s0, z, limit)
         if self.sticky:
-            tied = self.stuck
-            f[tied] -= kn[tied, None] * (x[tied] - self.stuck_point[tied])
+            tied = stuck
+            f[tied] -= kn[tied, None] * (x[tied] - state.stuck_point[tied])
             K[tied] -= kn[tied, None, None] * np.eye(2)
             status[tied] = 3
-        return f, K, status, proj, x
+        return f, K, status, proj, x, slip_state
 
-    def commit(self) -> None:
-        """Accept the state of the last evaluation (a converged step): positions for the
-        crossing test, stick points, newly stuck nodes, the time of first contact."""
-        x, proj, _, status, _, lam, _ = self.last
-        self.x_prev = x.copy()
+    def _next(self, state: ContactState, seen: ContactSeen, slip_state, lam: float) -> ContactState:
+        """The history after a step that ends at the evaluation `seen` from `state`: positions
+        for the crossing test, stick points, newly stuck nodes, the time of first contact."""
+        x, proj, status = seen.x, seen.proj, seen.status
+        s_stick, stuck, stuck_point = state.s_stick, state.stuck, state.stuck_point
         if self.mu > 0 and not self.sticky:
             # slip beyond z = Z_SATURATED is plastic: the stick point follows the node, so that
             # a reversal of the slip finds the opposite force after a slip of about
             # Z_SATURATED mu fn / kt, not after the whole slide (at 12, where the force is
             # saturated to 1e-10, reversing nodes had next to no tangential stiffness and a
             # frictional tube took twice the iterations and a cut)
-            contact, s0, z, limit = self._slip_state
+            contact, s0, z, limit = slip_state
             zc = np.clip(z, -Z_SATURATED, Z_SATURATED)
             s_new = np.where(z != zc, proj.s - zc * limit / np.maximum(self.kt0, 1e-300), s0)
-            self.s_stick = np.where(contact, s_new, np.nan)
+            s_stick = np.where(contact, s_new, np.nan)
         if self.sticky:
             new = (status == 1)
-            self.stuck_point[new] = x[new] - proj.g[new, None] * proj.n[new]
-            self.stuck |= new
-        self.first_contact[(status > 0) & np.isnan(self.first_contact)] = lam
+            stuck_point = stuck_point.copy()
+            stuck_point[new] = x[new] - proj.g[new, None] * proj.n[new]
+            stuck = stuck | new
+        first = np.where((status > 0) & np.isnan(state.first_contact), lam, state.first_contact)
+        return ContactState(self.nodes, x.copy(), s_stick, stuck, stuck_point, first, seen)
 
-    _history = ("x_prev", "s_stick", "stuck", "stuck_point", "first_contact")
-
-    def state(self) -> dict[str, np.ndarray]:
-        """Copies of the history variables updated at commit (restart)."""
-        return {k: getattr(self, k).copy() for k in self._history}
-
-    def restore(self, state: dict[str, np.ndarray]) -> None:
-        for k in self._history:
-            v = np.asarray(state[k])
-            if v.shape != getattr(self, k).shape:
-                raise ValueError(f"contact state '{k}' has shape {v.shape}, not {getattr(self, k).shape}")
-            setattr(self, k, v.astype(getattr(self, k).dtype, copy=True))
-
-    def report(self):
-        """Per node of the last evaluation: current (r, z) in the global frame, gap, contact
+    def report(self, state: ContactState) -> dict:
+        """Per node of the committed `state`'s evaluation: current (r, z) in the global frame, gap, contact
         pressure (normal force over the current ring area), status; and the totals (the
-        contact area is that of the reference configuration)."""
-        _, proj, f, status, a, _, traction = self.last
-        guard = self.guard_force if self.guarded else np.zeros((1, 2))
+        contact area is that of the reference configuration).  Nothing in contact before the
+        first step (or after a restart, until the next step)."""
+        if state.seen is None:
+            return self._untouched(state)
+        proj, f, status, a, traction, guard = (state.seen.proj, state.seen.f, state.seen.status, state.seen.a,
+                                               state.seen.traction, state.seen.guard_force)
         in_contact = status > 0
         gap = np.where(proj.active, proj.g, np.nan)
         return {
@@ -451,10 +511,18 @@ class ContactPair:
             "force": f,
             "area": self.area0,
             "current_area": a,
-            "first_contact": self.first_contact,
+            "first_contact": state.first_contact,
             "force_r": float(f[:, 0].sum() + guard[:, 0].sum()),
             "force_z": float(f[:, 1].sum() + guard[:, 1].sum()),
             "contact_area": float(self.area0[in_contact].sum()),
             "penetration": float(max(0.0, -np.nanmin(np.where(in_contact, gap, np.nan)))
                                  if (in_contact & proj.active).any() else 0.0),
         }
+
+    def _untouched(self, state: ContactState) -> dict:
+        """The report of a pair whose state holds no evaluation: no force, no contact."""
+        n = len(self.nodes)
+        return {"node": self.nodes, "pressure": np.zeros(n), "gap": np.full(n, np.nan), "status": np.zeros(n, np.int8),
+                "force": np.zeros((n, 2)), "area": self.area0, "current_area": self.area0,
+                "first_contact": state.first_contact, "force_r": 0.0, "force_z": 0.0, "contact_area": 0.0,
+                "penetration": 0.0}

@@ -95,8 +95,6 @@ class Cavity:
         if control != "pressure" and not self.V0 > 0:
             raise CavityError(f"the boundary encloses no volume on its gas side (V0 = {self.V0:.6g}): "
                               "volume and gas control need V0 > 0")
-        self.pressure_now = 0.0  # the last converged pressure and volume, for monitors
-        self.volume_now = self.V0
 
     @property
     def unknown(self) -> bool:

@@ -234,8 +234,9 @@ class ResultsWriter:
         self.summary.update(steps=self.steps, newton_iterations=self.newton_iterations,
                             load_factor=float(step.lam), monitors=values)
         if self.model.cavities:
-            self.summary["cavities"] = {c.name: {"pressure": float(c.pressure_now), "volume": float(c.volume_now),
-                                                 "initial_volume": float(c.V0)} for c in self.model.cavities}
+            self.summary["cavities"] = {c.name: {"pressure": float(held.pressure), "volume": float(held.volume),
+                                                 "initial_volume": float(c.V0)}
+                                        for c, held in zip(self.model.cavities, step.state.cavities)}
         if step.number % self.every == 0:
             self._write_fields(step)
         if self.thickness_every and step.number % self.thickness_every == 0:
@@ -256,8 +257,8 @@ class ResultsWriter:
         lines = ["pair,node,r,z,gap,pressure,status,first_contact"]  # header first (DESIGN 10.12)
         totals = []
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
-        for k, pair in enumerate(self.model.contacts):
-            rep = pair.report()
+        for k, (pair, held) in enumerate(zip(self.model.contacts, step.state.contacts)):
+            rep = pair.report(held)
             x = self.model.mesh.points[rep["node"]] + u[rep["node"]]
             for node, (r, z), g, p, st, t in zip(rep["node"], x, rep["gap"], rep["pressure"], rep["status"],
                                                   rep["first_contact"]):
@@ -274,13 +275,13 @@ class ResultsWriter:
         mesh = self.model.mesh
         self._last_written = step.number
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
-        self._thickness = thickness_table(mesh, u, self.model.contacts)
+        self._thickness = thickness_table(mesh, u, step.state.contacts)
         if self.vtu and self.model.contacts:
             write_atomic(self.out / "fields" / f"surfaces_{step.number:04d}.csv",
                          mould_outlines(self.model.contacts, float(step.lam)))
         if not (self.vtu or self.gid):
             return
-        data = point_fields(self.model, step.u)
+        data = point_fields(self.model, step.u, step.state)
         if self.gid:
             res = self.out / "axiform.post.res"
             with atomic(res) as tmp:
@@ -306,7 +307,7 @@ class ResultsWriter:
     def _write_thickness_step(self, step):
         """thickness/step_NNNN.csv: the thickness table of one step."""
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
-        table = thickness_table(self.model.mesh, u, self.model.contacts)
+        table = thickness_table(self.model.mesh, u, step.state.contacts)
         if table is not None:
             write_thickness_csv(self.out / "thickness" / f"step_{step.number:04d}.csv", table)
 
@@ -315,7 +316,7 @@ class ResultsWriter:
 
         mesh = self.model.mesh
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
-        data = point_fields(self.model, step.u)
+        data = point_fields(self.model, step.u, step.state)
         keep = {k: data[k] for k in ("displacement", "von_mises", "J")}
         with atomic(self.out / "revolved.vtu") as tmp:
             revolve(mesh.points + u, mesh.cells, self.revolved, keep).write(tmp, file_format="vtu")

@@ -21,6 +21,7 @@ from ..fem.graphs import connected_components
 from ..fem.loads import FollowerPressure
 from ..fem.mixed import MixedAssembly
 from ..fem.mesh import Mesh
+from .state import CavityState, ModelState
 
 DOF_NAMES = {"ur": 0, "uz": 1, "rot": 2}
 SFR_EDGE_RULES = ("tie", "fix", "free")
@@ -48,6 +49,7 @@ class Evaluation:
     nf: int | None = None  # force equations first in r; the rest are cavity constraints
     constraint_error: float = 0.0  # max |C| of the cavity constraints, relative to V0 (or p V0)
     u_norm: float = 0.0  # ||u|| of the state (all dofs)
+    trial: ModelState | None = None  # the history the model would have if this state were accepted
 
     @property
     def force_norm(self) -> float:
@@ -252,28 +254,20 @@ class Model:
         it = iter(u_f[self.dofmap.nf:])
         return [float(next(it)) if c.unknown else c.target(t)[0] for c in self.cavities]
 
-    def state(self) -> dict:
-        """The history variables (contact and cavity state) after the last commit (restart)."""
-        return {"contacts": [pair.state() for pair in self.contacts],
-                "cavities": [{"pressure": c.pressure_now, "volume": c.volume_now} for c in self.cavities]}
+    def initial_state(self) -> ModelState:
+        """The history before the first step (t = 0): contact pairs untouched, cavities at
+        their initial volume and no gauge pressure."""
+        return ModelState(0.0, tuple(pair.initial_state() for pair in self.contacts),
+                          tuple(CavityState(0.0, c.V0) for c in self.cavities))
 
-    def restore(self, state: dict) -> None:
-        """Put back the history variables of `state` (Model.state)."""
-        if len(state["contacts"]) != len(self.contacts) or len(state["cavities"]) != len(self.cavities):
+    def restore(self, saved: dict) -> ModelState:
+        """The state saved by ModelState.to_dict (a checkpoint), checked against this model."""
+        if len(saved["contacts"]) != len(self.contacts) or len(saved["cavities"]) != len(self.cavities):
             raise ValueError("the saved state has other contact pairs or cavities than this model")
-        for pair, s in zip(self.contacts, state["contacts"]):
-            pair.restore(s)
-        for cav, s in zip(self.cavities, state["cavities"]):
-            cav.pressure_now, cav.volume_now = float(s["pressure"]), float(s["volume"])
-
-    def commit(self) -> None:
-        """A step converged at the last evaluated state: update the history variables
-        (contact stick points, sticky nodes, positions for the crossing test, the cavities'
-        pressure and volume)."""
-        for pair in self.contacts:
-            pair.commit()
-        for cav in self.cavities:
-            cav.pressure_now, cav.volume_now = cav.last
+        start = self.initial_state()
+        return ModelState(float(saved.get("t", 0.0)),
+                          tuple(s.from_dict(d) for s, d in zip(start.contacts, saved["contacts"])),
+                          tuple(CavityState(float(d["pressure"]), float(d["volume"])) for d in saved["cavities"]))
 
     # ---- evaluation ------------------------------------------------------------------------
     def expand(self, u_f: np.ndarray, t: float) -> np.ndarray:
@@ -301,9 +295,15 @@ class Model:
                 data = self.pattern.accumulate(pos, ft * Ke, data)
         return f, df, data
 
-    def evaluate(self, u_f: np.ndarray, t: float, tangent: bool = True) -> Evaluation:
+    def evaluate(self, u_f: np.ndarray, t: float, state: ModelState | None = None, tangent: bool = True,
+                 predicting: bool = False) -> Evaluation:
         """Residual R = f_int - f_ext(t) - f_contact - sum p g (cavities) on the free
-        equations, then the cavity constraints; dR/dt; the (bordered) tangent."""
+        equations, then the cavity constraints; dR/dt; the (bordered) tangent; from the
+        committed history `state` (default: the initial state), whose trial successor the
+        Evaluation carries (`trial`).  Nothing is kept in the model.  predicting: the tangent
+        of a step's first iteration (ContactPair.evaluate)."""
+        if state is None:
+            state = self.initial_state()
         dm = self.dofmap
         nf = dm.nf
         presc, dpresc = self.prescribed(t)
@@ -317,30 +317,15 @@ class Model:
         f_ext, df_ext, dfext = self.external_load(u, t, tangent)
         r_full = f_int - f_ext
         dr_full = -df_ext  # dR/dt at fixed u
-        # contact: R -= f_c, K -= df_c/dx; a moving surface adds dR/dt = (df_c/dx) velocity
-        contact_data, guard_data = [], []
-        u2 = u.reshape(-1, self.dpn)[:, :2]
-        for pair, dofs in zip(self.contacts, self._contact_dofs):
-            fc, Kc, _ = pair.evaluate(u2, t)
-            np.add.at(r_full, dofs.ravel(), -fc.ravel())
-            velocity = pair.surface.velocity(t)
-            if velocity.any():
-                np.add.at(dr_full, dofs.ravel(), pair.rate(velocity).ravel())
-            contact_data.append(-Kc)
-            if pair.guarded:  # the mid-points of straight edges (ContactPair.guard)
-                fg, Kg, rate = pair.guard(u.reshape(-1, self.dpn), t, velocity)
-                np.add.at(r_full, self._guard_dofs[len(guard_data)].ravel(), -fg.ravel())
-                if velocity.any():
-                    np.add.at(dr_full, self._guard_dofs[len(guard_data)].ravel(), rate.ravel())
-                guard_data.append(-Kg)
+        contact_data, guard_data, contact_trials = self._contact(u, t, state, predicting, r_full, dr_full)
         # cavities: R -= p g, K -= p dg/du; under volume/gas control p is an unknown
         p_cav = self.cavity_pressures(u_f, t)
-        g_eq, cav_data, constraints = [], [], []
+        g_eq, cav_data, constraints, cav_trials = [], [], [], []
         for k, (cav, p) in enumerate(zip(self.cavities, p_cav)):
             V, ge, He = cav.evaluate(u, tangent)
             g = np.bincount(cav.dofs.ravel(), weights=ge.ravel(), minlength=self.n_full)
             r_full -= p * g
-            cav.last = (p, V)
+            cav_trials.append(CavityState(p, V))
             if cav.unknown:
                 goal, rate = cav.target(t)
                 if cav.control == "volume":  # C = V - V(t)
@@ -366,8 +351,8 @@ class Model:
                 data = self.pattern.accumulate(pos, Kg, data)
             for pos, Hc in zip(self._cavity_pos, cav_data):
                 data = self.pattern.accumulate(pos, Hc, data)
-            for pos, pair in zip(self._contact_edge_pos, self.contacts):
-                data = self.pattern.accumulate(pos, -pair.coupling, data)  # through the current areas
+            for pos, trial in zip(self._contact_edge_pos, contact_trials):
+                data = self.pattern.accumulate(pos, -trial.coupling, data)  # through the current areas
             K = self.pattern.free_block(data)
             if dm.np and dpresc.any():
                 dr_dt = dr_dt + self.pattern.fp_product(data, dpresc)
@@ -389,5 +374,34 @@ class Model:
         else:
             constraint_error = 0.0
         scale = float(np.linalg.norm(f_abs) + np.linalg.norm(f_ext))
+        trial = ModelState(float(t), tuple(c.state for c in contact_trials), tuple(cav_trials))
         return Evaluation(r, dr_dt, K, r_full, f_ext, scale, self._noise_floor, nf, constraint_error,
-                          float(np.linalg.norm(u)))
+                          float(np.linalg.norm(u)), trial)
+
+    def _contact(self, u: np.ndarray, t: float, state: ModelState, predicting: bool, r_full: np.ndarray,
+                 dr_full: np.ndarray):
+        """The contact pairs at the full displacements u (n_full,) and time t from `state`:
+        R -= f_c (in r_full, in place), and a moving surface adds dR/dt = (df_c/dx) velocity
+        (in dr_full); returns the tangent blocks of the nodes and of the edge guards, and the
+        pairs' trials (ContactTrial)."""
+        contact_data, guard_data, trials = [], [], []
+        u_nodes = u.reshape(-1, self.dpn)
+        u2 = u_nodes[:, :2]
+        guards = iter(self._guard_dofs)
+        for pair, dofs, history in zip(self.contacts, self._contact_dofs, state.contacts):
+            velocity = pair.surface.velocity(t)
+            guard_force = None
+            if pair.guarded:  # the mid-points of straight edges (ContactPair.guard)
+                fg, Kg, rate, guard_force = pair.guard(u_nodes, t, velocity, history)
+                gdofs = next(guards).ravel()
+                np.add.at(r_full, gdofs, -fg.ravel())
+                if velocity.any():
+                    np.add.at(dr_full, gdofs, rate.ravel())
+                guard_data.append(-Kg)
+            trial = pair.evaluate(u2, t, history, predicting, guard_force)
+            np.add.at(r_full, dofs.ravel(), -trial.f.ravel())
+            if velocity.any():
+                np.add.at(dr_full, dofs.ravel(), pair.rate(trial, velocity).ravel())
+            contact_data.append(-trial.K)
+            trials.append(trial)
+        return contact_data, guard_data, trials

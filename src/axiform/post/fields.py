@@ -17,8 +17,9 @@ from ..materials import cauchy_stress
 from .thickness import contact_times, nodal_thickness, pieces, thickness_table
 
 
-def point_fields(model, u_full: np.ndarray) -> dict[str, np.ndarray]:
-    """Nodal fields (n,) or (n, k) of the state u_full (all dofs): displacement (ur, uz, 0),
+def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]:
+    """Nodal fields (n,) or (n, k) of the state u_full (all dofs) with the committed history
+    `state` (model.state.ModelState; None: the initial one): displacement (ur, uz, 0),
     J, cauchy_stress (rr, zz, tt, rz), von_mises, principal_stretches (in-plane major, minor,
     hoop); fibre_rotation (SFR); thickness (meshes with fibres); contact_pressure and
     first_contact (the time a slave node first touched, -1 where never) with contact, and
@@ -62,16 +63,16 @@ def point_fields(model, u_full: np.ndarray) -> dict[str, np.ndarray]:
     if table is not None:
         out["thickness"] = nodal_thickness(mesh, table)
     if model.contacts:
+        history = (state or model.initial_state()).contacts
         pressure = np.zeros(mesh.n_nodes)
-        for pair in model.contacts:
-            if pair.last is not None:
-                rep = pair.report()
-                pressure[rep["node"]] += rep["pressure"]
+        for pair, held in zip(model.contacts, history):
+            rep = pair.report(held)
+            pressure[rep["node"]] += rep["pressure"]
         out["contact_pressure"] = pressure
-        when = contact_times(mesh, model.contacts)
+        when = contact_times(mesh, history)
         if when is not None:
             out["first_contact"] = np.nan_to_num(when, nan=-1.0)
-        for k, pair in pieces(model.contacts):
+        for k, pair in pieces(history):
             out[f"first_contact_{k}"] = np.nan_to_num(contact_times(mesh, [pair]), nan=-1.0)
     return out
 

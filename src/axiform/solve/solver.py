@@ -19,6 +19,7 @@ from ..model.guards import evaluation_fault
 from .linsolve import SingularTangentError, factorize, factorize_signed
 from ..materials import InvertedElementError
 from ..model.model import Evaluation, Model
+from ..model.state import ModelState
 
 
 @dataclass
@@ -101,6 +102,7 @@ class Step:
     u: np.ndarray
     r_full: np.ndarray  # the residual, reactions at the supports (full vector)
     checkpoint: dict | None = None  # the whole state after this step, to resume from (restart)
+    state: ModelState | None = None  # the committed history after this step (contact, cavities)
 
 
 @dataclass
@@ -165,7 +167,7 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
     first = 1
     if resume is not None:
         path.restore(resume["path"])
-        model.restore(resume["model"])
+        path.history = model.restore(resume["model"])
         size = float(resume["size"])
         first = int(resume["step"]) + 1
         result.newton_iterations = int(resume["newton_iterations"])
@@ -186,16 +188,17 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
                 break
             continue
         path.accept(u_new, lam_new, trial)
-        model.commit()
+        path.history = ev.trial  # the state of the accepted u, and only it
         result.newton_iterations += its
         if its <= opts.easy_iterations:
             size *= opts.growth
         size = min(size, path.nominal, key=abs)  # the nominal step may change (arc length)
         result.n_steps += 1
         number = first + result.n_steps - 1
-        checkpoint = {"path": path.state(), "model": model.state(), "size": size, "step": number,
+        checkpoint = {"path": path.state(), "model": path.history.to_dict(), "size": size, "step": number,
                       "newton_iterations": result.newton_iterations}
-        step = Step(number, lam_new, its, res, u_new, model.expand(u_new, lam_new), ev.r_full, checkpoint)
+        step = Step(number, lam_new, its, res, u_new, model.expand(u_new, lam_new), ev.r_full, checkpoint,
+                    path.history)
         del ev  # the tangent goes now, not at the next step
         result.steps.append(step)
         if keep is not None and len(result.steps) > keep:
@@ -221,6 +224,7 @@ class _Path:
         self.floor = _force_floor(model)
         self.u_f = np.zeros(model.n_free)
         self.lam = 0.0
+        self.history = model.initial_state()  # the committed state of the last converged step
 
     def clip(self, size: float) -> float:
         return size
@@ -262,9 +266,9 @@ class _Path:
         the last converged state (1 at the start, 0 at a limit point of the load); None when
         nothing responds to the load at the start."""
         try:
-            ev0 = _evaluate(self.model, np.zeros_like(self.u_f), 0.0)
+            ev0 = _evaluate(self.model, self.model.initial_state(), np.zeros_like(self.u_f), 0.0)
             t0 = _factorize(ev0.K)(ev0.dr_dlam)
-            ev = _evaluate(self.model, self.u_f, self.lam)
+            ev = _evaluate(self.model, self.history, self.u_f, self.lam)
             t = _factorize(ev.K)(ev.dr_dlam)
         except StepFailed:
             return None
@@ -311,7 +315,7 @@ class _Load(_Path):
             # linear (a flat sheet under pressure stiffens as it stretches)
             du, dlam = self.previous
             guess = self.u_f + ((lam - self.lam) / dlam) * du
-        return _newton_load(self.model, self.u_f, lam, self.opts, self.floor, guess)
+        return _newton_load(self.model, self.history, self.u_f, lam, self.opts, self.floor, guess)
 
     def accept(self, u_f, lam, size):
         self.previous = (u_f - self.u_f, lam - self.lam)
@@ -353,7 +357,7 @@ class _Displacement(_Path):
             du, dlam, dprev = self.previous
             ratio = (goal - self.reached) / dprev
             guess = (self.u_f + ratio * du, self.lam + ratio * dlam)
-        return _newton_displacement(self.model, self.u_f, self.lam, self.c, goal, self.opts, self.floor, guess)
+        return _newton_displacement(self.model, self.history, self.u_f, self.lam, self.c, goal, self.opts, self.floor, guess)
 
     def accept(self, u_f, lam, size):
         self.previous = (u_f - self.u_f, lam - self.lam, size)
@@ -398,7 +402,7 @@ class _ArcLength(_Path):
         if control.arc_length is not None:
             self.nominal = control.arc_length
         else:
-            ev = _evaluate(model, self.u_f, 0.0)
+            ev = _evaluate(model, self.history, self.u_f, 0.0)
             t = -_factorize(ev.K)(ev.dr_dlam)
             self.nominal = self.load_step * self._norm(t)
             if not self.nominal > 0:  # nothing responds to the load yet (a tool still in the air)
@@ -436,7 +440,7 @@ class _ArcLength(_Path):
             # no measure of the load: a load step instead, of the size load control takes
             dlam = np.copysign(self.load_step, lam_new - self.lam)
             guess = self.u_f + dlam / (lam_new - self.lam) * (u_new - self.u_f)
-            u_new, lam_new, its, res, ev = _newton_load(self.model, self.u_f, self.lam + dlam, self.opts, self.floor, guess)
+            u_new, lam_new, its, res, ev = _newton_load(self.model, self.history, self.u_f, self.lam + dlam, self.opts, self.floor, guess)
         if not self.loaded and self.previous is not None and np.dot(self.weight * (u_new - self.u_f), self.previous) < 0:
             raise StepFailed("the path turned back")
         if not self.loaded and self.branch_check and abs(lam_new - self.lam) <= self.load_step:
@@ -447,11 +451,11 @@ class _ArcLength(_Path):
                              "run backwards")
         c = self.control
         if self._crossed(self.lam, lam_new, c.target):
-            out = _newton_load(self.model, self.u_f, c.target, self.opts, self.floor)
+            out = _newton_load(self.model, self.history, self.u_f, c.target, self.opts, self.floor)
             self._landed = True
             return out
         if self.stop is not None and self._crossed(self.u_f[self.stop], u_new[self.stop], c.stop_value):
-            out = _newton_displacement(self.model, self.u_f, self.lam, self.stop, c.stop_value, self.opts, self.floor)
+            out = _newton_displacement(self.model, self.history, self.u_f, self.lam, self.stop, c.stop_value, self.opts, self.floor)
             self._landed = True
             return out
         self._landed = False
@@ -483,7 +487,7 @@ class _ArcLength(_Path):
         dlam = self.load_step * dl / self.nominal if self.nominal > 0 else self.load_step
         lam = self.lam + np.sign(target) * dlam if dlam < ahead[near] * (1 - 1e-9) else stops[near]
         self.loaded = True
-        return _newton_load(self.model, self.u_f, lam, self.opts, self.floor)
+        return _newton_load(self.model, self.history, self.u_f, lam, self.opts, self.floor)
 
     def _check_on_path(self, du, predictor):
         """Fail a converged step whose increment du leaves the direction of its predictor (the
@@ -535,7 +539,7 @@ class _ArcLength(_Path):
         model, opts, W = self.model, self.opts, self.weight
         at, t, start = self._tangent
         if at is not self.u_f:
-            ev = _evaluate(model, self.u_f, self.lam)
+            ev = _evaluate(model, self.history, self.u_f, self.lam)
             t = -_factorize(ev.K)(ev.dr_dlam)  # du/dlambda along the tangent
             start = ev.force_norm
         if not self._norm(t) > 0:
@@ -550,7 +554,7 @@ class _ArcLength(_Path):
         residuals = [start]
         for it in range(1, opts.max_iterations + 1):
             lam = self.lam + dlam
-            ev = _evaluate(model, self.u_f + du, lam)
+            ev = _evaluate(model, self.history, self.u_f + du, lam)
             if _check(ev, lam, opts, self.floor, residuals):
                 self._check_on_path(du, predictor)
                 return self.u_f + du, lam, it, residuals, ev
@@ -592,11 +596,11 @@ def _check(ev: Evaluation, lam: float, opts: NewtonOptions, floor: float, residu
     return (norm <= opts.tolerance * ref or norm <= ev.noise) and ev.constraint_error <= opts.tolerance
 
 
-def _evaluate(model: Model, u_f, lam) -> Evaluation:
-    """model.evaluate, failing the step on an inverted element, a residual that is not finite
+def _evaluate(model: Model, history: ModelState, u_f, lam, predicting: bool = False) -> Evaluation:
+    """model.evaluate from the committed history, failing the step on an inverted element, a residual that is not finite
     or a tangent with a free rigid translation (guards.evaluation_fault)."""
     try:
-        ev = model.evaluate(u_f, lam)
+        ev = model.evaluate(u_f, lam, history, predicting=predicting)
     except InvertedElementError as exc:
         raise StepFailed(str(exc)) from exc
     fault = evaluation_fault(model, ev.r_full, ev.K)
@@ -622,50 +626,41 @@ def _factorize(K):
     return checked
 
 
-def _newton_load(model, u_f, lam, opts, floor, guess=None):
+def _newton_load(model, history, u_f, lam, opts, floor, guess=None):
     """Newton at fixed lambda from a predicted state `guess`, and if that fails (or the guess
     is not admissible) from the last converged state u_f."""
     if guess is not None:
         try:
-            return _newton_load_from(model, guess.copy(), lam, opts, floor)
+            return _newton_load_from(model, history, guess.copy(), lam, opts, floor)
         except StepFailed:
             pass
-    return _newton_load_from(model, u_f.copy(), lam, opts, floor)
+    return _newton_load_from(model, history, u_f.copy(), lam, opts, floor)
 
 
-def _predictor_evaluate(model, u_f, lam):
-    """The evaluation at the start of a load step: with contact, nodes resting on a surface
-    get the penalty in this tangent only (ContactPair.predicting), so that the first
-    correction does not drive them through it."""
-    for pair in model.contacts:
-        pair.predicting = True
-    try:
-        return _evaluate(model, u_f, lam)
-    finally:
-        for pair in model.contacts:
-            pair.predicting = False
-
-
-def _newton_load_from(model, u_f, lam, opts, floor):
+def _newton_load_from(model, history, u_f, lam, opts, floor):
     """Newton at fixed lambda from u_f.  With contact, a correction that raises the residual
     is shortened (halved up to three times): the active set and the stick/slip states change
     between iterations, and a full step can overshoot.  If no shortened step lowers the
     residual either, the full step is taken: creeping by eighths of Newton steps stalled
-    sticky and frictional steps for 15 iterations at a residual that did not fall."""
+    sticky and frictional steps for 15 iterations at a residual that did not fall.  The
+    evaluation at the start is `predicting` (ContactPair.evaluate): with contact, nodes
+    resting on a surface get the penalty in this tangent only, so that the first correction
+    does not drive them through it.  The Evaluation returned is that of the u returned:
+    its trial state is the one to commit."""
     residuals: list[float] = []
-    ev = _predictor_evaluate(model, u_f, lam)
+    ev = _evaluate(model, history, u_f, lam, predicting=True)
     for it in range(opts.max_iterations + 1):
         if _check(ev, lam, opts, floor, residuals):
             return u_f, lam, it, residuals, ev
         if it == opts.max_iterations:
             break
         du = -_factorize(ev.K)(ev.r)
-        trial = _evaluate(model, u_f + du, lam)
+        trial = _evaluate(model, history, u_f + du, lam)
         if model.contacts and trial.force_norm > ev.force_norm:
             full = (du, trial)
             for _ in range(3):
                 du = 0.5 * du
-                trial = _evaluate(model, u_f + du, lam)
+                trial = _evaluate(model, history, u_f + du, lam)
                 if trial.force_norm <= ev.force_norm:
                     break
             else:
@@ -674,22 +669,22 @@ def _newton_load_from(model, u_f, lam, opts, floor):
     raise StepFailed(f"no convergence in {opts.max_iterations} iterations")
 
 
-def _newton_displacement(model, u_f, lam, c, target, opts, floor, guess=None):
+def _newton_displacement(model, history, u_f, lam, c, target, opts, floor, guess=None):
     """Newton with u_f[c] driven to target and lambda unknown (bordered system):
     du = a + dlam b, K a = -R, K b = -dR/dlambda, dlam chosen so that u_c reaches target.
     Starts from a predicted (u, lambda) `guess`, and if that fails from the converged state."""
     if guess is not None:
         try:
-            return _newton_displacement_from(model, guess[0].copy(), guess[1], c, target, opts, floor)
+            return _newton_displacement_from(model, history, guess[0].copy(), guess[1], c, target, opts, floor)
         except StepFailed:
             pass
-    return _newton_displacement_from(model, u_f.copy(), lam, c, target, opts, floor)
+    return _newton_displacement_from(model, history, u_f.copy(), lam, c, target, opts, floor)
 
 
-def _newton_displacement_from(model, u_f, lam, c, target, opts, floor):
+def _newton_displacement_from(model, history, u_f, lam, c, target, opts, floor):
     residuals: list[float] = []
     for it in range(opts.max_iterations + 1):
-        ev = _evaluate(model, u_f, lam)
+        ev = _evaluate(model, history, u_f, lam)
         if it > 0 and _check(ev, lam, opts, floor, residuals):
             return u_f, lam, it, residuals, ev
         if it == 0:

@@ -1,0 +1,37 @@
+"""The state of a model between steps: the history of every term that has one, as of one
+converged step (contact pairs, cavities; later the materials' quadrature points).
+
+States are immutable values: a term's `evaluate(u, t, state)` returns the trial state it
+would have if its evaluation were accepted; the solver holds the committed state and
+commits the trial of the accepted evaluation only, so an evaluation made after a run, or
+by a failed attempt, changes nothing that is written or reported.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..contact.pair import ContactState
+
+
+@dataclass(frozen=True)
+class CavityState:
+    """A cavity's gauge pressure and volume at one state."""
+
+    pressure: float
+    volume: float
+
+
+@dataclass(frozen=True)
+class ModelState:
+    """The committed (or trial) history of a model at process time t: one ContactState per
+    contact pair, one CavityState per cavity, in the model's order."""
+
+    t: float
+    contacts: tuple[ContactState, ...] = ()
+    cavities: tuple[CavityState, ...] = ()
+
+    def to_dict(self) -> dict:
+        """Plain arrays and numbers (a checkpoint)."""
+        return {"t": float(self.t), "contacts": [c.to_dict() for c in self.contacts],
+                "cavities": [{"pressure": c.pressure, "volume": c.volume} for c in self.cavities]}
