@@ -3,10 +3,12 @@ pre-run warnings of a built case (case.preflight), and the picture of `check --p
 
 import re
 import tomllib
+from pathlib import Path
 
 import pytest
 
-from axiform.case.schema import CaseError, parse
+from axiform.case.preflight import curves_past_target, inverting_loads, mould_checks, preflight
+from axiform.case.schema import CaseError, build, parse, read
 
 
 PLATE = """
@@ -70,3 +72,90 @@ surface = { profile = { start = [0.0, 1.0], pieces = [{ lin = { to = [8.0, 1.0] 
 slaves = { z = 0.5 }
 """
     assert 'contact[0].surface.profile.pieces[0].lin: unknown key; did you mean "line"?' in refused(text)
+
+
+# ---- pre-run warnings ---------------------------------------------------------------------------
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def built(path: Path, overrides=(), drop=()):
+    data = read(path, list(overrides))
+    for table, key in drop:
+        del data[table][key]
+    return build(parse(data), path.parent)
+
+
+@pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.toml")), ids=lambda p: p.name)
+def test_the_examples_give_no_warning(path):
+    assert preflight(built(path)) == []
+
+
+def test_a_curve_beyond_the_target_warns():
+    cup = EXAMPLES / "cup_thermoforming.toml"
+    warnings = preflight(built(cup, drop=[("solver", "target")]))
+    # the vacuum rises from t = 1 to 2; the plug's motion is constant after t = 1: not cut short
+    assert len(warnings) == 1
+    assert warnings[0].startswith("pressure[0].curve: the curve runs to t = 2, but the run ends at [solver] "
+                                  "target (default 1) = 1")
+    assert "contact[0]" not in warnings[0]
+    assert curves_past_target(built(cup, ["solver.target=1.5"]))[0].startswith("pressure[0].curve:")
+
+
+def test_no_curve_check_under_displacement_control():
+    plate = EXAMPLES / "toric_plate.toml"
+    assert curves_past_target(built(plate, ["pressure[0].curve=[[0.0, 0.0], [10.0, 1.0]]"])) == []
+
+
+@pytest.mark.parametrize("path, index", [
+    ("die_drawing.toml", 0), ("die_drawing.toml", 1), ("cup_thermoforming.toml", 0), ("cup_thermoforming.toml", 1),
+    ("parison_bottle.toml", 0), ("stretch_blow_moulding.toml", 1), ("bottle_blow_moulding.toml", 0),
+])
+def test_a_mould_walked_the_wrong_way_warns(path, index):
+    warnings = preflight(built(EXAMPLES / path, [f"contact[{index}].surface.reverse=true"]))
+    assert len(warnings) == 1, warnings
+    assert re.match(rf'contact\[{index}\]( \("\w+"\))?\.surface: faces away from its slaves: .*try reverse = false$',
+                    warnings[0]), warnings[0]
+
+
+def test_a_circle_on_the_wrong_side_warns():
+    warnings = preflight(built(EXAMPLES / "toric_plate.toml", ["contact[0].surface.circle.inside=true"]))
+    assert len(warnings) == 1
+    assert warnings[0].startswith("contact[0].surface: faces away from its slaves: 41 of the 41 ")
+    assert warnings[0].endswith("try inside = false")
+
+
+def test_slaves_inside_a_mould_at_the_start_warn():
+    torus = EXAMPLES / "toric_plate.toml"
+    warnings = mould_checks(built(torus, ["contact[0].surface.circle.center=[4.5, 1.8]"]))
+    assert warnings == ["contact[0].slaves: 7 slave node(s) lie inside the mould at t = 0, up to 0.2 deep "
+                        "(at r, z = 4.5, 0.5)"]
+    # touching (the circle's lowest point on the top face, g = 0): no warning
+    assert mould_checks(built(torus, ["contact[0].surface.circle.center=[4.5, 2.0]"])) == []
+
+
+@pytest.mark.parametrize("path, override, message", [
+    ("cup_thermoforming.toml", "pressure[0].value=90000.0", "pressure[0].value: 90000 MPa would invert elements"),
+    ("balloon.toml", "pressure[0].value=1.0e5", "pressure[0].value: 100000 MPa would invert elements"),
+    ("plate_arc_length.toml", "pressure[0].value=6895.0", "pressure[0].value: 6895 psi would invert elements"),
+    ("parison_bottle.toml", "fix[1].value=3000.0", "fix[1].value: 3000 mm would invert elements"),
+])
+def test_a_load_in_other_units_warns(path, override, message):
+    warnings = inverting_loads(built(EXAMPLES / path, [override]))
+    assert len(warnings) == 1 and warnings[0].startswith(message), warnings
+    assert warnings[0].endswith("is it in the units of the rest of the case?")
+
+
+def test_a_point_load_in_newtons_for_meganewtons_warns():
+    text = (EXAMPLES / "balloon.toml").read_text() + """
+[[point_load]]
+at = { r = 1.005, z = 0.0 }
+dof = "ur"
+value = {value}
+"""
+    for value, warns in (("2.0e-3", False), ("2.0e3", True)):
+        path = EXAMPLES / "balloon.toml"
+        data = tomllib.loads(text.replace("{value}", value))
+        warnings = inverting_loads(build(parse(data), path.parent))
+        assert bool(warnings) == warns, (value, warnings)
+        if warns:
+            assert warnings[0].startswith("point_load[0].value: 2000 MN would invert elements")
