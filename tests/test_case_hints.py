@@ -5,8 +5,10 @@ import re
 import tomllib
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+from axiform.post.check_plot import check_figure, plot_check
 from axiform.case.preflight import curves_past_target, inverting_loads, mould_checks, preflight
 from axiform.case.schema import CaseError, build, parse, read
 
@@ -159,3 +161,54 @@ value = {value}
         assert bool(warnings) == warns, (value, warnings)
         if warns:
             assert warnings[0].startswith("point_load[0].value: 2000 MN would invert elements")
+
+
+# ---- check --plot -------------------------------------------------------------------------------
+def legend_of(fig) -> list[str]:
+    return [t.get_text() for t in fig.legends[0].get_texts()]
+
+
+def test_the_check_picture_of_the_die_shows_supports_moulds_and_monitors(tmp_path):
+    from matplotlib.collections import LineCollection
+
+    b = built(EXAMPLES / "die_drawing.toml")
+    path = plot_check(b, tmp_path / "check.png")
+    assert path == tmp_path / "check.png"
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    fig = check_figure(b)
+    labels = legend_of(fig)
+    assert labels[0] == "mesh: 80 q4 cells, 123 nodes"
+    for label in ("ur held", "uz held", "contact[0] punch, ticks towards its body", "contact[0] punch at t = 1",
+                  "contact[1] die, ticks towards its body", "monitor punch_travel (uz)", "monitor rim_draw_in (ur)"):
+        assert label in labels, labels
+    ax = fig.axes[0]
+    # the moulds' normal ticks point to the body's side: the die's top face (z = 0, r > 4.5) upwards
+    ticks = [c for c in ax.collections if isinstance(c, LineCollection)]
+    assert len(ticks) == 2
+    die = np.array([s for s in ticks[1].get_segments() if s[0, 1] == 0.0 and s[0, 0] > 4.6])
+    assert len(die) > 3 and np.all(die[:, 1, 1] > 0) and np.allclose(die[:, 1, 0], die[:, 0, 0])
+    held = {line.get_label(): len(line.get_xdata()) for line in ax.lines}
+    assert held["ur held"] == 3 and held["uz held"] == 9  # the axis; the blank holder's box
+
+
+@pytest.mark.parametrize("name, expected", [
+    ("cup_thermoforming.toml", ["pressure[0] = 0.0900 MPa × f(t)", "ur and uz held", "contact[1] mould, ticks towards "
+                                "its body", "contact[0] plug at t = 2"]),
+    ("toric_plate.toml", ["pressure[0] = 1.00 psi × λ", "ur and uz held (and the fibre rotation)"]),
+    ("balloon.toml", ["pressure[0] = 1.00 MPa × λ", "monitor u_equator (ur)"]),
+    ("bottle_blow_moulding.toml", ['cavity "bottle" (gas control)', "contact[0] mould, ticks towards its body"]),
+    ("hughes_carnoy_plate.toml", ["reaction monitor rim_force_z (uz)"]),
+])
+def test_the_check_picture_names_what_the_case_sets_up(tmp_path, name, expected):
+    b = built(EXAMPLES / name)
+    labels = legend_of(check_figure(b))
+    for label in expected:
+        assert label in labels, labels
+    assert plot_check(b, tmp_path / "check.png").stat().st_size > 10_000
+
+
+def test_pressure_arrows_point_where_the_pressure_pushes():
+    fig = check_figure(built(EXAMPLES / "toric_plate.toml"))  # on the lower face, upwards into the plate
+    (quiver,) = [c for c in fig.axes[0].collections if type(c).__name__ == "Quiver"]
+    assert len(quiver.U) >= 10 and np.all(quiver.V > 0) and np.allclose(quiver.U, 0.0)
+    assert np.allclose(quiver.Y + quiver.V, 0.0)  # the heads on the face
