@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from axiform.post.check_plot import check_figure, plot_check
 from axiform.case.preflight import curves_past_target, inverting_loads, mould_checks, preflight
 from axiform.case.schema import CaseError, build, parse, read
+from axiform.post.check_plot import check_figure, plot_check
 
 
 PLATE = """
@@ -145,6 +145,13 @@ def test_a_load_in_other_units_warns(path, override, message):
     warnings = inverting_loads(built(EXAMPLES / path, [override]))
     assert len(warnings) == 1 and warnings[0].startswith(message), warnings
     assert warnings[0].endswith("is it in the units of the rest of the case?")
+
+
+def test_a_driven_displacement_in_other_units_warns():
+    cylinder = EXAMPLES / "thick_cylinder.toml"  # 0.5 mm over a wall of 1 mm, 10 steps
+    assert inverting_loads(built(cylinder)) == []
+    (warning,) = inverting_loads(built(cylinder, ["solver.target=500.0"]))  # in micrometres
+    assert warning.startswith("solver.target: 500 mm in 10 steps would invert elements within one step")
 
 
 def test_a_point_load_in_newtons_for_meganewtons_warns():

@@ -11,8 +11,8 @@ fault.
 - a load that inverts elements within one nominal step, in one linear solve of the reference
   tangent (no contact) for the largest increment its curve makes over one nominal step
   (INVERTING_FRACTION of it): a value typed in other units (a pressure in Pa in an mm / MPa
-  case).  Not under displacement control (the load factor is an unknown there), nor for
-  cavities under volume or gas control.
+  case); under displacement control (the load factor an unknown), the driven dof's step
+  target / steps instead.  Not for cavities under volume or gas control.
 
 `preflight(built)` runs them all; nothing here writes or prints.
 """
@@ -26,6 +26,7 @@ import numpy as np
 from ..contact.surfaces import Circle
 from ..fem.curves import Curve
 from ..fem.elements import gradient_operator
+from ..fem.selectors import select_nodes
 from ..solve.linsolve import SingularTangentError, factorize
 from ..solve.solver import DisplacementControl
 from .schema import Built
@@ -168,21 +169,60 @@ def _gradients(model, u_full: np.ndarray) -> tuple[float, float]:
     return float(np.abs(g).max()), float(det.min())
 
 
-def inverting_loads(built: Built) -> list[str]:
-    """Loads that invert elements within one nominal step, by a linear estimate."""
-    if isinstance(built.control, DisplacementControl):
-        return []  # the load factor is an unknown: a load's size does not set the step
-    t_end, steps = float(built.control.target), int(built.control.steps)
-    model = built.model
-    case = built.case
+def _reference_tangent(model):
+    """The contact-free copy of the model, its evaluation at rest (u = 0, t = 0) and the
+    factorization of its tangent; None where there is none (held by its moulds alone)."""
     try:
         body = _contact_free(model)
         ev = body.evaluate(np.zeros(body.n_free), 0.0)
         if not np.all(np.isfinite(ev.K.data)):
-            return []
-        solve = factorize(ev.K)
+            return None
+        return body, ev, factorize(ev.K)
     except (SingularTangentError, ValueError, np.linalg.LinAlgError):
+        return None
+
+
+def _inverts(body, du: np.ndarray, presc: np.ndarray) -> tuple[bool, float]:
+    """Whether INVERTING_FRACTION of the step (du on the unknowns, presc on the prescribed
+    equations) inverts an element, and the step's largest displacement gradient."""
+    dm = body.dofmap
+    if not (np.all(np.isfinite(du)) and np.all(np.isfinite(presc))):
+        return False, 0.0
+    h, det = _gradients(body, INVERTING_FRACTION * dm.expand(du[: dm.nf], presc))
+    return det <= 0.0, h / INVERTING_FRACTION
+
+
+def _driven_step(built: Built, reference) -> list[str]:
+    """Displacement control: whether the driven dof's step target / steps inverts elements,
+    the loads in proportion along the reference tangent."""
+    body, ev, solve = reference
+    control = built.control
+    dm = body.dofmap
+    eq = int(dm.eq[control.dof])
+    v = solve(-ev.dr_dlam)  # the response to a unit load factor
+    if eq >= dm.nf or not np.isfinite(v[eq]) or abs(v[eq]) <= 1e-300:
+        return []
+    lam = control.target / control.steps / v[eq]
+    bad, h = _inverts(body, lam * v, lam * body.prescribed(0.0)[1])
+    if not bad:
+        return []
+    unit = built.case.units.length
+    return [f"solver.target: {control.target:g}{' ' + unit if unit else ''} in {control.steps} steps would invert "
+            f"elements within one step (a linear estimate at the reference state: displacement gradients up to "
+            f"{h:.2g}): is it in the units of the rest of the case?"]
+
+
+def inverting_loads(built: Built) -> list[str]:
+    """Loads that invert elements within one nominal step, by a linear estimate (under
+    displacement control: the driven dof's step)."""
+    reference = _reference_tangent(built.model)
+    if reference is None:
         return []  # held by its moulds alone: no reference tangent without them
+    if isinstance(built.control, DisplacementControl):
+        return _driven_step(built, reference)
+    body, ev, solve = reference
+    t_end, steps = float(built.control.target), int(built.control.steps)
+    case = built.case
     dm = body.dofmap
     nf, n_eq = dm.nf, body.n_free
     zero = np.zeros(body.n_full)
@@ -219,26 +259,20 @@ def inverting_loads(built: Built) -> list[str]:
     for where, value, unit, f_full, u_p in loads:
         b = np.zeros(n_eq)
         b[:nf] = dm.gather(f_full)[:nf]
-        du = solve(b)
-        if not np.all(np.isfinite(du)):
-            continue
         presc = np.zeros(dm.np)
         if u_p is not None:
             presc[dm.eq[np.flatnonzero(u_p)] - nf] = u_p[np.flatnonzero(u_p)]
-        u_full = dm.expand(du[:nf], presc)
-        h, det = _gradients(body, INVERTING_FRACTION * u_full)
-        if det <= 0.0:
+        bad, h = _inverts(body, solve(b), presc)
+        if bad:
             given = f"{value:g}" + (f" {unit}" if unit else "")
             out.append(f"{where}: {given} would invert elements within one nominal step (a linear estimate at the "
-                       f"reference state: displacement gradients up to {h / INVERTING_FRACTION:.2g} in one step of "
+                       f"reference state: displacement gradients up to {h:.2g} in one step of "
                        f"{t_end / steps:g}): is it in the units of the rest of the case?")
     return out
 
 
 def _point_load_vector(model, case, i: int) -> np.ndarray:
     """The full force vector of [[point_load]] i at its full value."""
-    from ..fem.selectors import select_nodes
-
     spec = case.point_load[i]
     nodes = select_nodes(model.mesh, spec.at.model_dump(), f"point_load[{i}].at")
     f = np.zeros(model.n_full)
@@ -248,8 +282,6 @@ def _point_load_vector(model, case, i: int) -> np.ndarray:
 
 def _fix_dofs(model, case, i: int) -> np.ndarray:
     """The full dofs [[fix]] i prescribes."""
-    from ..fem.selectors import select_nodes
-
     spec = case.fix[i]
     nodes = select_nodes(model.mesh, spec.at.model_dump(), f"fix[{i}].at")
     names = [n for n in spec.dofs if not (n == "rot" and model.dpn == 2)]
