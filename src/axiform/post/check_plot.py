@@ -137,7 +137,7 @@ def check_figure(built):
             for s in moulds]
     travels = [s.offset(t_end) - s.offset(0.0) for s in moulds]
     lo, hi = _frame(X, [(p, d) for p, d in zip(outlines, travels)]
-                    + [(e, -d) for e, d in zip(ends, travels) if e is not None])
+                    + [(e, d) for e, d in zip(ends, travels) if e is not None])
     size = float((hi - lo).max())
     w, h = hi - lo
     scale = min(7.0 / w, 6.0 / h)
@@ -239,5 +239,5 @@ def check_figure(built):
 def plot_check(built, path: str | Path) -> Path:
     """Write check.png (or `path`): the set-up of a built case (see the module docstring)."""
     path = Path(path)
-    check_figure(built).savefig(path, dpi=130)
+    check_figure(built).savefig(path, dpi=130, bbox_inches="tight", pad_inches=0.1)
     return path
