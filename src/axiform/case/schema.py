@@ -39,6 +39,7 @@ from .material import MaterialSpec
 from .mesh import ArcPiece, LinePiece, MeshSpec, PieceSpec, build_mesh
 from .monitor import HISTORY_COLUMNS, Monitor, MonitorSpec, build_monitors
 from .output import OutputSpec, RestartSpec, Unit, UnitsSpec
+from .suggest import did_you_mean
 from .solver import DofRef, SolverSpec, StopSpec, build_control
 from ..model.guards import boundary_crossing, free_to_slide, not_numbers
 from ..fem.mesh import MeshError
@@ -106,7 +107,7 @@ def parse(data: dict[str, Any]) -> Case:
             msg = err["msg"].removeprefix("Value error, ")
             if err["type"] == "extra_forbidden":
                 msg = "unknown key"
-            lines.append(f"{_loc(err['loc'])}: {msg}")
+            lines.append(f"{_loc(err['loc'])}: {msg}{did_you_mean(Case, err)}")
         raise CaseError("\n".join(dict.fromkeys(lines))) from None
 
 

@@ -1,0 +1,309 @@
+"""Pre-run warnings of a built case (DESIGN § 13): what is valid but probably not what was
+meant, found without solving.  Each warning is one line that begins with the table and key at
+fault.
+
+- a load curve (fix, pressure, point load, mould motion, cavity) that still changes after
+  [solver] target: the run ends at target, the rest of the process is cut off;
+- slave nodes inside a mould at t = 0 (deeper than the contact smoothing);
+- a mould that faces away from its slaves (a polyline walked the wrong way, a circle with the
+  wrong `inside`): the surface's normal at the slaves' projections points the way the body's
+  own outward normal does, not against it;
+- a load that inverts elements within one nominal step, in one linear solve of the reference
+  tangent (no contact) for the largest increment its curve makes over one nominal step
+  (INVERTING_FRACTION of it): a value typed in other units (a pressure in Pa in an mm / MPa
+  case); under displacement control (the load factor an unknown), the driven dof's step
+  target / steps instead.  Not for cavities under volume or gas control.
+
+`preflight(built)` runs them all; nothing here writes or prints.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ..contact.surfaces import Circle
+from ..fem.curves import Curve
+from ..fem.elements import gradient_operator
+from ..fem.selectors import select_nodes
+from ..solve.linsolve import SingularTangentError, factorize
+from ..solve.solver import DisplacementControl
+from .schema import Built
+
+# a load is flagged where this fraction of its largest step would already invert elements in
+# the linear estimate: a margin for thin walls, whose linear bending overestimates the first
+# step many times over (the cup's vacuum: gradients up to 9 in a linear step that the membrane
+# carries), while a value in other units is off by 1e3 to 1e6
+INVERTING_FRACTION = 0.1
+# a mould faces away from its slaves where more than this fraction of the slave nodes that
+# project onto it lie behind it with its normal pointing the way their body's outward normal does
+WRONG_FACE_FRACTION = 0.5
+
+
+def preflight(built: Built) -> list[str]:
+    """Every pre-run warning of a built case (one line each), in the order of the checks.  A
+    check that fails on an unforeseen case gives no warning rather than stopping the run it
+    only advises (each check alone raises: the tests call them one by one)."""
+    out = []
+    for check in (curves_past_target, mould_checks, inverting_loads):
+        try:
+            out += check(built)
+        except Exception:  # noqa: BLE001 - advice only: never in the way of a valid case
+            continue
+    return out
+
+
+# ---- (a) curves that run past the end of the run -------------------------------------------------
+def _curves(built: Built):
+    """(key path, knots) of every curve the case gives."""
+    case = built.case
+    for name in ("fix", "pressure", "point_load", "cavity"):
+        for i, item in enumerate(getattr(case, name)):
+            if item.curve is not None:
+                yield f"{name}[{i}].curve", item.curve
+    for i, c in enumerate(case.contact):
+        if c.motion.curve is not None:
+            yield f"contact[{i}].motion.curve", c.motion.curve
+
+
+def _end_time(built: Built) -> float | None:
+    """The process time the run ends at ([solver] target), None where it is not known before
+    the run (displacement control: the load factor is an unknown)."""
+    if isinstance(built.control, DisplacementControl):
+        return None
+    return float(built.control.target)
+
+
+def curves_past_target(built: Built) -> list[str]:
+    """Curves that still change after the run's end time: the process is cut short."""
+    end = _end_time(built)
+    if end is None:
+        return []
+    out = []
+    for where, knots in _curves(built):
+        curve = Curve(knots)
+        t_last = float(curve.t[-1])
+        tol = 1e-9 * max(1.0, abs(end))
+        if t_last <= end + tol:
+            continue
+        f_end = curve(end)
+        later = curve.f[curve.t > end + tol]
+        if np.all(np.abs(later - f_end) <= 1e-12 * max(1.0, np.abs(curve.f).max())):
+            continue  # constant after the end: nothing is cut off
+        target = "target" if built.case.solver.target is not None else "target (default 1)"
+        out.append(f"{where}: the curve runs to t = {t_last:g}, but the run ends at [solver] {target} = "
+                   f"{end:g}: the process is cut short there (set [solver] target = {t_last:g}?)")
+    return out
+
+
+# ---- (b), (c) moulds ----------------------------------------------------------------------------
+def _mould_name(built: Built, i: int) -> str:
+    pair = built.model.contacts[i]
+    return f"contact[{i}]" + (f' ("{pair.name}")' if getattr(pair, "name", None) else "")
+
+
+def body_normals(pair) -> np.ndarray:
+    """The body's outward unit normal at each slave node of a contact pair (n, 2): the mean
+    of the outward normals of its slave edges (they run counter-clockwise around the body,
+    so the outward normal is the direction of travel turned by -90 degrees)."""
+    x = pair.X
+    e = pair.edges
+    t = x[e[:, 1]] - x[e[:, 0]]
+    n_edge = np.column_stack([t[:, 1], -t[:, 0]])
+    n_edge /= np.linalg.norm(n_edge, axis=1)[:, None]
+    out = np.zeros_like(x)
+    for k in range(e.shape[1]):
+        np.add.at(out, e[:, k], n_edge)
+    return out / np.maximum(np.linalg.norm(out, axis=1), 1e-300)[:, None]
+
+
+def mould_checks(built: Built) -> list[str]:
+    """Moulds that face away from their slaves, and slave nodes inside a mould at t = 0."""
+    model = built.model
+    span = float(np.ptp(model.mesh.points, axis=0).max())
+    out = []
+    for i, pair in enumerate(model.contacts):
+        spec = built.case.contact[i]
+        x = pair.X - pair.surface.offset(0.0)  # the surface's own frame at t = 0
+        # every projection, however deep: a mould walked the wrong way has its slaves behind it
+        proj = pair.surface.local(x, x, depth=10.0 * span + 1.0, method=pair.search)
+        on = proj.active & (proj.kind == 1)
+        if not on.any():
+            continue
+        alike = np.einsum("ij,ij->i", proj.n, body_normals(pair)) > 0.0
+        wrong = alike & (proj.g < pair.smoothing)  # behind it, and facing the way it faces
+        where = _mould_name(built, i)
+        if wrong[on].mean() > WRONG_FACE_FRACTION:
+            if isinstance(pair.surface, Circle):
+                fix = f"inside = {str(not spec.surface.circle.inside).lower()}"
+            else:
+                fix = f"reverse = {str(not spec.surface.reverse).lower()}"
+            out.append(f"{where}.surface: faces away from its slaves: {int(wrong[on].sum())} of the {int(on.sum())} "
+                       "slave nodes that project onto it lie behind it, its normal pointing the way the body's "
+                       f"outward normal does (walked the wrong way, or contact on the wrong face?): try {fix}")
+            continue
+        inside = proj.active & ~alike & (proj.g < -pair.smoothing)
+        if inside.any():
+            k = int(np.argmin(np.where(inside, proj.g, np.inf)))
+            r, z = pair.X[k]
+            out.append(f"{where}.slaves: {int(inside.sum())} slave node(s) lie inside the mould at t = 0, up to "
+                       f"{-proj.g[k]:.3g} deep (at r, z = {r:.6g}, {z:.6g})")
+    return out
+
+
+# ---- (d) loads that invert the first steps -------------------------------------------------------
+def _step_increment(curve, t_end: float, steps: int) -> float:
+    """The largest change of f over one nominal step t_end / steps of [0, t_end]."""
+    t = np.linspace(0.0, t_end, steps + 1)
+    f = np.array([curve(s) for s in t])
+    return float(np.abs(np.diff(f)).max())
+
+
+def _contact_free(model):
+    """The model without its contact pairs (the reference tangent of the body and its loads)."""
+    copy = dataclasses.replace(model, contacts=[])
+    return copy.finalize()
+
+
+def _gradients(model, u_full: np.ndarray) -> tuple[float, float]:
+    """The largest displacement gradient |H| and the smallest det(I + H) (the hoop stretch
+    1 + u_r / R included) over the Gauss points of the mesh, for displacements u_full."""
+    mesh = model.mesh
+    G, _ = gradient_operator(mesh.element, mesh.points[mesh.cells])
+    ue = u_full[model.solid.dofs]
+    g = np.einsum("eqcn,en->eqc", G, ue)  # du_r/dR, du_r/dZ, du_z/dR, du_z/dZ, u_r/R
+    det = ((1 + g[..., 0]) * (1 + g[..., 3]) - g[..., 1] * g[..., 2]) * (1 + g[..., 4])
+    return float(np.abs(g).max()), float(det.min())
+
+
+def _reference_tangent(model):
+    """The contact-free copy of the model, its evaluation at rest (u = 0, t = 0) and the
+    factorization of its tangent; None where there is none (held by its moulds alone)."""
+    try:
+        body = _contact_free(model)
+        ev = body.evaluate(np.zeros(body.n_free), 0.0)
+        if not np.all(np.isfinite(ev.K.data)):
+            return None
+        return body, ev, factorize(ev.K)
+    except (SingularTangentError, ValueError, np.linalg.LinAlgError):
+        return None
+
+
+def _inverts(body, du: np.ndarray, presc: np.ndarray) -> tuple[bool, float]:
+    """Whether INVERTING_FRACTION of the step (du on the unknowns, presc on the prescribed
+    equations) inverts an element, and the step's largest displacement gradient."""
+    dm = body.dofmap
+    if not (np.all(np.isfinite(du)) and np.all(np.isfinite(presc))):
+        return False, 0.0
+    h, det = _gradients(body, INVERTING_FRACTION * dm.expand(du[: dm.nf], presc))
+    return det <= 0.0, h / INVERTING_FRACTION
+
+
+def _driven_step(built: Built, reference) -> list[str]:
+    """Displacement control: whether the driven dof's step target / steps inverts elements,
+    the loads in proportion along the reference tangent."""
+    body, ev, solve = reference
+    control = built.control
+    dm = body.dofmap
+    eq = int(dm.eq[control.dof])
+    v = solve(-ev.dr_dlam)  # the response to a unit load factor
+    if eq >= dm.nf or not np.isfinite(v[eq]) or abs(v[eq]) <= 1e-300:
+        return []
+    lam = control.target / control.steps / v[eq]
+    bad, h = _inverts(body, lam * v, lam * body.prescribed(0.0)[1])
+    if not bad:
+        return []
+    unit = built.case.units.length
+    return [f"solver.target: {control.target:g}{' ' + unit if unit else ''} in {control.steps} steps would invert "
+            f"elements within one step (a linear estimate at the reference state: displacement gradients up to "
+            f"{h:.2g}): is it in the units of the rest of the case?"]
+
+
+def inverting_loads(built: Built) -> list[str]:
+    """Loads that invert elements within one nominal step, by a linear estimate (under
+    displacement control: the driven dof's step)."""
+    reference = _reference_tangent(built.model)
+    if reference is None:
+        return []  # held by its moulds alone: no reference tangent without them
+    if isinstance(built.control, DisplacementControl):
+        return _driven_step(built, reference)
+    body, ev, solve = reference
+    t_end, steps = float(built.control.target), int(built.control.steps)
+    case = built.case
+    dm = body.dofmap
+    nf, n_eq = dm.nf, body.n_free
+    zero = np.zeros(body.n_full)
+    units = case.units
+    loads = []  # (key path, value, what, full load vector, full prescribed displacements)
+    for i, (spec, p) in enumerate(zip(case.pressure, body.pressures)):
+        step = spec.value * _step_increment(p.curve, t_end, steps)
+        if step:
+            fe, _ = p.evaluate(zero, tangent=False)
+            f = np.bincount(p.dofs.ravel(), fe.ravel(), body.n_full) / p.value * step
+            loads.append((f"pressure[{i}].value", spec.value, units.pressure, f, None))
+    for i, spec in enumerate(case.point_load):
+        step = spec.value * _step_increment(spec.build_curve(), t_end, steps)
+        if step:
+            f = _point_load_vector(body, case, i) * step / spec.value
+            loads.append((f"point_load[{i}].value", spec.value, units.force, f, None))
+    for i, (spec, cav) in enumerate(zip(case.cavity, body.cavities)):
+        if spec.control != "pressure":
+            continue
+        step = spec.pressure * _step_increment(cav.curve, t_end, steps)
+        if step:
+            _, ge, _ = cav.evaluate(zero, tangent=False)
+            f = np.bincount(cav.dofs.ravel(), ge.ravel(), body.n_full) * step
+            loads.append((f"cavity[{i}].pressure", spec.pressure, units.pressure, f, None))
+    for i, spec in enumerate(case.fix):
+        if not spec.value:
+            continue
+        step = spec.value * _step_increment(spec.build_curve(), t_end, steps)
+        if step:
+            u_p = np.zeros(body.n_full)
+            u_p[_fix_dofs(body, case, i)] = step
+            loads.append((f"fix[{i}].value", spec.value, units.length, -_internal_rate(body, u_p), u_p))
+    out = []
+    for where, value, unit, f_full, u_p in loads:
+        b = np.zeros(n_eq)
+        b[:nf] = dm.gather(f_full)[:nf]
+        presc = np.zeros(dm.np)
+        if u_p is not None:
+            presc[dm.eq[np.flatnonzero(u_p)] - nf] = u_p[np.flatnonzero(u_p)]
+        bad, h = _inverts(body, solve(b), presc)
+        if bad:
+            given = f"{value:g}" + (f" {unit}" if unit else "")
+            out.append(f"{where}: {given} would invert elements within one nominal step (a linear estimate at the "
+                       f"reference state: displacement gradients up to {h:.2g} in one step of "
+                       f"{t_end / steps:g}): is it in the units of the rest of the case?")
+    return out
+
+
+def _point_load_vector(model, case, i: int) -> np.ndarray:
+    """The full force vector of [[point_load]] i at its full value."""
+    spec = case.point_load[i]
+    nodes = select_nodes(model.mesh, spec.at.model_dump(), f"point_load[{i}].at")
+    f = np.zeros(model.n_full)
+    f[model.dof(nodes, spec.dof)] = spec.value
+    return f
+
+
+def _fix_dofs(model, case, i: int) -> np.ndarray:
+    """The full dofs [[fix]] i prescribes."""
+    spec = case.fix[i]
+    nodes = select_nodes(model.mesh, spec.at.model_dump(), f"fix[{i}].at")
+    names = [n for n in spec.dofs if not (n == "rot" and model.dpn == 2)]
+    return np.concatenate([model.dof(nodes, n) for n in names])
+
+
+def _internal_rate(model, u_p: np.ndarray) -> np.ndarray:
+    """K u_p (full vector): the internal forces of the displacements u_p at the reference
+    state, linearised (central differences of the solid's internal forces)."""
+    scale = float(np.abs(u_p).max())
+    eps = 1e-6 * model.mesh.size() / scale
+
+    def f_int(u):
+        fe, _ = model.solid.evaluate(u, False, model.solid.buffers(False))
+        return np.bincount(model.solid.dofs.ravel(), fe.ravel(), model.n_full)
+
+    return (f_int(eps * u_p) - f_int(-eps * u_p)) / (2 * eps)

@@ -1,0 +1,243 @@
+"""The picture of `axiform check CASE --plot` (check.png): what the case sets up, before any
+solve.  The undeformed mesh; the supports (a marker per held node: which dofs it holds, and
+the nodes whose displacement is prescribed to a value); the loaded faces with arrows of their
+pressure (pointing where it pushes); point loads; the moulds with short ticks on the side
+their body must be (their outward normal), and where a moving mould ends the run (dotted);
+the boundaries of the gas cavities; the monitored points; a legend naming each.
+
+Drawn from a built case (axiform.case.schema.Built) with matplotlib's Figure, not pyplot.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .labels import short, unit_of, with_unit
+
+# sizes as fractions of the drawing's size: pressure arrows and the least gap between two of
+# them, the normal ticks along a mould and their spacing
+ARROW, ARROW_GAP = 0.045, 0.035
+TICK, TICK_SPACING = 0.02, 0.03
+COLOURS = {"mesh": "0.55", "held": "tab:blue", "prescribed": "tab:purple", "pressure": "tab:orange",
+           "point": "tab:pink", "cavity": "tab:cyan", "monitor": "tab:green"}
+MOULD_COLOURS = ["tab:red", "tab:brown", "tab:olive", "tab:gray", "firebrick", "darkgoldenrod"]
+
+
+def _outline(mesh) -> np.ndarray:
+    """The cells' nodes in order round each cell (Q8: the mid-side nodes between the corners)."""
+    if mesh.cells.shape[1] == 8:
+        return mesh.cells[:, [0, 4, 1, 5, 2, 6, 3, 7]]
+    return mesh.cells[:, :4]
+
+
+def _is_thin(x: np.ndarray, cells: np.ndarray, extent: float) -> bool:
+    """True when the typical cell is thinner than about 2 pixels of the drawing (its area over
+    its longest side below 0.4 % of the drawing's size): its edges are then drawn wide."""
+    c = x[cells[:, :4]]
+    area = 0.5 * np.abs(np.einsum("ei,ei->e", c[..., 0], np.roll(c[..., 1], -1, axis=1))
+                        - np.einsum("ei,ei->e", c[..., 1], np.roll(c[..., 0], -1, axis=1)))
+    longest = np.linalg.norm(c - np.roll(c, -1, axis=1), axis=-1).max(axis=1)
+    return bool(np.median(area / longest) < 4e-3 * extent)
+
+
+def _end_time(built) -> float:
+    from ..solve.solver import DisplacementControl
+
+    control = built.control
+    return 1.0 if isinstance(control, DisplacementControl) else float(control.target)
+
+
+def _mould_points(surface) -> np.ndarray:
+    return surface.polyline()
+
+
+def _mould_normals(surface, spacing: float) -> tuple[np.ndarray, np.ndarray]:
+    """Points every `spacing` along a mould's outline and its unit normal there (towards the
+    side the body must be on)."""
+    from ..contact.surfaces import Circle
+
+    pts = _mould_points(surface)
+    seg = np.diff(pts, axis=0)
+    length = np.linalg.norm(seg, axis=1)
+    s = np.concatenate([[0.0], np.cumsum(length)])
+    if s[-1] <= 0:
+        return np.zeros((0, 2)), np.zeros((0, 2))
+    count = max(2, int(s[-1] / spacing))
+    at = (np.arange(count) + 0.5) * s[-1] / count
+    k = np.clip(np.searchsorted(s, at, side="right") - 1, 0, len(seg) - 1)
+    frac = (at - s[k]) / np.where(length[k] > 0, length[k], 1.0)
+    p = pts[k] + frac[:, None] * seg[k]
+    if isinstance(surface, Circle):
+        e = p - np.asarray(surface.center, float)
+        n = e / np.linalg.norm(e, axis=1)[:, None] * (-1.0 if surface.inside else 1.0)
+    else:  # the body lies to the left of the direction of travel
+        t = seg[k] / np.where(length[k] > 0, length[k], 1.0)[:, None]
+        n = np.column_stack([-t[:, 1], t[:, 0]])
+    return p, n
+
+
+def _frame(body: np.ndarray, moulds: list[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
+    """The drawing's corners, with a margin: the body; each mould (points, travel over the run)
+    whole where it is at most twice the body's size, else its parts within 30 % of the body's
+    size of the box the body sweeps along the mould's travel (a punch at the end of its stroke)."""
+    lo, hi = body.min(axis=0), body.max(axis=0)
+    extent = float((hi - lo).max())
+    pad = 0.3 * extent
+    blo, bhi = lo.copy(), hi.copy()
+    for pts, travel in moulds:
+        if float(np.ptp(pts, axis=0).max()) <= 2.0 * extent:
+            near = pts
+        else:
+            slo, shi = np.minimum(blo, blo + travel) - pad, np.maximum(bhi, bhi + travel) + pad
+            near = pts[((pts > slo) & (pts < shi)).all(axis=1)]
+        if len(near):
+            lo, hi = np.minimum(lo, near.min(axis=0)), np.maximum(hi, near.max(axis=0))
+    margin = 0.08 * float((hi - lo).max())
+    return lo - margin, hi + margin
+
+
+def _spaced(points: np.ndarray, gap: float) -> np.ndarray:
+    """Indices of points at least `gap` apart (greedy, in order)."""
+    kept: list[int] = []
+    for i, p in enumerate(points):
+        if not kept or np.min(np.linalg.norm(points[kept] - p, axis=1)) >= gap:
+            kept.append(i)
+    return np.array(kept, dtype=int)
+
+
+def _face(X: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """The edges (m, k) as polylines through their nodes (Q8: end, middle, end), (m, k, 2)."""
+    return X[edges[:, [0, 2, 1]] if edges.shape[1] == 3 else edges]
+
+
+def _times(curve) -> str:
+    return " × f(t)" if curve is not None else " × λ"
+
+
+def _value(v: float, quantity: str, units: dict[str, str]) -> str:
+    unit = unit_of(quantity, units)
+    return f"{short(v)} {unit}".strip()
+
+
+def check_figure(built):
+    """The Figure of plot_check (see the module docstring)."""
+    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.figure import Figure
+
+    case, model = built.case, built.model
+    mesh = model.mesh
+    X = mesh.points
+    units = {k: v for k, v in case.units.model_dump().items() if v}
+    t_end = _end_time(built)
+    moulds = [pair.surface for pair in model.contacts]
+    outlines = [_mould_points(s) + s.offset(0.0) for s in moulds]
+    ends = [(_mould_points(s) + s.offset(t_end)) if np.any(s.offset(t_end) != s.offset(0.0)) else None
+            for s in moulds]
+    travels = [s.offset(t_end) - s.offset(0.0) for s in moulds]
+    lo, hi = _frame(X, [(p, d) for p, d in zip(outlines, travels)]
+                    + [(e, d) for e, d in zip(ends, travels) if e is not None])
+    size = float((hi - lo).max())
+    w, h = hi - lo
+    scale = min(7.0 / w, 6.0 / h)
+    fig = Figure(figsize=(max(w * scale, 2.2) + 3.6, max(h * scale, 1.4) + 1.1))
+    ax = fig.add_subplot()
+
+    # the mesh
+    thin = _is_thin(X, mesh.cells, size)
+    ax.add_collection(PolyCollection(X[_outline(mesh)], facecolor="0.85" if thin else "0.93",
+                                     edgecolor="0.4" if thin else COLOURS["mesh"], lw=1.2 if thin else 0.3,
+                                     label=f"mesh: {mesh.n_cells} {mesh.element.name} cells, {mesh.n_nodes} nodes"))
+
+    # supports: which dofs each node holds; nodes prescribed to a non-zero value apart
+    held = np.zeros((mesh.n_nodes, 3), bool)
+    moved = np.zeros(mesh.n_nodes, bool)
+    for d, v in model.fixed.items():
+        node, k = divmod(d, model.dpn)
+        held[node, k] = True
+        moved[node] |= v != 0.0
+    kinds = [((True, False), ">", "ur held"), ((False, True), "^", "uz held"), ((True, True), "s", "ur and uz held")]
+    for (r, z), marker, label in kinds:
+        nodes = np.flatnonzero((held[:, 0] == r) & (held[:, 1] == z) & ~moved)
+        if nodes.size:
+            ax.plot(X[nodes, 0], X[nodes, 1], marker, ls="none", ms=4.5, mfc="none", mec=COLOURS["held"],
+                    label=label + (" (and the fibre rotation)" if held[nodes, 2].all() and model.dpn == 3 else ""))
+    nodes = np.flatnonzero(moved)
+    if nodes.size:
+        ax.plot(X[nodes, 0], X[nodes, 1], "D", ls="none", ms=4.5, mfc="none", mec=COLOURS["prescribed"],
+                label="displacement prescribed")
+
+    # pressures: the face, and arrows where they push (into the body for a positive value)
+    arrow = ARROW * size
+    for i, (spec, p) in enumerate(zip(case.pressure, model.pressures)):
+        a, b = X[p.nodes[:, 0]], X[p.nodes[:, 1]]
+        ax.add_collection(LineCollection(_face(X, p.nodes), colors=COLOURS["pressure"], lw=2.0))
+        mid = X[p.nodes[:, 2]] if p.nodes.shape[1] == 3 else 0.5 * (a + b)
+        t = b - a
+        out = np.column_stack([t[:, 1], -t[:, 0]]) / np.linalg.norm(t, axis=1)[:, None]
+        push = -np.sign(spec.value or 1.0) * out
+        k = _spaced(mid, ARROW_GAP * size)
+        tail = mid[k] - push[k] * arrow if spec.value >= 0 else mid[k]
+        ax.quiver(tail[:, 0], tail[:, 1], push[k, 0] * arrow, push[k, 1] * arrow, angles="xy", scale_units="xy",
+                  scale=1.0, color=COLOURS["pressure"], width=0.004, headwidth=4, headlength=5,
+                  label=f"pressure[{i}] = {_value(spec.value, 'pressure', units)}{_times(spec.curve)}")
+
+    # point loads
+    for i, spec in enumerate(case.point_load):
+        from ..fem.selectors import select_nodes
+
+        nodes = select_nodes(mesh, spec.at.model_dump(), f"point_load[{i}].at")
+        e = np.array([1.0, 0.0]) if spec.dof == "ur" else np.array([0.0, 1.0])
+        d = np.sign(spec.value) * e * arrow
+        ax.quiver(X[nodes, 0] - d[0], X[nodes, 1] - d[1], np.full(len(nodes), d[0]), np.full(len(nodes), d[1]),
+                  angles="xy", scale_units="xy", scale=1.0, color=COLOURS["point"], width=0.005,
+                  label=f"point_load[{i}] = {_value(spec.value, 'force', units)}{_times(spec.curve)} along {spec.dof}")
+
+    # gas cavities: their boundary
+    for i, (spec, cav) in enumerate(zip(case.cavity, model.cavities)):
+        ax.add_collection(LineCollection(_face(X, cav.nodes), colors=COLOURS["cavity"], lw=3.5, alpha=0.8,
+                                         label=f'cavity "{spec.name}" ({spec.control} control)'))
+
+    # moulds: outline, normal ticks on the body's side, the end of a moving mould's travel
+    for i, (pair, pts, end) in enumerate(zip(model.contacts, outlines, ends)):
+        colour = MOULD_COLOURS[i % len(MOULD_COLOURS)]
+        name = f"contact[{i}]" + (f" {pair.name}" if pair.name else "")
+        ax.plot(pts[:, 0], pts[:, 1], "-", color=colour, lw=1.8, label=f"{name}, ticks towards its body")
+        p, n = _mould_normals(pair.surface, TICK_SPACING * size)
+        p = p + pair.surface.offset(0.0)
+        ax.add_collection(LineCollection(np.stack([p, p + TICK * size * n], axis=1), colors=colour, lw=0.8))
+        if end is not None:
+            ax.plot(end[:, 0], end[:, 1], ":", color=colour, lw=1.2, label=f"{name} at t = {t_end:g}")
+
+    # monitored points (one node) and monitored reactions (their nodes)
+    for m in case.monitor:
+        if m.at is None and m.reaction is None:
+            continue
+        monitor = next(x for x in built.monitors if x.name == m.name)
+        nodes = np.unique(monitor.dofs // model.dpn)
+        marker = "*" if m.at is not None else "x"
+        what = "monitor" if m.at is not None else "reaction monitor"
+        ax.plot(X[nodes, 0], X[nodes, 1], marker, ls="none", ms=10 if marker == "*" else 6, color=COLOURS["monitor"],
+                label=f"{what} {m.name} ({m.dof})")
+        if m.at is not None:
+            ax.annotate(m.name, X[nodes[0]], xytext=(5, 5), textcoords="offset points", fontsize=7,
+                        color=COLOURS["monitor"])
+
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_aspect("equal")
+    ax.ticklabel_format(useOffset=False)
+    ax.set_xlabel(with_unit("r", "length", units))
+    ax.set_ylabel(with_unit("z", "length", units))
+    fig.suptitle(case.title or "case", fontsize=10, x=0.02, ha="left")
+    fig.set_layout_engine("constrained")
+    fig.legend(loc="outside right lower", fontsize=7, frameon=False)
+    return fig
+
+
+def plot_check(built, path: str | Path) -> Path:
+    """Write check.png (or `path`): the set-up of a built case (see the module docstring)."""
+    path = Path(path)
+    check_figure(built).savefig(path, dpi=130, bbox_inches="tight", pad_inches=0.1)
+    return path
