@@ -194,7 +194,8 @@ def measure_case(element: str, n_elements: int, min_time: float, unique_limit: i
         raise RuntimeError("solid_pieces no longer follows SolidAssembly.evaluate: update it")
     del fe1, Ke1
     pat, dm = model.pattern, model.dofmap
-    data = pat.accumulate(model._solid_pos, Ke)
+    solid_pos = pat.positions(s.dofs)
+    data = pat.accumulate(solid_pos, Ke)
     K, _ = pat.blocks(data)
     dofs = s.dofs.ravel()
 
@@ -210,7 +211,7 @@ def measure_case(element: str, n_elements: int, min_time: float, unique_limit: i
         "total": lambda: model.evaluate(u_f, lam),
         "solid": lambda: solid_pieces(s, u)[0],
         "expand": lambda: model.expand(u_f, lam),
-        "refill": lambda: pat.accumulate(model._solid_pos, Ke),
+        "refill": lambda: pat.accumulate(solid_pos, Ke),
         "blocks": lambda: pat.blocks(data),
         "forces": forces,
         "load": lambda: model.external_load(u),

@@ -97,7 +97,7 @@ def test_pressure_resultant_is_pressure_times_projected_area(element):
     model.pressure(select_edges(mesh, {"z": 0.5}), 1.0)
     model.finalize()
     u = full_vector(model, homogeneous(mesh.points, a=0.2, d=0.1))
-    f, _, _ = model.external_load(u, 1.0, tangent=False)
+    f, _ = model.external_load(u, 1.0)
     fz = f.reshape(-1, model.dpn)[:, 1].sum()
     assert fz == pytest.approx(-np.pi * (2.0 * 1.2) ** 2, rel=1e-12)
 

@@ -22,6 +22,7 @@ from ..fem.loads import FollowerPressure
 from ..fem.mixed import MixedAssembly
 from ..fem.mesh import Mesh
 from .state import CavityState, ModelState
+from .terms import CavityTerm, Constraint, ContactTerm, PointLoadTerm, PressureTerm, SolidTerm
 
 DOF_NAMES = {"ur": 0, "uz": 1, "rot": 2}
 SFR_EDGE_RULES = ("tie", "fix", "free")
@@ -193,26 +194,28 @@ class Model:
         return ties
 
     def finalize(self) -> "Model":
-        """Number the equations and build the sparse pattern (once)."""
+        """Number the equations, make the terms of the residual (model.terms) and build the
+        sparse pattern (once)."""
         fixed = dict(self.fixed)
         ties = self._sfr_constraints(fixed) if self.dpn == 3 else []
         self.dofmap = DofMap(self.n_full, fixed, ties)
+        n = self.n_full
         if self.formulation == "mixed":
             self.solid = MixedAssembly(self.mesh, self.material, self.pressure_space)
         else:
             self.solid = SolidAssembly(self.mesh, self.material)
+        by_curve: dict[Curve, np.ndarray] = {}  # point loads grouped by curve
+        for d, v, c in self.point_loads:
+            by_curve.setdefault(c, np.zeros(n))[d] += v
+        self.loads = ([SolidTerm(self.solid, n)] + [PressureTerm(p, n) for p in self.pressures]
+                      + ([PointLoadTerm(by_curve, n)] if by_curve else []))
+        self.contact_terms = [ContactTerm(pair, self.dpn, n) for pair in self.contacts]
+        self.cavity_terms = [CavityTerm(c, n) for c in self.cavities]
         self.pattern = SparsePattern(self.dofmap, [self.solid.dofs] + [p.dofs for p in self.pressures]
                                      + [c.dofs for c in self.cavities])
-        self._solid_pos = self.pattern.positions(self.solid.dofs)
-        self._buffers = [None, None]  # the solid's (fe, Ke) held between evaluations, without / with K
-        self._pressure_pos = [self.pattern.positions(p.dofs) for p in self.pressures]
-        self._cavity_pos = [self.pattern.positions(c.dofs) for c in self.cavities]
-        self._contact_dofs = [c.dofs(self.dpn) for c in self.contacts]
-        self._contact_pos = [self.pattern.positions(d) for d in self._contact_dofs]
-        # point loads grouped by curve: [(curve, full vector of the values)]
-        self._point = {}
-        for d, v, c in self.point_loads:
-            self._point.setdefault(c, np.zeros(self.n_full))[d] += v
+        terms = self.loads + self.contact_terms + self.cavity_terms
+        self._positions = {id(term): [self.pattern.positions(b) for b in term.blocks] for term in terms}
+        self._point_curves = list(by_curve)
         # prescribed equations grouped by curve: value_i f_c(t)
         dm = self.dofmap
         curve_of_eq = {int(dm.eq[d]) - dm.nf: self.fixed_curve.get(d, PROPORTIONAL) for d in fixed}
@@ -225,9 +228,6 @@ class Model:
         span = float(np.ptp(self.mesh.points, axis=0).max())
         mu = float(getattr(self.material, "shear_modulus", 1.0))
         self._noise_floor = 16 * np.finfo(float).eps * 2 * np.pi * mu * span**2 * np.sqrt(dm.nf)
-        self._contact_edge_pos = [self.pattern.positions(c.edge_dofs(self.dpn)) for c in self.contacts]
-        self._guard_dofs = [c.guard_dofs(self.dpn) for c in self.contacts if c.guarded]
-        self._guard_pos = [self.pattern.positions(d) for d in self._guard_dofs]
         return self
 
     @property
@@ -238,7 +238,7 @@ class Model:
 
     def knots(self) -> np.ndarray:
         """Every time at which some curve of the model changes its slope (sorted)."""
-        curves = ([p.curve for p in self.pressures] + list(self._point) + self._presc_curves
+        curves = ([p.curve for p in self.pressures] + self._point_curves + self._presc_curves
                   + [c.curve for c in self.cavities] + [getattr(c.surface, "curve", PROPORTIONAL) for c in self.contacts])
         return np.unique(np.concatenate([np.empty(0)] + [c.knots() for c in curves]))
 
@@ -274,134 +274,83 @@ class Model:
         """Full displacement vector (n_full,) from the unknowns and the time t."""
         return self.dofmap.expand(u_f, self.prescribed(t)[0])
 
-    def external_load(self, u_full: np.ndarray, t: float = 1.0, tangent: bool = True):
-        """The applied external load at time t (full vector), its rate d/dt, and, if asked,
-        the pattern data of its derivative d f_ext / du (follower pressures)."""
-        f = np.zeros(self.n_full)
-        df = np.zeros(self.n_full)
-        for c, v in self._point.items():
-            f += c(t) * v
-            df += c.slope(t) * v
-        data = None
-        for p, pos in zip(self.pressures, self._pressure_pos):
-            ft, dft = p.curve(t), p.curve.slope(t)
-            if ft == 0.0 and dft == 0.0:
-                continue
-            fe, Ke = p.evaluate(u_full, tangent)
-            fp = np.bincount(p.dofs.ravel(), weights=fe.ravel(), minlength=self.n_full)
-            f += ft * fp
-            df += dft * fp
-            if tangent:
-                data = self.pattern.accumulate(pos, ft * Ke, data)
-        return f, df, data
+    def external_load(self, u_full: np.ndarray, t: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+        """The applied external load at time t (pressures and point loads, full vector) and
+        its rate d/dt at fixed u."""
+        f, df = np.zeros(self.n_full), np.zeros(self.n_full)
+        for term in self.loads[1:]:
+            part = term.evaluate(u_full, t, tangent=False)
+            if part is not None:
+                f += part.load
+                df -= part.dr_dt
+        return f, df
 
     def evaluate(self, u_f: np.ndarray, t: float, state: ModelState | None = None, tangent: bool = True,
                  predicting: bool = False) -> Evaluation:
         """Residual R = f_int - f_ext(t) - f_contact - sum p g (cavities) on the free
-        equations, then the cavity constraints; dR/dt; the (bordered) tangent; from the
-        committed history `state` (default: the initial state), whose trial successor the
-        Evaluation carries (`trial`).  Nothing is kept in the model.  predicting: the tangent
-        of a step's first iteration (ContactPair.evaluate)."""
+        equations, then the cavity constraints; dR/dt; the (bordered) tangent: the sum of the
+        terms' contributions (model.terms) at u_f (n_free,) and time t, from the committed
+        history `state` (default: the initial state), whose trial successor the Evaluation
+        carries (`trial`).  Nothing is kept in the model.  predicting: the tangent of a
+        step's first iteration (ContactPair.evaluate)."""
         if state is None:
             state = self.initial_state()
         dm = self.dofmap
         nf = dm.nf
         presc, dpresc = self.prescribed(t)
         u = dm.expand(u_f, presc)
-        k = 1 if tangent else 0
-        if self._buffers[k] is None:
-            self._buffers[k] = self.solid.buffers(tangent)
-        fe, Ke = self.solid.evaluate(u, tangent, self._buffers[k])  # consumed below, refilled next call
-        f_int = np.bincount(self.solid.dofs.ravel(), weights=fe.ravel(), minlength=self.n_full)
-        f_abs = np.bincount(self.solid.dofs.ravel(), weights=np.abs(fe).ravel(), minlength=self.n_full)
-        f_ext, df_ext, dfext = self.external_load(u, t, tangent)
-        r_full = f_int - f_ext
-        dr_full = -df_ext  # dR/dt at fixed u
-        contact_data, guard_data, contact_trials = self._contact(u, t, state, predicting, r_full, dr_full)
-        # cavities: R -= p g, K -= p dg/du; under volume/gas control p is an unknown
-        p_cav = self.cavity_pressures(u_f, t)
-        g_eq, cav_data, constraints, cav_trials = [], [], [], []
-        for k, (cav, p) in enumerate(zip(self.cavities, p_cav)):
-            V, ge, He = cav.evaluate(u, tangent)
-            g = np.bincount(cav.dofs.ravel(), weights=ge.ravel(), minlength=self.n_full)
-            r_full -= p * g
-            cav_trials.append(CavityState(p, V))
-            if cav.unknown:
-                goal, rate = cav.target(t)
-                if cav.control == "volume":  # C = V - V(t)
-                    constraints.append((V - goal, -rate, 1.0, 0.0, cav.V0))
-                else:  # C = (p + ambient) V - content(t)
-                    constraints.append(((p + cav.ambient) * V - goal, -rate, p + cav.ambient, V,
-                                        cav.ambient * cav.V0))
-                g_eq.append(dm.gather(g))
-            else:
-                dr_full -= cav.target(t)[1] * g
-            if tangent:
-                cav_data.append(-p * He)
-        r_eq = dm.gather(r_full)
+        parts = [(term, term.evaluate(u, t, None, tangent)) for term in self.loads]
+        parts += [(term, term.evaluate(u, t, held, tangent, predicting))
+                  for term, held in zip(self.contact_terms, state.contacts)]
+        constraints = []
+        for term, held, p in zip(self.cavity_terms, state.cavities, self.cavity_pressures(u_f, t)):
+            part, constraint = term.evaluate(u, t, held, tangent, p)
+            parts.append((term, part))
+            if constraint is not None:
+                constraints.append(constraint)
+        parts = [(term, part) for term, part in parts if part is not None]
+        r_full = parts[0][1].r.copy()  # the solid's
+        dr_full = np.zeros(self.n_full)
+        f_ext = np.zeros(self.n_full)
+        for _, part in parts[1:]:
+            r_full += part.r
+            if part.dr_dt is not None:
+                dr_full += part.dr_dt
+            if part.load is not None:
+                f_ext += part.load
         dr_dt = dm.gather(dr_full)[:nf]
         K = None
         if tangent:
-            data = self.pattern.accumulate(self._solid_pos, Ke)
-            if dfext is not None:
-                data -= dfext
-            for pos, Kc in zip(self._contact_pos, contact_data):
-                data = self.pattern.accumulate(pos, Kc, data)
-            for pos, Kg in zip(self._guard_pos, guard_data):
-                data = self.pattern.accumulate(pos, Kg, data)
-            for pos, Hc in zip(self._cavity_pos, cav_data):
-                data = self.pattern.accumulate(pos, Hc, data)
-            for pos, trial in zip(self._contact_edge_pos, contact_trials):
-                data = self.pattern.accumulate(pos, -trial.coupling, data)  # through the current areas
+            data = None
+            for term, part in parts:
+                for pos, Ke in zip(self._positions[id(term)], part.K):
+                    data = self.pattern.accumulate(pos, Ke, data)
             K = self.pattern.free_block(data)
             if dm.np and dpresc.any():
                 dr_dt = dr_dt + self.pattern.fp_product(data, dpresc)
-        r = r_eq[:nf]
+        r = dm.gather(r_full)[:nf]
+        constraint_error = 0.0
         if constraints:
-            # bordered system [[K, -G], [dC/du, dC/dp]] for the unknown cavity pressures
-            G = np.column_stack([g[:nf] for g in g_eq])  # (nf, m)
-            C = np.array([c[0] for c in constraints])
-            dC_dt = np.array([c[1] for c in constraints])
-            # prescribed displacements move the wall: dC/dt += dC/du_p du_p/dt
-            dC_dt += np.array([c[2] * (g[nf:] @ dpresc) for c, g in zip(constraints, g_eq)])
-            Cu = np.array([c[2] for c in constraints])[:, None] * G.T
-            Cp = np.diag([c[3] for c in constraints])
-            r = np.concatenate([r, C])
-            dr_dt = np.concatenate([dr_dt, dC_dt])
-            if K is not None:
-                K = sp.bmat([[K, sp.csr_matrix(-G)], [sp.csr_matrix(Cu), sp.csr_matrix(Cp)]], format="csr")
-            constraint_error = float(np.max(np.abs(C) / np.array([c[4] for c in constraints])))
-        else:
-            constraint_error = 0.0
-        scale = float(np.linalg.norm(f_abs) + np.linalg.norm(f_ext))
-        trial = ModelState(float(t), tuple(c.state for c in contact_trials), tuple(cav_trials))
+            r, dr_dt, K = self._bordered(r, dr_dt, K, constraints, dpresc)
+            constraint_error = float(np.max([abs(c.value) / c.scale for c in constraints]))
+        scale = float(np.linalg.norm(parts[0][1].magnitude) + np.linalg.norm(f_ext))
+        trial = ModelState(float(t), tuple(part.trial for term, part in parts if isinstance(term, ContactTerm)),
+                           tuple(part.trial for term, part in parts if isinstance(term, CavityTerm)))
         return Evaluation(r, dr_dt, K, r_full, f_ext, scale, self._noise_floor, nf, constraint_error,
                           float(np.linalg.norm(u)), trial)
 
-    def _contact(self, u: np.ndarray, t: float, state: ModelState, predicting: bool, r_full: np.ndarray,
-                 dr_full: np.ndarray):
-        """The contact pairs at the full displacements u (n_full,) and time t from `state`:
-        R -= f_c (in r_full, in place), and a moving surface adds dR/dt = (df_c/dx) velocity
-        (in dr_full); returns the tangent blocks of the nodes and of the edge guards, and the
-        pairs' trials (ContactTrial)."""
-        contact_data, guard_data, trials = [], [], []
-        u_nodes = u.reshape(-1, self.dpn)
-        u2 = u_nodes[:, :2]
-        guards = iter(self._guard_dofs)
-        for pair, dofs, history in zip(self.contacts, self._contact_dofs, state.contacts):
-            velocity = pair.surface.velocity(t)
-            guard_force = None
-            if pair.guarded:  # the mid-points of straight edges (ContactPair.guard)
-                fg, Kg, rate, guard_force = pair.guard(u_nodes, t, velocity, history)
-                gdofs = next(guards).ravel()
-                np.add.at(r_full, gdofs, -fg.ravel())
-                if velocity.any():
-                    np.add.at(dr_full, gdofs, rate.ravel())
-                guard_data.append(-Kg)
-            trial = pair.evaluate(u2, t, history, predicting, guard_force)
-            np.add.at(r_full, dofs.ravel(), -trial.f.ravel())
-            if velocity.any():
-                np.add.at(dr_full, dofs.ravel(), pair.rate(trial, velocity).ravel())
-            contact_data.append(-trial.K)
-            trials.append(trial)
-        return contact_data, guard_data, trials
+    def _bordered(self, r: np.ndarray, dr_dt: np.ndarray, K: sp.csr_matrix | None, constraints: list[Constraint],
+                  dpresc: np.ndarray):
+        """The system bordered by the constraints of the cavities whose pressure is unknown:
+        [[K, -G], [dC/du, dC/dp]], r and dR/dt followed by C and dC/dt."""
+        nf = self.dofmap.nf
+        g_eq = [self.dofmap.gather(c.g) for c in constraints]
+        G = np.column_stack([g[:nf] for g in g_eq])  # (nf, m)
+        C = np.array([c.value for c in constraints])
+        # prescribed displacements move the wall: dC/dt += dC/du_p du_p/dt
+        dC_dt = np.array([c.rate + c.c_u * (g[nf:] @ dpresc) for c, g in zip(constraints, g_eq)])
+        if K is not None:
+            Cu = np.array([c.c_u for c in constraints])[:, None] * G.T
+            Cp = np.diag([c.c_p for c in constraints])
+            K = sp.bmat([[K, sp.csr_matrix(-G)], [sp.csr_matrix(Cu), sp.csr_matrix(Cp)]], format="csr")
+        return np.concatenate([r, C]), np.concatenate([dr_dt, dC_dt]), K

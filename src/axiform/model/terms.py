@@ -1,0 +1,190 @@
+"""The terms of the residual, each behind one call: `evaluate(u, t, state) -> Contribution`.
+
+R(u, t) = f_int(u) - f_ext(u, t) - f_contact(u, t) - sum p g(u) is the sum of its terms'
+contributions: the solid (displacement or mixed form), the follower pressures, the point
+loads, each contact pair, each gas cavity.  A term keeps nothing between calls: it is
+handed its committed history `state` (None where it has none) and returns, with its part of
+R, of dR/dt and of the tangent dR/du, the `trial` state it would have if this evaluation
+were accepted.  The model sums the contributions (model.Model.evaluate); the solver commits
+the trial states of the accepted evaluation only.
+
+Arrays: u (n_full,) all dofs of the mesh, node by node; each term's tangent comes as element
+matrices, one array per block of dofs it declares (`blocks`: (m, k) dof tables whose sparse
+positions the model computes once).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..contact.pair import ContactPair, ContactState
+from ..fem.cavity import Cavity
+from ..fem.curves import Curve
+from ..fem.loads import FollowerPressure
+from .state import CavityState
+
+
+@dataclass
+class Contribution:
+    """One term at one state: its part r (n_full,) of the residual R, of dR/dt at fixed u
+    (n_full,) or None, of the tangent dR/du as element matrices K (one (m, k, k) array per
+    block of the term, empty when not asked), the applied external load it holds (n_full,)
+    or None, the assembled magnitudes of its element forces (n_full,) or None (the scale
+    of the residual), and its trial state."""
+
+    r: np.ndarray
+    dr_dt: np.ndarray | None = None
+    K: tuple[np.ndarray, ...] = ()
+    load: np.ndarray | None = None
+    magnitude: np.ndarray | None = None
+    trial: object = None
+
+
+def assemble(dofs: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
+    """Element vectors values (m, k) summed into a full vector (n,) at dofs (m, k)."""
+    return np.bincount(dofs.ravel(), weights=values.ravel(), minlength=n)
+
+
+class SolidTerm:
+    """The body's internal forces f_int (eqs. 17-30) and material tangent, by the assembly
+    of its formulation (fem.assembly.SolidAssembly or fem.mixed.MixedAssembly).  Elastic
+    laws carry no history: its state is None.  The element arrays are written into scratch
+    buffers reused from call to call (work space, not state: nothing of one call is read by
+    the next)."""
+
+    def __init__(self, assembly, n_full: int):
+        self.assembly = assembly
+        self.n_full = n_full
+        self.blocks = (assembly.dofs,)
+        self._scratch: dict[bool, tuple] = {}
+
+    def evaluate(self, u: np.ndarray, t: float, state=None, tangent: bool = True) -> Contribution:
+        if tangent not in self._scratch:
+            self._scratch[tangent] = self.assembly.buffers(tangent)
+        fe, Ke = self.assembly.evaluate(u, tangent, self._scratch[tangent])
+        dofs = self.assembly.dofs
+        return Contribution(assemble(dofs, fe, self.n_full), K=(Ke,) if tangent else (),
+                            magnitude=assemble(dofs, np.abs(fe), self.n_full))
+
+
+class PressureTerm:
+    """A follower pressure value x f(t) on boundary edges (eq. 14): R -= f(t) f_p(u), with its
+    load stiffness; dR/dt = -f'(t) f_p(u)."""
+
+    def __init__(self, pressure: FollowerPressure, n_full: int):
+        self.pressure = pressure
+        self.n_full = n_full
+        self.blocks = (pressure.dofs,)
+
+    def evaluate(self, u: np.ndarray, t: float, state=None, tangent: bool = True) -> Contribution | None:
+        curve = self.pressure.curve
+        f, df = curve(t), curve.slope(t)
+        if f == 0.0 and df == 0.0:
+            return None
+        fe, Ke = self.pressure.evaluate(u, tangent)
+        fp = assemble(self.pressure.dofs, fe, self.n_full)
+        load = f * fp
+        return Contribution(-load, -df * fp, (-f * Ke,) if tangent else (), load)
+
+
+class PointLoadTerm:
+    """Forces value x f(t) at dofs (the total force on each revolved ring), grouped by
+    curve: {curve: full vector of the values}."""
+
+    blocks = ()
+
+    def __init__(self, by_curve: dict[Curve, np.ndarray], n_full: int):
+        self.by_curve = by_curve
+        self.n_full = n_full
+
+    def evaluate(self, u: np.ndarray, t: float, state=None, tangent: bool = True) -> Contribution:
+        load = np.zeros(self.n_full)
+        rate = np.zeros(self.n_full)
+        for curve, values in self.by_curve.items():
+            load += curve(t) * values
+            rate += curve.slope(t) * values
+        return Contribution(-load, -rate, load=load)
+
+
+class ContactTerm:
+    """A contact pair (contact.pair.ContactPair): R -= f_c at the slave nodes (and at the
+    nodes of the guarded edges), K -= df_c/du over three blocks (the slave nodes, the slave
+    edges through the current ring areas, the guarded edges); a moving surface adds
+    dR/dt = (df_c/dx) velocity.  Its state is the pair's ContactState."""
+
+    def __init__(self, pair: ContactPair, dpn: int, n_full: int):
+        self.pair = pair
+        self.dpn = dpn
+        self.n_full = n_full
+        self.node_dofs = pair.dofs(dpn)  # (n, 2)
+        self.guard_dofs = pair.guard_dofs(dpn) if pair.guarded else None  # (m, 2 dpn)
+        self.blocks = (self.node_dofs, pair.edge_dofs(dpn)) + ((self.guard_dofs,) if pair.guarded else ())
+
+    def evaluate(self, u: np.ndarray, t: float, state: ContactState, tangent: bool = True,
+                 predicting: bool = False) -> Contribution:
+        pair = self.pair
+        velocity = pair.surface.velocity(t)
+        moving = bool(velocity.any())
+        u_nodes = u.reshape(-1, self.dpn)
+        r = np.zeros(self.n_full)
+        dr = np.zeros(self.n_full) if moving else None
+        guard_force, guard_K = None, ()
+        if pair.guarded:  # the mid-points of straight edges (ContactPair.guard)
+            fg, Kg, rate, guard_force = pair.guard(u_nodes, t, velocity, state)
+            np.add.at(r, self.guard_dofs.ravel(), -fg.ravel())
+            if moving:
+                np.add.at(dr, self.guard_dofs.ravel(), rate.ravel())
+            guard_K = (-Kg,)
+        trial = pair.evaluate(u_nodes[:, :2], t, state, predicting, guard_force)
+        np.add.at(r, self.node_dofs.ravel(), -trial.f.ravel())
+        if moving:
+            np.add.at(dr, self.node_dofs.ravel(), pair.rate(trial, velocity).ravel())
+        K = (-trial.K, -trial.coupling) + guard_K if tangent else ()
+        return Contribution(r, dr, K, trial=trial.state)
+
+
+@dataclass
+class Constraint:
+    """The constraint row of a cavity whose pressure is an unknown: C(u, p, t) = 0 (volume
+    control: V - V(t); gas control: (p + ambient) V - content(t)), its rate dC/dt at fixed
+    u, the factor c_u of dC/du = c_u g, dC/dp, the scale C is measured against, and g = dV/du
+    (n_full,)."""
+
+    value: float
+    rate: float
+    c_u: float
+    c_p: float
+    scale: float
+    g: np.ndarray
+
+
+class CavityTerm:
+    """A gas cavity (fem.cavity.Cavity) at gauge pressure p: R -= p g, g = dV/du, and
+    K -= p dg/du.  Under pressure control p = value x f(t) (and dR/dt = -p'(t) g); under
+    volume or gas control p is an unknown of the system, handed in by the model, and the
+    term adds its constraint row (`constraint`).  Its state is the CavityState (p, V)."""
+
+    def __init__(self, cavity: Cavity, n_full: int):
+        self.cavity = cavity
+        self.n_full = n_full
+        self.blocks = (cavity.dofs,)
+
+    def evaluate(self, u: np.ndarray, t: float, state: CavityState | None = None, tangent: bool = True,
+                 pressure: float | None = None) -> tuple[Contribution, Constraint | None]:
+        cav = self.cavity
+        p = cav.target(t)[0] if pressure is None else pressure
+        V, ge, He = cav.evaluate(u, tangent)
+        g = assemble(cav.dofs, ge, self.n_full)
+        dr, constraint = None, None
+        if cav.unknown:
+            goal, rate = cav.target(t)
+            if cav.control == "volume":
+                constraint = Constraint(V - goal, -rate, 1.0, 0.0, cav.V0, g)
+            else:
+                absolute = p + cav.ambient
+                constraint = Constraint(absolute * V - goal, -rate, absolute, V, cav.ambient * cav.V0, g)
+        else:
+            dr = -cav.target(t)[1] * g
+        return Contribution(-p * g, dr, (-p * He,) if tangent else (), trial=CavityState(p, V)), constraint
