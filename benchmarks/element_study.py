@@ -388,7 +388,7 @@ def main(argv=None) -> int:
     L += [f"Times: CPU time of the process (time.process_time, one BLAS thread) from building the model to the "
           f"last step, minimum over {repeat} repeat(s); wall time likewise. \"shipped\": axiform's own factorization "
           f"as found in the tree ({linsolve_identity()}); \"COLAMD\": scipy.sparse.linalg.splu(K, "
-          "permc_spec=\"COLAMD\") swapped in for axiform.solve.solver.factorize by this script only; \"committed\" (one "
+          "permc_spec=\"COLAMD\") swapped in for axiform.solve.newton.factorize by this script only; \"committed\" (one "
           "repeat): splu(K, permc_spec=\"MMD_AT_PLUS_A\"), the factorization of axiform.solve.linsolve as committed in "
           "5d22fce, swapped in likewise. Same curves with all (max relative difference of p over the path given "
           "below).", ""]

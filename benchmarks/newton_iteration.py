@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """Time of one Newton iteration against the number of dofs, for several sparse solvers.
 
-One iteration of the displacement-controlled Newton (solver._newton_displacement) is
+One iteration of the displacement-controlled Newton (solve.newton.newton_displacement) is
     ev = model.evaluate(u_f, lam);  solve = factorize(ev.K);  solve([-r, -dR/dlambda])
 i.e. the residual and tangent, one LU factorization and two right-hand sides.  The model is
 the benchmark ring of benchmarks/_perf_common.py on square meshes (Q4 up to 1e6 dofs, SFR up

@@ -64,7 +64,7 @@ import scipy.sparse.linalg as sla  # noqa: E402
 from scipy.interpolate import CubicSpline  # noqa: E402
 
 import axiform as af  # noqa: E402
-import axiform.solve.solver as _solver  # noqa: E402
+import axiform.solve.newton as _solver  # noqa: E402
 from axiform.solve.linsolve import SingularTangentError  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
@@ -223,7 +223,7 @@ def linear_solver(name: str):
     """Run axiform with another sparse factorization (benchmark-local; the package is not
     changed): 'shipped' keeps axiform.solve.linsolve.factorize."""
     if not hasattr(_solver, "factorize"):
-        raise RuntimeError("axiform.solve.solver no longer calls a module-level 'factorize': update linear_solver()")
+        raise RuntimeError("axiform.solve.newton no longer calls a module-level 'factorize': update linear_solver()")
     original = _solver.factorize
     if LINEAR_SOLVERS[name] is not None:
         _solver.factorize = LINEAR_SOLVERS[name]

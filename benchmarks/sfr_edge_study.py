@@ -47,7 +47,7 @@ from pathlib import Path
 import numpy as np
 from scipy.sparse.linalg import splu
 
-import axiform.solve.solver
+import axiform.solve.newton
 from axiform import (DisplacementControl, Model, MooneyRivlin, rectangle, select_edges,
                      select_nodes, solve)
 from axiform.solve.linsolve import SingularTangentError
@@ -69,7 +69,7 @@ RULES = ("tie", "fix", "free")
 
 
 # ------------------------------------------------------------------------ linear solver
-_stock_factorize = axiform.solve.solver.factorize
+_stock_factorize = axiform.solve.newton.factorize
 
 
 def symmetric_mode_factorize(K):
@@ -90,7 +90,7 @@ def symmetric_mode_factorize(K):
 
 
 def use_factorization(fast: bool) -> None:
-    axiform.solve.solver.factorize = symmetric_mode_factorize if fast else _stock_factorize
+    axiform.solve.newton.factorize = symmetric_mode_factorize if fast else _stock_factorize
 
 
 # ------------------------------------------------------------------------------ helpers

@@ -22,7 +22,7 @@ folder unless given).  Measured per run: wall time and CPU time (time.process_ti
 threads) of the solve minus the time spent writing results, Newton iterations, steps (60
 nominal; more means cut-backs), and the split of the time between element assembly,
 contact, and the linear solver (SuperLU, axiform.solve.linsolve: factorization + solves), taken by
-wrapping Model.evaluate, ContactPair.evaluate and axiform.solve.solver._factorize (the library is
+wrapping Model.evaluate, ContactPair.evaluate and axiform.solve.newton.factorize_checked (the library is
 not changed).  Times are medians of --repeat runs (3; 1 for runs over 20 s and with --quick),
 all runs of a repeat done one after the other, round robin.
 
@@ -65,7 +65,10 @@ ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 from _common import RESULTS, machine, table  # noqa: E402
 
-import axiform.solve.solver as solver_mod  # noqa: E402
+import axiform.solve.arc_length as _arc  # noqa: E402
+import axiform.solve.newton as solver_mod  # noqa: E402
+import axiform.solve.paths as _paths  # noqa: E402
+from axiform.solve.solver import solve  # noqa: E402
 from axiform.case.schema import build, load  # noqa: E402
 from axiform.contact.pair import ContactPair  # noqa: E402
 from axiform.model.model import Model  # noqa: E402
@@ -103,7 +106,7 @@ class Timers:
 
 
 TIMERS = Timers()
-_orig_eval, _orig_contact, _orig_fact = Model.evaluate, ContactPair.evaluate, solver_mod._factorize
+_orig_eval, _orig_contact, _orig_fact = Model.evaluate, ContactPair.evaluate, solver_mod.factorize_checked
 
 
 def _evaluate(self, *a, **k):
@@ -123,7 +126,8 @@ def _factorize(K):
 
 Model.evaluate = _evaluate
 ContactPair.evaluate = _contact
-solver_mod._factorize = _factorize
+for _module in (solver_mod, _paths, _arc):  # each imports factorize_checked by name
+    _module.factorize_checked = _factorize
 _stock_factorize = solver_mod.factorize
 
 
@@ -162,7 +166,7 @@ def run_case(element: str, layers: int, radial: int, out: Path, lu: str = "stock
     solver_mod.factorize = symmetric_factorize if lu == "symmetric" else _stock_factorize
     try:
         w0, c0 = time.perf_counter(), time.process_time()
-        result = solver_mod.solve(built.model, built.control, built.options, on_step=on_step)
+        result = solve(built.model, built.control, built.options, on_step=on_step)
         wall, cpu = time.perf_counter() - w0, time.process_time() - c0
     finally:
         solver_mod.factorize = _stock_factorize

@@ -212,11 +212,11 @@ def test_a_path_run_back_to_zero_load_ends_the_run(monkeypatch):
     """The same plate with 400 steps and the two checks of a step's end turned off: a step
     lands on the loaded branch near the snap-back at w = 11.8 and the path runs back down it;
     the run ends where lambda would cross zero, saying so (before: 1000 steps, to w = -3.6)."""
-    from axiform.solve import solver as solver_module
+    from axiform.solve import arc_length
     from conftest import clamped_plate
 
-    monkeypatch.setattr(solver_module, "MAX_TURN", np.pi)
-    monkeypatch.setattr(solver_module._ArcLength, "_check_branch", lambda self, u_new, ev: None)
+    monkeypatch.setattr(arc_length, "MAX_TURN", np.pi)
+    monkeypatch.setattr(arc_length.ArcLengthPath, "_check_branch", lambda self, u_new, ev: None)
     model = clamped_plate("q8", "displacement")
     w = plate_centre(model)
     res = solve(model, ArcLengthControl(target=100.0, steps=400, stop_dof=w, stop_value=23.0))
@@ -228,12 +228,13 @@ def test_a_path_run_back_to_zero_load_ends_the_run(monkeypatch):
 def test_the_branch_check_is_left_to_systems_superlu_factorizes_cheaply(monkeypatch):
     """The sign of det K comes from SuperLU, 8 to 13 times PARDISO's time at 1e5 unknowns: the
     branch check runs on systems of up to BRANCH_CHECK_MAX unknowns only."""
-    from axiform.solve import solver as solver_module
+    from axiform.solve import arc_length
+    from axiform.solve.controls import NewtonOptions
     from conftest import clamped_plate
 
     model = clamped_plate("q8", "displacement")
     control = ArcLengthControl(target=100.0, steps=400, stop_dof=plate_centre(model), stop_value=23.0)
-    opts = solver_module.NewtonOptions()
-    assert solver_module._ArcLength(model, control, opts).branch_check
-    monkeypatch.setattr(solver_module, "BRANCH_CHECK_MAX", model.n_free - 1)
-    assert not solver_module._ArcLength(model, control, opts).branch_check
+    opts = NewtonOptions()
+    assert arc_length.ArcLengthPath(model, control, opts).branch_check
+    monkeypatch.setattr(arc_length, "BRANCH_CHECK_MAX", model.n_free - 1)
+    assert not arc_length.ArcLengthPath(model, control, opts).branch_check

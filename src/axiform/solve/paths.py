@@ -1,0 +1,166 @@
+"""Path following, step by step: what each control keeps of its last converged state (u_f,
+lambda, the committed history), how it clips a step to land on the curves' knots and its
+end, and the Newton it runs for a step (load and displacement control here; arc length in
+arc_length.py).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..fem.folds import folded_nodes
+from ..model.model import Model
+from .controls import DisplacementControl, LoadControl, NewtonOptions
+from .newton import StepFailed, evaluate_checked, factorize_checked, force_floor, newton_displacement, newton_load
+
+
+class PathFollowing:
+    """Shared state of a path-following scheme: the last converged (u_f, lambda)."""
+
+    max_steps = 10**9
+
+    def __init__(self, model: Model, opts: NewtonOptions):
+        self.model = model
+        self.opts = opts
+        self.floor = force_floor(model)
+        self.u_f = np.zeros(model.n_free)
+        self.lam = 0.0
+        self.history = model.initial_state()  # the committed state of the last converged step
+
+    def clip(self, size: float) -> float:
+        return size
+
+    _state_keys = ("u_f", "lam")
+
+    def state(self) -> dict:
+        """What the path needs to go on from its last converged step (restart)."""
+        out = {}
+        for key in self._state_keys:
+            v = getattr(self, key)
+            out[key] = v.copy() if isinstance(v, np.ndarray) else v
+        return out
+
+    def restore(self, state: dict) -> None:
+        missing = [key for key in self._state_keys if key not in state]
+        if missing:
+            raise ValueError(f"the checkpoint lacks the path's {', '.join(missing)} (written by another version "
+                             "of axiform, or for another control): run the case again from its start")
+        for key in self._state_keys:
+            v = state[key]
+            setattr(self, key, v.copy() if isinstance(v, np.ndarray) else v)
+
+    def diagnosis(self) -> str:
+        """Why the path stopped, where the state tells (appended to the stop message): an
+        element folded at one of its nodes in the last converged state."""
+        folds = folded_nodes(self.model.mesh, self.model.expand(self.u_f, self.lam))
+        if not folds:
+            return ""
+        element, node, j = folds[0]
+        r, z = self.model.mesh.points[node]
+        more = f" ({len(folds)} element nodes folded in all)" if len(folds) > 1 else ""
+        return (f"; element {element} is folded at its node {node} (r, z = {r:.6g}, {z:.6g}; in-plane J = {j:.2g} "
+                f"there at the last converged step){more}: the mesh there no longer maps the body one to one, "
+                "and other elements there (larger or finer) move the stop")
+
+    def _stiffness_ratio(self) -> float | None:
+        """The current stiffness parameter: ||du/dlambda|| at the start over ||du/dlambda|| at
+        the last converged state (1 at the start, 0 at a limit point of the load); None when
+        nothing responds to the load at the start."""
+        try:
+            ev0 = evaluate_checked(self.model, self.model.initial_state(), np.zeros_like(self.u_f), 0.0)
+            t0 = factorize_checked(ev0.K)(ev0.dr_dlam)
+            ev = evaluate_checked(self.model, self.history, self.u_f, self.lam)
+            t = factorize_checked(ev.K)(ev.dr_dlam)
+        except StepFailed:
+            return None
+        n = self.model.dofmap.nf
+        n0, n1 = np.linalg.norm(t0[:n]), np.linalg.norm(t[:n])
+        return n0 / n1 if n0 > 0 and n1 > 0 else None
+
+    def accept(self, u_f, lam, size):
+        self.u_f, self.lam = u_f, lam
+
+
+class LoadPath(PathFollowing):
+    """lambda = t from 0 to the target; every knot of every curve is a step's end."""
+
+    _state_keys = ("u_f", "lam", "previous")
+
+    def __init__(self, model, control: LoadControl, opts):
+        super().__init__(model, opts)
+        self.target = control.target
+        self.nominal = control.target / control.steps
+        k = model.knots()
+        lo, hi = sorted((0.0, self.target))
+        self.stops = np.append(k[(k > lo) & (k < hi)][:: 1 if self.target > 0 else -1], self.target)
+        self.previous = None  # the last converged increment (du, dlambda)
+
+    def done(self):
+        return abs(self.target - self.lam) <= 1e-12 * abs(self.target)
+
+    def _next_stop(self) -> float:
+        ahead = (self.stops - self.lam) * np.sign(self.target) > 1e-12 * abs(self.target)
+        return float(self.stops[np.argmax(ahead)]) if ahead.any() else self.target
+
+    def clip(self, size):
+        remaining = self._next_stop() - self.lam
+        return remaining if abs(size) > abs(remaining) else size
+
+    def attempt(self, size):
+        stop = self._next_stop()
+        lam = stop if abs(stop - self.lam - size) <= 1e-12 * abs(self.target) else self.lam + size
+        guess = None
+        if self.previous is not None:
+            # secant predictor: the last increment scaled to this step; Newton from the last
+            # converged state instead needs many iterations where the response is far from
+            # linear (a flat sheet under pressure stiffens as it stretches)
+            du, dlam = self.previous
+            guess = self.u_f + ((lam - self.lam) / dlam) * du
+        return newton_load(self.model, self.history, self.u_f, lam, self.opts, self.floor, guess)
+
+    def accept(self, u_f, lam, size):
+        self.previous = (u_f - self.u_f, lam - self.lam)
+        super().accept(u_f, lam, size)
+
+    def diagnosis(self):
+        ratio = self._stiffness_ratio() if self.lam != 0 else None
+        if ratio is not None and ratio < 0.05:
+            return (f"; this is a limit point of the load: the structure's stiffness against it has fallen to "
+                    f"{100 * ratio:.2g} % of its initial value, so it carries no more load; follow the path "
+                    "past it with control = \"arc-length\" or \"displacement\", or a cavity under volume control")
+        return super().diagnosis()
+
+
+class DisplacementPath(PathFollowing):
+    _state_keys = ("u_f", "lam", "previous", "reached")
+
+    def __init__(self, model, control: DisplacementControl, opts):
+        super().__init__(model, opts)
+        self.c = int(model.dofmap.eq[control.dof])
+        if self.c >= model.n_free:
+            raise ValueError("the controlled dof is prescribed: it cannot be driven by displacement control")
+        self.target = control.target
+        self.nominal = control.target / control.steps
+        self.reached = 0.0
+        self.previous = None  # the last converged increment (du, dlambda, d reached)
+
+    def done(self):
+        return abs(self.target - self.reached) <= 1e-12 * abs(self.target)
+
+    def clip(self, size):
+        remaining = self.target - self.reached
+        return remaining if abs(size) > abs(remaining) else size
+
+    def attempt(self, size):
+        goal = self.target if abs(self.target - self.reached - size) <= 1e-12 * abs(self.target) else self.reached + size
+        guess = None
+        if self.previous is not None:  # secant predictor, as under load control
+            du, dlam, dprev = self.previous
+            ratio = (goal - self.reached) / dprev
+            guess = (self.u_f + ratio * du, self.lam + ratio * dlam)
+        return newton_displacement(self.model, self.history, self.u_f, self.lam, self.c, goal, self.opts, self.floor, guess)
+
+    def accept(self, u_f, lam, size):
+        self.previous = (u_f - self.u_f, lam - self.lam, size)
+        super().accept(u_f, lam, size)
+        self.reached += size
