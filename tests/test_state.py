@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from axiform.case.schema import build, load
-from axiform.contact.pair import ContactState
+from axiform.contact.state import ContactState
 from axiform.post.fields import point_fields
 from axiform.solve.solver import solve
 

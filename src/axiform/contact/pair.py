@@ -7,12 +7,11 @@ times the current ring area of each node (the consistent area, integral of 2 pi 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
-
 import numpy as np
 
-from ..fem.elements import edge_shape, gauss_1d
 from ..fem.mesh import Mesh
+from .rings import edge_heights, pole_rows, ring_areas, slave_edges
+from .state import ContactSeen, ContactState, ContactTrial
 from .surfaces import RigidSurface
 
 STATUS = {0: "open", 1: "stick", 2: "slip", 3: "sticky"}  # slip: |ft| > tanh(1) mu fn
@@ -25,85 +24,6 @@ Z_SATURATED = 3.0
 GUARD_ALLOWANCE = 0.25
 
 
-def slave_edges(mesh: Mesh, nodes: np.ndarray) -> np.ndarray:
-    """Boundary edges (m, edge_nodes) all of whose nodes (Q8: the mid-side node too) are among
-    `nodes`, ends first, as the owning cell runs."""
-    is_slave = np.zeros(mesh.n_nodes, bool)
-    is_slave[nodes] = True
-    e = mesh.boundary_edges
-    return e[is_slave[e].all(axis=1)]
-
-
-def ring_areas(x: np.ndarray, edges: np.ndarray, derivative: bool = False):
-    """The consistent ring areas of the edge nodes, a_i = int 2 pi r N_i ds over each edge
-    with the edge's own shape functions N_i (linear, or quadratic for Q8: Simpson's corner
-    weight 1/6 and mid-side weight 2/3 on a straight edge at constant r), in the
-    configuration x (n_nodes, 2) (reference or current).
-
-    Returns per edge and edge node the part a (m, k) and, if asked, its derivative
-    da[m, i, j, :] = d a_i / d x_j (m, k, k, 2) with respect to the positions of the edge's
-    nodes; a node's area is the sum of its parts over its edges."""
-    s, wq = gauss_1d(3)
-    N, dN = edge_shape(edges.shape[1], s)  # (p, k)
-    X = x[edges]  # (m, k, 2)
-    t = np.einsum("pk,mkd->mpd", dN, X)  # dx/ds (m, p, 2)
-    L = np.linalg.norm(t, axis=2)  # (m, p)
-    r = np.einsum("pk,mk->mp", N, X[..., 0])
-    a = 2 * np.pi * np.einsum("p,pi,mp->mi", wq, N, r * L)
-    if not derivative:
-        return a
-    m, k = edges.shape
-    da = np.zeros((m, k, k, 2))
-    # d(r L) / dx_j = N_j L e_r + r dN_j t / L
-    da[..., 0] = np.einsum("p,pi,pj,mp->mij", wq, N, N, L)
-    da += np.einsum("p,pi,pj,mpd->mijd", wq, N, dN, (r / L)[..., None] * t)
-    return a, 2 * np.pi * da
-
-
-def pole_rows(x: np.ndarray, edges: np.ndarray, corner: np.ndarray, derivative: bool = False):
-    """The row of the consistent ring-area matrix M_ij = int 2 pi r N_i N_j ds of each edge's
-    node on the axis i = corner (the pole), over the nodes j of that edge, in the
-    configuration x (n_nodes, 2); edges (q, k), corner (q,) in {0, 1}.
-
-    The row sums to the pole's consistent ring area, which is zero for a Q8 corner on the
-    axis (int r N_0 ds = 0 where r grows linearly along the edge); the row itself is not:
-    M_00 = -M_01 = 2 pi r_1 L / 60 on a straight edge.
-
-    Returns M (q, k) and, if asked, dM[q, j, l, :] = d M_ij / d x_l (q, k, k, 2)."""
-    s, wq = gauss_1d(3)  # the rule of `ring_areas`, so that the row sums to its area exactly
-    N, dN = edge_shape(edges.shape[1], s)  # (p, k)
-    X = x[edges]  # (q, k, 2)
-    t = np.einsum("pk,qkd->qpd", dN, X)
-    L = np.linalg.norm(t, axis=2)  # (q, p)
-    r = np.einsum("pk,qk->qp", N, X[..., 0])
-    Ni = N[:, corner].T  # (q, p)
-    M = 2 * np.pi * np.einsum("p,qp,pj,qp->qj", wq, Ni, N, r * L)
-    if not derivative:
-        return M
-    # d(r L) / dx_l = N_l L e_r + r dN_l t / L, as in `ring_areas`
-    dM = np.zeros(M.shape + M.shape[1:] + (2,))
-    dM[..., 0] = np.einsum("p,qp,pj,pl,qp->qjl", wq, Ni, N, N, L)
-    dM += np.einsum("p,qp,pj,pl,qpd->qjld", wq, Ni, N, dN, (r / L)[..., None] * t)
-    return M, 2 * np.pi * dM
-
-
-def _edge_heights(mesh: Mesh, edges: np.ndarray) -> np.ndarray:
-    """Height of the cell under each boundary edge (m,): the cell's area in the (r, z) plane
-    over the edge's chord."""
-    local = mesh.element.edge_local_nodes()[:, :2]  # (4, 2) corner pairs of the cell edges
-    ends = np.sort(mesh.cells[:, local], axis=2).reshape(-1, 2)  # (4 e, 2)
-    n = mesh.n_nodes
-    keys = ends[:, 0] * n + ends[:, 1]
-    order = np.argsort(keys)
-    want = np.sort(edges[:, :2], axis=1)
-    cell = order[np.searchsorted(keys[order], want[:, 0] * n + want[:, 1])] // 4
-    c = mesh.points[mesh.cells[cell, :4]]  # corners, counter-clockwise
-    area = 0.5 * np.abs((c[..., 0] * np.roll(c[..., 1], -1, axis=1)
-                         - np.roll(c[..., 0], -1, axis=1) * c[..., 1]).sum(axis=1))
-    chord = np.linalg.norm(mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]], axis=1)
-    return area / chord
-
-
 def _normal_law(g: np.ndarray, touching: np.ndarray, kn, d: float):
     """The normal law (eqs. 40-41) rounded over -d < g < 0: the force fn (n,) (>= 0, along
     the normal) at gaps g (n,) where `touching` (and g < 0), and dfn/dg (n,)."""
@@ -112,70 +32,6 @@ def _normal_law(g: np.ndarray, touching: np.ndarray, kn, d: float):
     fn = np.where(contact, np.where(band, kn * g * g / (2 * d), -kn * (g + 0.5 * d)), 0.0)
     dfn = np.where(contact, np.where(band, kn * g / d, -kn), 0.0)
     return fn, dfn
-
-
-@dataclass(frozen=True)
-class ContactSeen:
-    """What an evaluation of a pair found, per slave node (n,): current positions relative to
-    the surface x (n, 2), the projection `proj`, the forces f (n, 2), status, current ring
-    areas a, the traction per unit current area (n, 2), and the forces of the mid-point
-    guards (m, 2) (zeros where none)."""
-
-    x: np.ndarray
-    proj: object
-    f: np.ndarray
-    status: np.ndarray
-    a: np.ndarray
-    traction: np.ndarray
-    guard_force: np.ndarray
-
-
-@dataclass(frozen=True)
-class ContactState:
-    """The history of a pair, per slave node (n,), as of one converged step: positions for
-    the crossing test x_prev (n, 2) (surface frame), friction stick points s_stick (NaN:
-    none), sticky nodes and their points, the time of first contact (NaN: never); and what
-    the step's evaluation found (`seen`, None before the first step and after a restart).
-    Immutable: an evaluation returns a new (trial) state, the solver keeps the committed one."""
-
-    nodes: np.ndarray
-    x_prev: np.ndarray
-    s_stick: np.ndarray
-    stuck: np.ndarray
-    stuck_point: np.ndarray
-    first_contact: np.ndarray
-    seen: ContactSeen | None = None
-
-    HISTORY = ("x_prev", "s_stick", "stuck", "stuck_point", "first_contact")
-
-    def to_dict(self) -> dict[str, np.ndarray]:
-        """The history arrays (a checkpoint)."""
-        return {k: getattr(self, k).copy() for k in self.HISTORY}
-
-    def from_dict(self, saved: dict[str, np.ndarray]) -> "ContactState":
-        """This state with the history arrays of `saved` (ContactState.to_dict), checked."""
-        values = {}
-        for k in self.HISTORY:
-            v = np.asarray(saved[k])
-            ref = getattr(self, k)
-            if v.shape != ref.shape:
-                raise ValueError(f"contact state '{k}' has shape {v.shape}, not {ref.shape}")
-            values[k] = v.astype(ref.dtype, copy=True)
-        return replace(self, seen=None, **values)
-
-
-@dataclass(frozen=True)
-class ContactTrial:
-    """One evaluation of a pair: its forces on the slave nodes f (n, 2), their derivative K
-    (n, 2, 2) with respect to the positions relative to the surface, the coupling through the
-    current ring areas (m, 2k, 2k), the poles' rate blocks (or None), and the state the pair
-    would have if this evaluation were accepted (`state`)."""
-
-    f: np.ndarray
-    K: np.ndarray
-    coupling: np.ndarray
-    pole_rate: np.ndarray | None
-    state: ContactState
 
 
 def outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -281,7 +137,7 @@ class ContactPair:
         if penalty is None:
             if modulus is None:
                 raise ValueError("give a penalty, or the material's modulus for the default one")
-            height = _edge_heights(mesh, edges)[:, None]
+            height = edge_heights(mesh, edges)[:, None]
             weight = parts + 1e-300  # ring-area weighted mean of the heights of the node's cells
             h = np.bincount(self.edges.ravel(), (weight * height).ravel(), n) / np.bincount(
                 self.edges.ravel(), weight.ravel(), n)
@@ -295,7 +151,7 @@ class ContactPair:
         if self.guarded:
             self.guard_weight = (2.0 / 3.0) * parts.sum(axis=1)
             self.guard_kn = 0.5 * self.kn0[self.edges].sum(axis=1)
-            self.guard_allowance = GUARD_ALLOWANCE * _edge_heights(mesh, edges)
+            self.guard_allowance = GUARD_ALLOWANCE * edge_heights(mesh, edges)
             chord = mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]]
             self.guard_arm = 0.25 * np.column_stack([-chord[:, 1], chord[:, 0]])  # SFR: d x_m / d theta_a
         self.kt0 = self.kn0 if tangential_penalty is None else np.full(len(self.nodes), float(tangential_penalty))

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..contact.pair import ContactState
+from ..contact.state import ContactState
 
 
 @dataclass(frozen=True)

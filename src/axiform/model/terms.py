@@ -19,7 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..contact.pair import ContactPair, ContactState
+from ..contact.pair import ContactPair
+from ..contact.state import ContactState
 from ..fem.cavity import Cavity
 from ..fem.curves import Curve
 from ..fem.loads import FollowerPressure

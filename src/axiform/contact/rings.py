@@ -1,0 +1,90 @@
+"""The ring areas of a slave face of the body of revolution: the consistent area of each node
+(integral of 2 pi r N_i ds over its edges) and the consistent row of a node on the axis (a
+pole), with their derivatives; the slave edges of a node set; the cell height under an edge.
+Arrays over the edges of a slave face, vectorized."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..fem.elements import edge_shape, gauss_1d
+from ..fem.mesh import Mesh
+
+
+def slave_edges(mesh: Mesh, nodes: np.ndarray) -> np.ndarray:
+    """Boundary edges (m, edge_nodes) all of whose nodes (Q8: the mid-side node too) are among
+    `nodes`, ends first, as the owning cell runs."""
+    is_slave = np.zeros(mesh.n_nodes, bool)
+    is_slave[nodes] = True
+    e = mesh.boundary_edges
+    return e[is_slave[e].all(axis=1)]
+
+
+def ring_areas(x: np.ndarray, edges: np.ndarray, derivative: bool = False):
+    """The consistent ring areas of the edge nodes, a_i = int 2 pi r N_i ds over each edge
+    with the edge's own shape functions N_i (linear, or quadratic for Q8: Simpson's corner
+    weight 1/6 and mid-side weight 2/3 on a straight edge at constant r), in the
+    configuration x (n_nodes, 2) (reference or current).
+
+    Returns per edge and edge node the part a (m, k) and, if asked, its derivative
+    da[m, i, j, :] = d a_i / d x_j (m, k, k, 2) with respect to the positions of the edge's
+    nodes; a node's area is the sum of its parts over its edges."""
+    s, wq = gauss_1d(3)
+    N, dN = edge_shape(edges.shape[1], s)  # (p, k)
+    X = x[edges]  # (m, k, 2)
+    t = np.einsum("pk,mkd->mpd", dN, X)  # dx/ds (m, p, 2)
+    L = np.linalg.norm(t, axis=2)  # (m, p)
+    r = np.einsum("pk,mk->mp", N, X[..., 0])
+    a = 2 * np.pi * np.einsum("p,pi,mp->mi", wq, N, r * L)
+    if not derivative:
+        return a
+    m, k = edges.shape
+    da = np.zeros((m, k, k, 2))
+    # d(r L) / dx_j = N_j L e_r + r dN_j t / L
+    da[..., 0] = np.einsum("p,pi,pj,mp->mij", wq, N, N, L)
+    da += np.einsum("p,pi,pj,mpd->mijd", wq, N, dN, (r / L)[..., None] * t)
+    return a, 2 * np.pi * da
+
+
+def pole_rows(x: np.ndarray, edges: np.ndarray, corner: np.ndarray, derivative: bool = False):
+    """The row of the consistent ring-area matrix M_ij = int 2 pi r N_i N_j ds of each edge's
+    node on the axis i = corner (the pole), over the nodes j of that edge, in the
+    configuration x (n_nodes, 2); edges (q, k), corner (q,) in {0, 1}.
+
+    The row sums to the pole's consistent ring area, which is zero for a Q8 corner on the
+    axis (int r N_0 ds = 0 where r grows linearly along the edge); the row itself is not:
+    M_00 = -M_01 = 2 pi r_1 L / 60 on a straight edge.
+
+    Returns M (q, k) and, if asked, dM[q, j, l, :] = d M_ij / d x_l (q, k, k, 2)."""
+    s, wq = gauss_1d(3)  # the rule of `ring_areas`, so that the row sums to its area exactly
+    N, dN = edge_shape(edges.shape[1], s)  # (p, k)
+    X = x[edges]  # (q, k, 2)
+    t = np.einsum("pk,qkd->qpd", dN, X)
+    L = np.linalg.norm(t, axis=2)  # (q, p)
+    r = np.einsum("pk,qk->qp", N, X[..., 0])
+    Ni = N[:, corner].T  # (q, p)
+    M = 2 * np.pi * np.einsum("p,qp,pj,qp->qj", wq, Ni, N, r * L)
+    if not derivative:
+        return M
+    # d(r L) / dx_l = N_l L e_r + r dN_l t / L, as in `ring_areas`
+    dM = np.zeros(M.shape + M.shape[1:] + (2,))
+    dM[..., 0] = np.einsum("p,qp,pj,pl,qp->qjl", wq, Ni, N, N, L)
+    dM += np.einsum("p,qp,pj,pl,qpd->qjld", wq, Ni, N, dN, (r / L)[..., None] * t)
+    return M, 2 * np.pi * dM
+
+
+def edge_heights(mesh: Mesh, edges: np.ndarray) -> np.ndarray:
+    """Height of the cell under each boundary edge (m,): the cell's area in the (r, z) plane
+    over the edge's chord."""
+    local = mesh.element.edge_local_nodes()[:, :2]  # (4, 2) corner pairs of the cell edges
+    ends = np.sort(mesh.cells[:, local], axis=2).reshape(-1, 2)  # (4 e, 2)
+    n = mesh.n_nodes
+    keys = ends[:, 0] * n + ends[:, 1]
+    order = np.argsort(keys)
+    want = np.sort(edges[:, :2], axis=1)
+    cell = order[np.searchsorted(keys[order], want[:, 0] * n + want[:, 1])] // 4
+    c = mesh.points[mesh.cells[cell, :4]]  # corners, counter-clockwise
+    area = 0.5 * np.abs((c[..., 0] * np.roll(c[..., 1], -1, axis=1)
+                         - np.roll(c[..., 0], -1, axis=1) * c[..., 1]).sum(axis=1))
+    chord = np.linalg.norm(mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]], axis=1)
+    return area / chord

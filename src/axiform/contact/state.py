@@ -1,0 +1,73 @@
+"""The state of a contact pair: its history as of a converged step (ContactState), what one
+evaluation saw (ContactSeen), and one evaluation's forces and derivatives (ContactTrial).
+Immutable values: the solver holds the committed state, an evaluation returns a trial."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class ContactSeen:
+    """What an evaluation of a pair found, per slave node (n,): current positions relative to
+    the surface x (n, 2), the projection `proj`, the forces f (n, 2), status, current ring
+    areas a, the traction per unit current area (n, 2), and the forces of the mid-point
+    guards (m, 2) (zeros where none)."""
+
+    x: np.ndarray
+    proj: object
+    f: np.ndarray
+    status: np.ndarray
+    a: np.ndarray
+    traction: np.ndarray
+    guard_force: np.ndarray
+
+
+@dataclass(frozen=True)
+class ContactState:
+    """The history of a pair, per slave node (n,), as of one converged step: positions for
+    the crossing test x_prev (n, 2) (surface frame), friction stick points s_stick (NaN:
+    none), sticky nodes and their points, the time of first contact (NaN: never); and what
+    the step's evaluation found (`seen`, None before the first step and after a restart).
+    Immutable: an evaluation returns a new (trial) state, the solver keeps the committed one."""
+
+    nodes: np.ndarray
+    x_prev: np.ndarray
+    s_stick: np.ndarray
+    stuck: np.ndarray
+    stuck_point: np.ndarray
+    first_contact: np.ndarray
+    seen: ContactSeen | None = None
+
+    HISTORY = ("x_prev", "s_stick", "stuck", "stuck_point", "first_contact")
+
+    def to_dict(self) -> dict[str, np.ndarray]:
+        """The history arrays (a checkpoint)."""
+        return {k: getattr(self, k).copy() for k in self.HISTORY}
+
+    def from_dict(self, saved: dict[str, np.ndarray]) -> "ContactState":
+        """This state with the history arrays of `saved` (ContactState.to_dict), checked."""
+        values = {}
+        for k in self.HISTORY:
+            v = np.asarray(saved[k])
+            ref = getattr(self, k)
+            if v.shape != ref.shape:
+                raise ValueError(f"contact state '{k}' has shape {v.shape}, not {ref.shape}")
+            values[k] = v.astype(ref.dtype, copy=True)
+        return replace(self, seen=None, **values)
+
+
+@dataclass(frozen=True)
+class ContactTrial:
+    """One evaluation of a pair: its forces on the slave nodes f (n, 2), their derivative K
+    (n, 2, 2) with respect to the positions relative to the surface, the coupling through the
+    current ring areas (m, 2k, 2k), the poles' rate blocks (or None), and the state the pair
+    would have if this evaluation were accepted (`state`)."""
+
+    f: np.ndarray
+    K: np.ndarray
+    coupling: np.ndarray
+    pole_rate: np.ndarray | None
+    state: ContactState
