@@ -99,7 +99,7 @@ def _write(tmp_path, case):
     return path
 
 
-def _rows(folder):
+def stress_rows(folder):
     with open(folder / "history.csv", newline="") as fh:
         return [[float(v) for v in r] for r in list(csv.reader(fh))[1:]]
 
@@ -123,9 +123,9 @@ def test_axiform_run_resume_gives_the_same_history(tmp_path, monkeypatch):
     out = tmp_path / "cut"
     assert cli.main(["run", str(path), "--out", str(out), "-q"]) == 128 + signal.SIGTERM
     monkeypatch.setattr(solver, "solve", real_solve)
-    assert len(_rows(out)) == 5
+    assert len(stress_rows(out)) == 5
     assert cli.main(["run", str(path), "--resume", str(out), "-q"]) == 0
-    full, resumed = _rows(tmp_path / "full"), _rows(out)
+    full, resumed = stress_rows(tmp_path / "full"), stress_rows(out)
     assert len(full) == len(resumed)
     np.testing.assert_allclose(resumed, full, rtol=1e-10, atol=1e-12)
 
@@ -139,5 +139,5 @@ def test_resume_refuses_another_model(tmp_path, capsys):
     assert cli.main(["run", str(path), "--resume", str(tmp_path / "nowhere"), "-q"]) == 2
     # a later target is allowed: the run goes on from its last step
     assert cli.main(["run", str(path), "--resume", str(out), "--set", "solver.target=1.5", "-q"]) == 0
-    rows = _rows(out)
+    rows = stress_rows(out)
     assert rows[-1][1] == pytest.approx(1.5) and [r[0] for r in rows] == list(range(1, len(rows) + 1))

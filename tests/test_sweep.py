@@ -69,7 +69,7 @@ monitor = "rim_force_z"
 """
 
 
-def _rows(path):
+def stress_rows(path):
     with open(path, newline="") as f:
         return list(csv.DictReader(f))
 
@@ -85,7 +85,7 @@ def test_sweep_failure_recorded_and_resume(sweep_dir, capsys):
     out = sweep_dir / "out"
     args = ["sweep", str(sweep_dir / "sweep.toml"), "--out", str(out), "--workers", "2"]
     assert main(args) == 1  # one case did not finish
-    rows = _rows(out / "sweep.csv")
+    rows = stress_rows(out / "sweep.csv")
     assert list(rows[0]) == ["case", "material.C1", "solver.steps", "solver.max_iterations", "solver.min_step",
                              "status", "exit_code", "steps", "wall_time_s", "message", "w_center", "rim_force_z"]
     assert [r["case"] for r in rows] == ["0001", "0002", "0003"]
@@ -114,7 +114,7 @@ def test_sweep_failure_recorded_and_resume(sweep_dir, capsys):
     assert (out / "cases" / "0001" / "history.csv").stat().st_mtime_ns == stamps["0001"]
     assert (out / "cases" / "0003" / "history.csv").stat().st_mtime_ns == stamps["0003"]
     assert (out / "cases" / "0002" / "history.csv").stat().st_mtime_ns != stamps["0002"]
-    again = _rows(out / "sweep.csv")
+    again = stress_rows(out / "sweep.csv")
     assert [r["status"] for r in again] == ["finished", "stopped", "finished"]
     assert again[0]["rim_force_z"] == rows[0]["rim_force_z"]
 

@@ -108,14 +108,14 @@ class MixedAssembly(SolidAssembly):
         """P = P_iso + p dJ/dF (e, q, 5) with the element pressure p."""
         xt, shape = to_rows(x)
         p, dJ = self._pressure(xt, sl)
-        P = self.material._rows(xt, 0.0, False)[0]
+        P = self.material.stress_rows(xt, 0.0, False)[0]
         P += p * dJ
         return from_rows(P, None, shape)[0]
 
     def evaluate(self, u_full: np.ndarray, tangent: bool = True, out: tuple | None = None):
         """Element internal forces fe (e, nd) and, if asked, element tangents Ke (e, nd, nd),
         written into out = (fe, Ke) when given (from `buffers`) and returned.  The law's
-        isochoric part (`_rows` with kappa = 0) and the pressure terms are computed on the
+        isochoric part (`stress_rows` with kappa = 0) and the pressure terms are computed on the
         contiguous component rows (5, n), then brought to (m, q, 5, 5) once."""
         e, q, _, nd = self.G.shape
         fe, Ke = out if out is not None else self.buffers(tangent)
@@ -124,7 +124,7 @@ class MixedAssembly(SolidAssembly):
             m = sl.stop - sl.start
             xt, shape = to_rows(x)
             p, dJ = self._pressure(xt, sl)
-            P, A = self.material._rows(xt, 0.0, tangent)
+            P, A = self.material.stress_rows(xt, 0.0, tangent)
             P += p * dJ
             if tangent:
                 add_pressure_hessian(A, xt, p)

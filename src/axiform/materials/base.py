@@ -33,8 +33,8 @@ def sym_outer(u: np.ndarray, v: np.ndarray) -> np.ndarray:
 class Hyperelastic(ABC):
     """Decoupled law W = W_iso(F_bar) + kappa/2 (J - 1)^2; kappa the bulk modulus.
 
-    Subclasses give `_rows(xt, kappa, tangent)`: P rows (5, n) and, if asked, A rows (5, 5, n)
-    of W_iso + kappa/2 (J - 1)^2 at x rows xt (5, n) (kappa = 0: the isochoric part alone),
+    Subclasses give `stress_rows(xt, kappa, tangent)` (the mixed elements call it with kappa
+    = 0): P rows (5, n) and, if asked, A rows (5, 5, n) of W_iso + kappa/2 (J - 1)^2 at x rows xt (5, n) (kappa = 0: the isochoric part alone),
     `iso_energy` and `shear_modulus`.
     """
 
@@ -50,7 +50,7 @@ class Hyperelastic(ABC):
         """W_iso(F_bar(F)) (...) per unit reference volume at x (..., 5)."""
 
     @abstractmethod
-    def _rows(self, xt: np.ndarray, kappa: float, tangent: bool):
+    def stress_rows(self, xt: np.ndarray, kappa: float, tangent: bool):
         """P (5, n) and A (5, 5, n) or None of W_iso + kappa/2 (J - 1)^2 at rows xt (5, n)."""
 
     def energy(self, x: np.ndarray) -> np.ndarray:
@@ -61,22 +61,22 @@ class Hyperelastic(ABC):
     def stress(self, x: np.ndarray) -> np.ndarray:
         """First Piola-Kirchhoff stress P = dW/dF (..., 5)."""
         xt, shape = to_rows(x)
-        return from_rows(self._rows(xt, self.kappa, False)[0], None, shape)[0]
+        return from_rows(self.stress_rows(xt, self.kappa, False)[0], None, shape)[0]
 
     def stress_tangent(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """P (..., 5) and A = dP/dF (..., 5, 5) of the whole W."""
         xt, shape = to_rows(x)
-        return from_rows(*self._rows(xt, self.kappa, True), shape)
+        return from_rows(*self.stress_rows(xt, self.kappa, True), shape)
 
     def iso_stress(self, x: np.ndarray) -> np.ndarray:
         """P_iso = dW_iso(F_bar(F))/dF (..., 5)."""
         xt, shape = to_rows(x)
-        return from_rows(self._rows(xt, 0.0, False)[0], None, shape)[0]
+        return from_rows(self.stress_rows(xt, 0.0, False)[0], None, shape)[0]
 
     def iso_stress_tangent(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """P_iso (..., 5) and A_iso = dP_iso/dF (..., 5, 5) of W_iso(F_bar(F)) alone."""
         xt, shape = to_rows(x)
-        return from_rows(*self._rows(xt, 0.0, True), shape)
+        return from_rows(*self.stress_rows(xt, 0.0, True), shape)
 
     def volumetric_stress_tangent(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """P_vol = kappa (J - 1) dJ (..., 5) and A_vol = kappa (dJ dJ^T + (J - 1) d2J)
@@ -121,7 +121,7 @@ class ReducedLaw(Hyperelastic):
     def _reduced(self, xt: np.ndarray, s: np.ndarray, j2: np.ndarray, tangent: bool):
         """g (3, n) and H (6, n) or None of W_iso in (s, j2, f)."""
 
-    def _rows(self, xt: np.ndarray, kappa: float, tangent: bool):
+    def stress_rows(self, xt: np.ndarray, kappa: float, tangent: bool):
         a, b, c, d, f = xt
         s = a * a + b * b + c * c + d * d
         j2 = a * d - b * c

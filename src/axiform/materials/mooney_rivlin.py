@@ -45,7 +45,7 @@ class MooneyRivlin(InvariantLaw):
     def psi_derivatives(self, I1b: np.ndarray, I2b: np.ndarray | None, tangent: bool) -> tuple:
         return np.full_like(I1b, self.C1), np.full_like(I1b, self.C2), None, None, None
 
-    def _rows(self, xt: np.ndarray, kappa: float, tangent: bool):
+    def stress_rows(self, xt: np.ndarray, kappa: float, tangent: bool):
         """P (5, n) and A = dP/dF (5, 5, n) at x rows xt (5, n), volumetric kappa included.
 
         A = 2 W1 I + W2 d2I2 + WJ d2J + W1J (dI1 dJ + dJ dI1) + W2J (dI2 dJ + dJ dI2)
