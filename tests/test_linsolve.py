@@ -7,6 +7,7 @@ import threading
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from scipy.sparse.linalg import spsolve
 
 import axiform.solve.linsolve as ls
 from axiform import Model, MooneyRivlin, rectangle
@@ -30,9 +31,9 @@ def _tangent(element: str, divisions, seed: int = 0):
 def _backend(monkeypatch, name: str):
     monkeypatch.setattr(ls, "DENSE_MAX", 10**9 if name == "dense" else 0)
     if name == "superlu":
-        monkeypatch.setattr(ls, "_mkl", lambda: None)
-    elif name == "pardiso" and ls._mkl() is None:
-        pytest.skip("MKL is not installed")
+        monkeypatch.setattr(ls, "_pypardiso", lambda: None)
+    elif name == "pardiso" and ls._pypardiso() is None:
+        pytest.skip("pypardiso (MKL) is not installed")
 
 
 @pytest.mark.parametrize("element", ["q4", "sfr", "q8"])
@@ -44,7 +45,7 @@ def test_backends_agree(monkeypatch, element):
         _backend(monkeypatch, name)
         x[name] = ls.factorize(K)(B)
         monkeypatch.undo()
-    ref = np.linalg.solve(K.toarray(), B)
+    ref = spsolve(K.tocsc(), B)
     for name, xi in x.items():
         assert np.abs(xi - ref).max() <= 1e-10 * np.abs(ref).max(), name
         assert xi.shape == B.shape
@@ -90,6 +91,38 @@ def test_singular_dense():
     K = sp.csr_matrix(np.array([[1.0, 2.0], [2.0, 4.0]]))
     with pytest.raises(ls.SingularTangentError):
         ls.factorize(K)
+
+
+@pytest.mark.parametrize("name", ["pardiso", "superlu"])
+def test_singular_sparse(monkeypatch, name):
+    """An exactly singular K (a zero column; PARDISO perturbs the zero pivot, which sends K
+    to SuperLU) raises SingularTangentError, so does an empty row (a dof nothing stiffens).
+    (Singular only up to round-off, e.g. two equal rows, SuperLU answers a finite x: the
+    module's documented limit.)"""
+    _backend(monkeypatch, name)
+    K, B = _tangent("q4", (7, 6), seed=5)
+    K = K.tolil()
+    K[:, 7] = 0.0
+    assert K.tocsr()[7].nnz > 0
+    with pytest.raises(ls.SingularTangentError):
+        ls.factorize(K.tocsr())(B)
+    K[7, :] = 0.0
+    with pytest.raises(ls.SingularTangentError, match="empty row"):
+        ls.factorize(K.tocsr())(B)
+
+
+def test_pardiso_one_and_several_rhs(monkeypatch):
+    """1-D and (n, k) right-hand sides, below and above PARALLEL_MIN (one call per column or
+    all columns in one call), against spsolve."""
+    _backend(monkeypatch, "pardiso")
+    K, B = _tangent("q4", (7, 6), seed=4)
+    ref = spsolve(K.tocsc(), B)
+    for parallel_min in (10**9, 0):
+        monkeypatch.setattr(ls, "PARALLEL_MIN", parallel_min)
+        solve = ls.factorize(K)
+        assert np.abs(solve(B) - ref).max() <= 1e-10 * np.abs(ref).max()
+        assert np.abs(solve(B[:, 1]) - ref[:, 1]).max() <= 1e-10 * np.abs(ref).max()
+        assert solve(B[:, :1]).shape == (K.shape[0], 1)
 
 
 def test_threads_keep_their_own(monkeypatch):
