@@ -31,9 +31,9 @@ def _tangent(element: str, divisions, seed: int = 0):
 def _backend(monkeypatch, name: str):
     monkeypatch.setattr(ls, "DENSE_MAX", 10**9 if name == "dense" else 0)
     if name == "superlu":
-        monkeypatch.setattr(ls, "_pypardiso", lambda: None)
-    elif name == "pardiso" and ls._pypardiso() is None:
-        pytest.skip("pypardiso (MKL) is not installed")
+        monkeypatch.setattr(ls, "_mkl", lambda: None)
+    elif name == "pardiso" and ls._mkl() is None:
+        pytest.skip("MKL is not installed")
 
 
 @pytest.mark.parametrize("element", ["q4", "sfr", "q8"])
@@ -109,6 +109,27 @@ def test_singular_sparse(monkeypatch, name):
     K[7, :] = 0.0
     with pytest.raises(ls.SingularTangentError, match="empty row"):
         ls.factorize(K.tocsr())(B)
+
+
+def test_pardiso_typed_and_guarded(monkeypatch):
+    """The binding declares pardiso()'s prototype (16 typed pointers, no bare addresses),
+    writes nothing into the environment, and a K whose indices would not fit PARDISO's
+    32-bit integers raises a ValueError instead of being cast."""
+    _backend(monkeypatch, "pardiso")
+    import ctypes
+    import os
+
+    environ = dict(os.environ)
+    K, B = _tangent("q4", (7, 6), seed=6)
+    ls.factorize(K)(B)
+    assert dict(os.environ) == environ
+    argtypes = ls._mkl().pardiso.argtypes
+    assert len(argtypes) == 16 and ctypes.c_void_p not in argtypes
+    assert ls._mkl().MKL_Set_Num_Threads_Local.argtypes == [ctypes.c_int]
+    monkeypatch.setattr(ls, "_INT32_MAX", K.nnz - 1)
+    ls._STATE.pardiso.release()
+    with pytest.raises(ValueError, match="32-bit"):
+        ls.factorize(K)
 
 
 def test_pardiso_one_and_several_rhs(monkeypatch):

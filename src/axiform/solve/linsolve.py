@@ -5,13 +5,17 @@ The solver is chosen by the size n of K (benchmarks/README.md § 3.2 measured ea
 
 - n <= DENSE_MAX: dense LAPACK LU (getrf / getrs), where the sparse solvers' fixed costs
   exceed the whole dense work;
-- larger: MKL PARDISO (matrix type 11, real non-symmetric) through pypardiso's solver
-  object, phase by phase: phase 11 (ordering: minimum degree below MINIMUM_DEGREE_MAX
-  unknowns, METIS nested dissection above; symbolic factorization) once for each sparsity
-  pattern, then phase 22 (numerical factorization) for each K and phase 33 for each solve
-  (pypardiso's factorize() would redo phase 11 on every matrix).  pypardiso is imported
-  when the first sparse K is factorized (its import looks for MKL: 0.1 to 0.3 s);
-- without pypardiso (not x86-64): SciPy's SuperLU with the column ordering minimum degree on
+- larger: MKL PARDISO (matrix type 11, real non-symmetric) called through ctypes with typed
+  prototypes, phase 11 (ordering: minimum degree below MINIMUM_DEGREE_MAX unknowns, METIS
+  nested dissection above; symbolic factorization) once for each sparsity pattern, then
+  phase 22 (numerical factorization) for each K and phase 33 for each solve.  pypardiso
+  installs MKL; only the library it brings is used here, found when first needed.  Its
+  solver object, driven phase by phase, was measured slower (benchmarks/README.md § 3.9:
+  its import and constructor look for MKL through site-packages, 0.23 to 0.37 s a process,
+  and each call converts the indices to one-based and builds its pointers, +0.1 ms = +9 to
+  13 % for a factorization and solve at 1e3 unknowns), so this module keeps its own binding
+  (DESIGN § 12);
+- without MKL (not x86-64): SciPy's SuperLU with the column ordering minimum degree on
   K^T K (MMD_ATA), computed once per pattern and then given as the natural order of the
   permuted K.  A column ordering bounds the fill whatever rows partial pivoting picks;
   minimum degree on K^T + K assumes diagonal pivots and on some tangents the fill grew 3x
@@ -28,6 +32,9 @@ solve function of an earlier one raises.  Each thread keeps its own solver state
 from __future__ import annotations
 
 import ctypes
+import glob
+import os
+import sys
 import threading
 from typing import Callable
 
@@ -53,114 +60,176 @@ def _check(x: np.ndarray) -> np.ndarray:
     return x
 
 
-# ---- MKL PARDISO through pypardiso's solver object ---------------------------------------
-_SOLVER_CLASS: type | None | bool = False  # False: not imported yet; None: pypardiso absent
-_INT32_MAX = np.iinfo(np.int32).max
+# ---- MKL PARDISO ------------------------------------------------------------------------
+_MKL: ctypes.CDLL | None | bool = False  # False: not looked for yet; None: not found
+_INT32_MAX = int(np.iinfo(np.int32).max)
+_I32P, _F64P = ctypes.POINTER(ctypes.c_int32), ctypes.POINTER(ctypes.c_double)
 
 
-def _pypardiso() -> type | None:
-    """pypardiso's PyPardisoSolver class, imported once (None where pypardiso or MKL is
-    absent).  Its import builds pypardiso's module-level solver, which looks for libmkl_rt
-    (0.1 to 0.3 s): done when the first sparse matrix is factorized, not at import."""
-    global _SOLVER_CLASS
-    if _SOLVER_CLASS is False:
+def _mkl_candidates():
+    """Paths to try for libmkl_rt, in order: $PYPARDISO_MKL_RT (read, as pypardiso does), the
+    library folder of this Python's prefix (where the mkl wheel installs it), the linker's
+    path (asked last, only when needed: find_library runs ldconfig, gcc and ld, 0.02 to
+    0.05 s)."""
+    yield os.environ.get("PYPARDISO_MKL_RT")
+    for prefix in dict.fromkeys((sys.prefix, sys.base_prefix)):
+        yield from sorted(glob.glob(os.path.join(prefix, "lib", "libmkl_rt.so*")), key=len)
+        yield from sorted(glob.glob(os.path.join(prefix, "Library", "bin", "mkl_rt*.dll")), key=len)
+    import ctypes.util
+
+    yield ctypes.util.find_library("mkl_rt")
+    yield ctypes.util.find_library("mkl_rt.1")
+
+
+def _mkl() -> ctypes.CDLL | None:
+    """MKL's runtime library (libmkl_rt) with the prototypes of the two functions used,
+    looked for once (_mkl_candidates).  Nothing process-wide is set: MKL's OpenMP threads
+    keep their default KMP_BLOCKTIME unless the user's environment says otherwise (below
+    PARALLEL_MIN unknowns PARDISO runs on one thread, which leaves nothing spinning)."""
+    global _MKL
+    if _MKL is not False:
+        return _MKL
+    _MKL = None
+    for path in filter(None, _mkl_candidates()):
         try:
-            from pypardiso import PyPardisoSolver
-        except ImportError:  # not installed (not x86-64), or libmkl_rt not found
-            _SOLVER_CLASS = None
-        else:
-            _SOLVER_CLASS = PyPardisoSolver
-    return _SOLVER_CLASS
+            lib = ctypes.CDLL(path)
+            pardiso, threads = lib.pardiso, lib.MKL_Set_Num_Threads_Local
+        except (OSError, AttributeError):
+            continue
+        # void pardiso(void *pt[64], const MKL_INT *maxfct, *mnum, *mtype, *phase, *n,
+        #              const void *a, const MKL_INT *ia, *ja, MKL_INT *perm, const MKL_INT *nrhs,
+        #              MKL_INT *iparm, const MKL_INT *msglvl, void *b, void *x, MKL_INT *error)
+        # with MKL_INT 32-bit (mkl_rt's default LP64 interface)
+        pardiso.argtypes = [ctypes.POINTER(ctypes.c_void_p), _I32P, _I32P, _I32P, _I32P, _I32P,
+                            _F64P, _I32P, _I32P, _I32P, _I32P, _I32P, _I32P, _F64P, _F64P, _I32P]
+        pardiso.restype = None
+        threads.argtypes = [ctypes.c_int]  # int MKL_Set_Num_Threads_Local(int): this thread only
+        threads.restype = ctypes.c_int
+        _MKL = lib
+        break
+    return _MKL
+
+
+def _address(a: np.ndarray) -> tuple[int, int]:
+    return a.__array_interface__["data"][0], a.size
+
+
+def _int32(a: np.ndarray, what: str) -> np.ndarray:
+    """a as a contiguous int32 array; ValueError where a value does not fit (PARDISO's LP64
+    interface takes 32-bit indices)."""
+    if a.size and (a.max() > _INT32_MAX or a.min() < 0):
+        raise ValueError(f"{what}: values up to {a.max()} do not fit PARDISO's 32-bit indices")
+    return np.ascontiguousarray(a, dtype=np.int32)
 
 
 class _Pardiso:
-    """One pypardiso solver object (real non-symmetric), driven phase by phase: analyse()
-    (phase 11: ordering and symbolic factorization) once per sparsity pattern, factor()
-    (phase 22) per matrix, solve() (phase 33) per set of right-hand sides, release()
-    (phase -1).  pypardiso's own factorize() and solve() run phases 12 and 13, which redo
-    the analysis on every matrix; set_phase() and the object's call (_call_pardiso, which
-    pypardiso's docstring names for phase 33 on a kept factorization) run one phase each.
-    Below PARALLEL_MIN unknowns every phase runs on one thread of this Python thread only
-    (MKL_Set_Num_Threads_Local; MKL's threads gain nothing there: benchmarks/README.md
-    § 3.2); the number is chosen at the analysis and kept for its phases."""
+    """One PARDISO handle (real non-symmetric, zero-based CSR): analyse() once per pattern,
+    factor() per matrix, solve() per set of right-hand sides, release() (phase -1).  Below
+    PARALLEL_MIN unknowns every phase runs on one thread (MKL's threads gain nothing there:
+    benchmarks/README.md § 3.2); the number of threads is chosen at the analysis and kept
+    for its phases.  The arguments are typed (_mkl: argtypes); the pointers to the scalars,
+    the handle and the pattern are made once per pattern, those to the values and the
+    right-hand sides per call (building every pointer on every call cost 10 to 20 us a call,
+    as pypardiso does: benchmarks/README.md § 3.9)."""
 
-    def __init__(self, solver_class: type):
-        self.solver = solver_class(mtype=11)
-        self._threads_local = self.solver.libmkl.MKL_Set_Num_Threads_Local
-        self._threads_local.argtypes = [ctypes.c_int]
-        self._threads_local.restype = ctypes.c_int
-        iparm = self.solver.set_iparm  # 1-based, as in MKL's Fortran documentation
-        iparm(1, 1)  # the values below, not the defaults
-        iparm(2, 2)  # nested dissection (METIS); minimum degree (0) for small n: analyse()
-        iparm(8, 0)  # iterative refinement only where pivots were perturbed
-        iparm(10, 13)  # pivots below 1e-13 |K| are perturbed (and counted: iparm 14)
-        iparm(11, 1)  # scaling and
-        iparm(13, 1)  # weighted matching, for non-symmetric matrices
-        iparm(12, 0)  # K x = b (CSR), not the transposed system
-        self._none = np.zeros(0)
-        self.K: sp.csr_matrix | None = None  # the analysed matrix (its pattern)
+    def __init__(self, lib: ctypes.CDLL):
+        self.lib = lib
+        self.pt = (ctypes.c_void_p * 64)()  # PARDISO's handle, zero before the first call
+        self.iparm = np.zeros(64, dtype=np.int32)
+        self.iparm[0] = 1  # the values below, not the defaults
+        self.iparm[1] = 2  # nested dissection (METIS); minimum degree (0) for small n: analyse()
+        self.iparm[7] = 0  # iterative refinement only where pivots were perturbed
+        self.iparm[9] = 13  # pivots below 1e-13 |K| are perturbed (and counted: iparm[13])
+        self.iparm[10] = 1  # scaling and
+        self.iparm[12] = 1  # weighted matching, for non-symmetric matrices
+        self.iparm[34] = 1  # zero-based indices
+        self.maxfct, self.mnum, self.mtype = ctypes.c_int32(1), ctypes.c_int32(1), ctypes.c_int32(11)
+        self.phase, self.n, self.nrhs = ctypes.c_int32(0), ctypes.c_int32(0), ctypes.c_int32(1)
+        self.msglvl, self.error = ctypes.c_int32(0), ctypes.c_int32(0)
+        self._scalars = [ctypes.pointer(c) for c in (self.maxfct, self.mnum, self.mtype, self.phase, self.n)]
+        self._p_nrhs, self._p_msglvl, self._p_error = (ctypes.pointer(c) for c in (self.nrhs, self.msglvl, self.error))
+        self._p_iparm = self.iparm.ctypes.data_as(_I32P)
+        self._dummy = np.zeros(1)
         self.threads = 0  # 0: MKL's own setting
+        self.indptr = self.indices = None
         self.token: object | None = None
 
-    def _call(self, phase: int, K: sp.csr_matrix, b: np.ndarray | None = None) -> np.ndarray:
-        """One phase on K; b: the right-hand sides (n,) or (n, k) in column-major order."""
-        self.solver.set_phase(phase)
-        before = self._threads_local(self.threads) if self.threads else 0
-        try:
-            return self.solver._call_pardiso(K, self._none if b is None else b)
-        except Exception as exc:  # pypardiso.PyPardisoError: PARDISO's error code
-            raise SingularTangentError(f"PARDISO phase {phase} failed: {exc}") from exc
-        finally:
-            if self.threads:
-                self._threads_local(before)
+    def _call(self, phase: int, data: np.ndarray, b: np.ndarray | None = None, x: np.ndarray | None = None) -> int:
+        if self.threads:
+            before = self.lib.MKL_Set_Num_Threads_Local(self.threads)  # this thread only
+            try:
+                return self._pardiso(phase, data, b, x)
+            finally:
+                self.lib.MKL_Set_Num_Threads_Local(before)
+        return self._pardiso(phase, data, b, x)
 
-    @property
-    def perturbed_pivots(self) -> int:
-        return int(self.solver.get_iparm(14))
+    def _pardiso(self, phase: int, data: np.ndarray, b: np.ndarray | None, x: np.ndarray | None) -> int:
+        """One call of pardiso(); data: K's values (float64, contiguous); b, x: the right-hand
+        sides and the solutions (self.nrhs columns, each contiguous, float64)."""
+        self.phase.value, self.error.value = phase, 0
+        b = self._dummy if b is None else b
+        x = self._dummy if x is None else x
+        self.lib.pardiso(self.pt, *self._scalars, data.ctypes.data_as(_F64P), self._p_indptr, self._p_indices, None,
+                         self._p_nrhs, self._p_iparm, self._p_msglvl, b.ctypes.data_as(_F64P),
+                         x.ctypes.data_as(_F64P), self._p_error)
+        return self.error.value
 
     def same_pattern(self, K: sp.csr_matrix) -> bool:
-        held = self.K
-        if held is None or K.shape != held.shape:
+        if self.indptr is None or K.shape[0] != self.n.value:
             return False
-        if (K.indices.ctypes.data == held.indices.ctypes.data and K.indptr.ctypes.data == held.indptr.ctypes.data
-                and K.indices.size == held.indices.size):
+        if _address(K.indices) == _address(self._src_indices) and _address(K.indptr) == _address(self._src_indptr):
             return True  # the arrays of the analysed matrix (kept alive here), not a copy
-        return np.array_equal(K.indptr, held.indptr) and np.array_equal(K.indices, held.indices)
+        return np.array_equal(K.indptr, self.indptr) and np.array_equal(K.indices, self.indices)
 
     def analyse(self, K: sp.csr_matrix) -> None:
-        """Phase 11: ordering and symbolic factorization of K's pattern."""
+        """Phase 11: ordering and symbolic factorization of K's pattern.  ValueError where K
+        is too large for 32-bit indices."""
         self.release()
         n = K.shape[0]
-        if n > _INT32_MAX or K.nnz > _INT32_MAX - 1:  # pypardiso passes 32-bit indices
-            raise ValueError(f"K ({n} unknowns, {K.nnz} non-zeros) is too large for PARDISO's 32-bit indices")
+        if n > _INT32_MAX:
+            raise ValueError(f"K has {n} unknowns: more than PARDISO's 32-bit indices can count")
+        indptr = _int32(K.indptr, f"K's row pointers ({K.nnz} non-zeros)")
+        indices = _int32(K.indices, "K's column indices")
         self.threads = 1 if n < PARALLEL_MIN else 0
-        self.solver.set_iparm(2, 0 if n <= MINIMUM_DEGREE_MAX else 2)
-        self._call(11, K)
-        self.K = K
+        self.iparm[1] = 0 if n <= MINIMUM_DEGREE_MAX else 2
+        self._src_indptr, self._src_indices = K.indptr, K.indices
+        self.indptr, self.indices = indptr, indices
+        self._p_indptr, self._p_indices = indptr.ctypes.data_as(_I32P), indices.ctypes.data_as(_I32P)
+        self.n.value = n
+        error = self._call(11, np.ascontiguousarray(K.data, dtype=float))
+        if error:
+            self.indptr = None
+            raise SingularTangentError(f"PARDISO analysis failed (error {error})")
 
-    def factor(self, K: sp.csr_matrix) -> None:
-        """Phase 22: numerical factorization of K (in the analysed pattern)."""
+    def factor(self, data: np.ndarray) -> None:
+        """Phase 22: numerical factorization of the values data (in the analysed pattern)."""
         self.token = None
-        self._call(22, K)
+        error = self._call(22, data)
+        if error:
+            raise SingularTangentError(f"PARDISO factorization failed (error {error})")
 
-    def solve(self, K: sp.csr_matrix, b: np.ndarray) -> np.ndarray:
+    def solve(self, data: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Phase 33: K^-1 b for b (n,) or (n, k).  Below PARALLEL_MIN unknowns one column at a
         time: a call with two right-hand sides took 1.4 times as long as two calls at 1e3
         unknowns; above, all in one call, which reads the factors once (benchmarks/README.md
         § 3.7)."""
-        if b.ndim == 1:
-            return self._call(33, K, np.ascontiguousarray(b, dtype=float))
-        if self.K is not None and K.shape[0] < PARALLEL_MIN:
-            return np.column_stack([self._call(33, K, np.ascontiguousarray(b[:, k], dtype=float))
-                                    for k in range(b.shape[1])])
-        return self._call(33, K, np.asfortranarray(b, dtype=float))
+        columns = np.ascontiguousarray(b.T if b.ndim == 2 else b[None], dtype=float)  # (k, n)
+        if columns.shape[1] != self.n.value or len(columns) > _INT32_MAX:
+            raise ValueError(f"right-hand sides of shape {b.shape} for K with {self.n.value} unknowns")
+        x = np.empty_like(columns)
+        blocks = zip(columns, x) if self.n.value < PARALLEL_MIN else ((columns, x),)
+        for bk, xk in blocks:
+            self.nrhs.value = 1 if bk.ndim == 1 else len(bk)
+            error = self._call(33, data, bk, xk)
+            if error:
+                raise SingularTangentError(f"PARDISO solve failed (error {error})")
+        return np.ascontiguousarray(x.T) if b.ndim == 2 else x[0]
 
     def release(self) -> None:
-        """Phase -1: free PARDISO's memory of this solver object."""
-        if self.K is not None:
-            self.K = None
-            self.threads = 0
-            self._call(-1, sp.csr_matrix((0, 0)))
+        """Phase -1: free PARDISO's memory of this handle."""
+        if self.indptr is not None:
+            self._call(-1, self._dummy)
+            self.indptr = None
         self.token = None
 
 
@@ -173,23 +242,22 @@ class _State(threading.local):
 _STATE = _State()
 
 
-def _factorize_pardiso(K: sp.csr_matrix, solver_class: type) -> Solve:
+def _factorize_pardiso(K: sp.csr_matrix, lib: ctypes.CDLL) -> Solve:
     s = _STATE.pardiso
     if s is None:
-        s = _STATE.pardiso = _Pardiso(solver_class)
+        s = _STATE.pardiso = _Pardiso(lib)
     if not s.same_pattern(K):
         s.analyse(K)
-    if K.dtype != np.float64:
-        K = K.astype(np.float64)
-    s.factor(K)
-    if s.perturbed_pivots > 0:
+    data = np.ascontiguousarray(K.data, dtype=float)
+    s.factor(data)
+    if s.iparm[13] > 0:
         return _factorize_superlu(K)
     token = s.token = object()
 
     def solve(b: np.ndarray) -> np.ndarray:
         if s.token is not token:
             raise RuntimeError("this factorization was replaced by a later factorize() call")
-        return _check(s.solve(K, np.asarray(b, dtype=float)))
+        return _check(s.solve(data, np.asarray(b, dtype=float)))
 
     return solve
 
@@ -253,9 +321,9 @@ def factorize(K: sp.spmatrix) -> Solve:
         K = K.sorted_indices()
     if np.any(np.diff(K.indptr) == 0):
         raise SingularTangentError("the tangent has an empty row")
-    solver_class = _pypardiso()
-    if solver_class is not None:
-        return _factorize_pardiso(K, solver_class)
+    lib = _mkl()
+    if lib is not None:
+        return _factorize_pardiso(K, lib)
     return _factorize_superlu(K)
 
 
