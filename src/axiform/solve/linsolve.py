@@ -11,7 +11,7 @@ The solver is chosen by the size n of K (benchmarks/README.md § 3.2 measured ea
   phase 22 (numerical factorization) for each K and phase 33 for each solve.  pypardiso
   installs MKL; only the library it brings is used here, found when first needed.  Its
   solver object, driven phase by phase, was measured slower (benchmarks/README.md § 3.9:
-  its import and constructor look for MKL through site-packages, 0.23 to 0.37 s a process,
+  its import and constructor look for MKL through site-packages, 0.24 to 0.40 s a process,
   and each call converts the indices to one-based and builds its pointers, +0.1 ms = +9 to
   13 % for a factorization and solve at 1e3 unknowns), so this module keeps its own binding
   (DESIGN § 12);
