@@ -7,6 +7,7 @@ import threading
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from scipy.sparse.linalg import spsolve
 
 import axiform.solve.linsolve as ls
 from axiform import Model, MooneyRivlin, rectangle
@@ -44,7 +45,7 @@ def test_backends_agree(monkeypatch, element):
         _backend(monkeypatch, name)
         x[name] = ls.factorize(K)(B)
         monkeypatch.undo()
-    ref = np.linalg.solve(K.toarray(), B)
+    ref = spsolve(K.tocsc(), B)
     for name, xi in x.items():
         assert np.abs(xi - ref).max() <= 1e-10 * np.abs(ref).max(), name
         assert xi.shape == B.shape
@@ -90,6 +91,59 @@ def test_singular_dense():
     K = sp.csr_matrix(np.array([[1.0, 2.0], [2.0, 4.0]]))
     with pytest.raises(ls.SingularTangentError):
         ls.factorize(K)
+
+
+@pytest.mark.parametrize("name", ["pardiso", "superlu"])
+def test_singular_sparse(monkeypatch, name):
+    """An exactly singular K (a zero column; PARDISO perturbs the zero pivot, which sends K
+    to SuperLU) raises SingularTangentError, so does an empty row (a dof nothing stiffens).
+    (Singular only up to round-off, e.g. two equal rows, SuperLU answers a finite x: the
+    module's documented limit.)"""
+    _backend(monkeypatch, name)
+    K, B = _tangent("q4", (7, 6), seed=5)
+    K = K.tolil()
+    K[:, 7] = 0.0
+    assert K.tocsr()[7].nnz > 0
+    with pytest.raises(ls.SingularTangentError):
+        ls.factorize(K.tocsr())(B)
+    K[7, :] = 0.0
+    with pytest.raises(ls.SingularTangentError, match="empty row"):
+        ls.factorize(K.tocsr())(B)
+
+
+def test_pardiso_typed_and_guarded(monkeypatch):
+    """The binding declares pardiso()'s prototype (16 typed pointers, no bare addresses),
+    writes nothing into the environment, and a K whose indices would not fit PARDISO's
+    32-bit integers raises a ValueError instead of being cast."""
+    _backend(monkeypatch, "pardiso")
+    import ctypes
+    import os
+
+    environ = dict(os.environ)
+    K, B = _tangent("q4", (7, 6), seed=6)
+    ls.factorize(K)(B)
+    assert dict(os.environ) == environ
+    argtypes = ls._mkl().pardiso.argtypes
+    assert len(argtypes) == 16 and ctypes.c_void_p not in argtypes
+    assert ls._mkl().MKL_Set_Num_Threads_Local.argtypes == [ctypes.c_int]
+    monkeypatch.setattr(ls, "_INT32_MAX", K.nnz - 1)
+    ls._STATE.pardiso.release()
+    with pytest.raises(ValueError, match="32-bit"):
+        ls.factorize(K)
+
+
+def test_pardiso_one_and_several_rhs(monkeypatch):
+    """1-D and (n, k) right-hand sides, below and above PARALLEL_MIN (one call per column or
+    all columns in one call), against spsolve."""
+    _backend(monkeypatch, "pardiso")
+    K, B = _tangent("q4", (7, 6), seed=4)
+    ref = spsolve(K.tocsc(), B)
+    for parallel_min in (10**9, 0):
+        monkeypatch.setattr(ls, "PARALLEL_MIN", parallel_min)
+        solve = ls.factorize(K)
+        assert np.abs(solve(B) - ref).max() <= 1e-10 * np.abs(ref).max()
+        assert np.abs(solve(B[:, 1]) - ref[:, 1]).max() <= 1e-10 * np.abs(ref).max()
+        assert solve(B[:, :1]).shape == (K.shape[0], 1)
 
 
 def test_threads_keep_their_own(monkeypatch):

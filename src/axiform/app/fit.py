@@ -40,6 +40,7 @@ from scipy.optimize import least_squares, lsq_linear
 
 from ..case.material import KEYS, MAX_OGDEN_TERMS, MaterialSpec
 from ..materials import ArrudaBoyce, Gent, Hyperelastic, MooneyRivlin, Ogden, Yeoh
+from ..post.fit_plots import plot_fit as plot
 
 MODES = ("uniaxial", "equibiaxial", "planar")
 STABILITY_STRETCHES = 10.0 ** np.linspace(-1.0, 1.0, 401)  # 0.1 to 10, 1 in the middle
@@ -319,30 +320,6 @@ def combined_range(result: FitResult) -> tuple[float, float] | None:
     if any(r is None for r in ranges):
         return None
     return max(r[0] for r in ranges), min(r[1] for r in ranges)
-
-
-def plot(result: FitResult, data: Data, mode: str, path: Path) -> None:
-    """Data as markers, the model as a line, for one mode."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    sel = data.mode == MODES.index(mode)
-    lam = data.stretch[sel]
-    grid = np.linspace(min(lam.min(), 1.0), lam.max() * 1.02, 300)
-    fig, ax = plt.subplots(figsize=(6.4, 4.6))
-    ax.plot(lam, data.stress[sel], "o", mfc="none", color="k", label="data")
-    ax.plot(grid, nominal_stress(result.law, mode, grid), "-", color="C3", label=f"{result.model} fit")
-    ax.axhline(0.0, color="0.8", lw=0.8)
-    ax.set_xlabel(f"stretch λ in the loading direction ({mode})")
-    ax.set_ylabel("nominal stress (units of the data)")
-    ax.set_title(f"{_name(result)}, {mode}: RMS relative error {100 * result.rms[mode]:.2f} %")
-    ax.legend(loc="upper left")
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
 
 
 def _name(result: FitResult) -> str:

@@ -40,6 +40,7 @@ from ..model.model import Model
 from .sensitivity import sensitivity
 from ..solve.solver import LoadControl, solve
 from ..post.thickness import thickness_table
+from ..post.optimize_plots import plot_optimization
 
 BOUNDS = (0.2, 5.0)  # design bounds, times the initial thickness
 METHODS = ("gradient", "fixed-point")
@@ -423,89 +424,6 @@ def write_outputs(out: Path, design: ThicknessDesign, result: OptimizeResult,
                "final": None if final is None else final.name}
     write_atomic(out / "optimize.json", json.dumps(summary, indent=2) + "\n")
     plot_optimization(out / "optimize.png", design, result, target)
-
-
-def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResult,
-                      target: tuple[np.ndarray, np.ndarray]) -> None:
-    """optimize.png: the section (initial parison filled, optimized parison outlined, their
-    final mid-surfaces and the moulds), the initial and optimized wall straightened (faces at
-    +-t/2 about the mid-surface against s, the same way), the final thickness of both against
-    the target (the stations outside the target's range shaded), and the objective and the max
-    deviation of each iteration against the forward solves spent."""
-    from ..post.plots import _pyplot, _save
-
-    plt = _pyplot()
-    units = design.built.case.units
-    length = f" [{units.length}]" if units.length else ""
-    grey, blue = "0.55", "C0"
-    runs = ((design.initial, result.initial, grey, "initial"), (result.best.design, result.best, blue, "optimized"))
-    fig, axes = plt.subplots(2, 2, figsize=(11, 8.5))
-    ax = axes[0, 0]
-    for values, it, colour, name in runs:
-        model = design.model(values)
-        f = model.mesh.fibres
-        a, b = model.mesh.points[f[:, 0]], model.mesh.points[f[:, -1]]
-        ring = np.vstack([a, b[::-1], a[:1]])
-        if it is result.initial:
-            ax.fill(ring[:, 0], ring[:, 1], color=colour, alpha=0.5, lw=0, label=f"{name} parison")
-        else:
-            ax.plot(ring[:, 0], ring[:, 1], "-", color=colour, lw=0.9, label=f"{name} parison")
-        if it.thickness is not None:
-            ax.plot(it.thickness["r"], it.thickness["z"], "-", color=colour, lw=1.2, label=f"{name}: final wall")
-    end = float(design.control.target)
-    for k, pair in enumerate(design.built.model.contacts):
-        pts = pair.surface.polyline() + pair.surface.offset(end)
-        ax.plot(pts[:, 0], pts[:, 1], "k-", lw=1.0, label="mould" if k == 0 else None)
-    ax.set_xlim(0, 1.08 * ax.get_xlim()[1])
-    ax.set_aspect("equal", adjustable="box")
-    ax.set_xlabel("r" + length)
-    ax.set_ylabel("z" + length)
-    ax.set_title("section: parison and final wall (mid-surface)")
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)  # beside the tall part
-    ax = axes[0, 1]
-    s_fine = np.linspace(design.knots[0], design.knots[-1], 400)
-    for values, _, colour, name in runs:
-        t = np.interp(s_fine, design.knots, values)
-        if values is design.initial:
-            ax.fill_between(s_fine, -t / 2, t / 2, color=colour, alpha=0.5, lw=0, label=f"{name} wall")
-        else:
-            ax.plot(s_fine, t / 2, "-", color=colour, lw=1.2, label=f"{name} wall")
-            ax.plot(s_fine, -t / 2, "-", color=colour, lw=1.2)
-        ax.plot(design.knots, values / 2, "o", color=colour, ms=4)
-    ax.axhline(0.0, color="k", lw=0.5)
-    ax.set_xlabel("reference arc length s" + length)
-    ax.set_ylabel("faces at ±t/2 about the mid-surface" + length)
-    ax.set_title("the wall straightened (dots: the thickness table)")
-    ax.legend(fontsize=8)
-    ax = axes[1, 0]
-    s_t, t_t = target
-    top = [t_t.max()]
-    s_all = design.built.model.mesh.fibre_s
-    outside = [(a, b) for a, b in ((s_all[0], s_t[0]), (s_t[-1], s_all[-1])) if b > a]
-    for k, (a, b) in enumerate(outside):
-        ax.axvspan(a, b, color="0.9", lw=0, label=None if k else "not in the target")
-    for _, it, colour, name in runs:
-        if it.thickness is not None:
-            ax.plot(it.thickness["s"], it.thickness["thickness"], ".-", color=colour, label=f"with the {name} design")
-            top.append(it.thickness["thickness"].max())
-    ax.plot(s_t, t_t, "k--", lw=1.2, label="target")
-    ax.set_ylim(0, 1.1 * max(top))
-    ax.set_xlabel("reference arc length s" + length)
-    ax.set_ylabel("final thickness" + length)
-    ax.set_title(f"final wall: max deviation {100 * result.initial.deviation:.3g} % -> "
-                 f"{100 * result.best.deviation:.3g} %")
-    ax.legend(fontsize=8)
-    ax = axes[1, 1]
-    solves = [r[3] for r in result.rows]  # the cost: rejected trials of the gradient method count too
-    ax.semilogy(solves, [r[1] for r in result.rows], "o-", color=blue, label="objective")
-    ax.semilogy(solves, [r[2] for r in result.rows], "s--", color="C1", label="max relative deviation")
-    ax.axhline(result.tolerance, color="C1", lw=0.8, ls=":", label=f"tolerance {result.tolerance:g}")
-    ax.set_xlabel("forward solves (a marker per iteration)")
-    ax.set_title(f"{result.method}: {len(result.rows) - 1} iterations, {result.forward_solves} forward solves")
-    ax.xaxis.get_major_locator().set_params(integer=True)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    _save(fig, path)
 
 
 def run(case_path: str, target_path: str, out: str, max_iter: int = 20, method: str = "gradient",

@@ -5,12 +5,16 @@ The solver is chosen by the size n of K (benchmarks/README.md § 3.2 measured ea
 
 - n <= DENSE_MAX: dense LAPACK LU (getrf / getrs), where the sparse solvers' fixed costs
   exceed the whole dense work;
-- larger: MKL PARDISO (matrix type 11, real non-symmetric) called through ctypes, phase 11
-  (ordering: minimum degree below MINIMUM_DEGREE_MAX unknowns, METIS nested dissection
-  above; symbolic factorization) once for each sparsity pattern, then phase 22
-  (numerical factorization) for each K and phase 33 for each solve.  pypardiso, which
-  installs MKL, redoes phase 11 on every factorization, and its import scans site-packages
-  (0.1 to 0.5 s): only the library it brings is used here, found when first needed;
+- larger: MKL PARDISO (matrix type 11, real non-symmetric) called through ctypes with typed
+  prototypes, phase 11 (ordering: minimum degree below MINIMUM_DEGREE_MAX unknowns, METIS
+  nested dissection above; symbolic factorization) once for each sparsity pattern, then
+  phase 22 (numerical factorization) for each K and phase 33 for each solve.  pypardiso
+  installs MKL; only the library it brings is used here, found when first needed.  Its
+  solver object, driven phase by phase, was measured slower (benchmarks/README.md § 3.9:
+  its import and constructor look for MKL through site-packages, 0.24 to 0.40 s a process,
+  and each call converts the indices to one-based and builds its pointers, +0.1 ms = +9 to
+  13 % for a factorization and solve at 1e3 unknowns), so this module keeps its own binding
+  (DESIGN § 12);
 - without MKL (not x86-64): SciPy's SuperLU with the column ordering minimum degree on
   K^T K (MMD_ATA), computed once per pattern and then given as the natural order of the
   permuted K.  A column ordering bounds the fill whatever rows partial pivoting picks;
@@ -58,12 +62,15 @@ def _check(x: np.ndarray) -> np.ndarray:
 
 # ---- MKL PARDISO ------------------------------------------------------------------------
 _MKL: ctypes.CDLL | None | bool = False  # False: not looked for yet; None: not found
+_INT32_MAX = int(np.iinfo(np.int32).max)
+_I32P, _F64P = ctypes.POINTER(ctypes.c_int32), ctypes.POINTER(ctypes.c_double)
 
 
 def _mkl_candidates():
-    """Paths to try for libmkl_rt, in order: $PYPARDISO_MKL_RT, the library folder of this
-    Python's prefix (where the mkl wheel installs it), the linker's path (asked last, only
-    when needed: find_library runs ldconfig, gcc and ld, 0.02 to 0.05 s)."""
+    """Paths to try for libmkl_rt, in order: $PYPARDISO_MKL_RT (read, as pypardiso does), the
+    library folder of this Python's prefix (where the mkl wheel installs it), the linker's
+    path (asked last, only when needed: find_library runs ldconfig, gcc and ld, 0.02 to
+    0.05 s)."""
     yield os.environ.get("PYPARDISO_MKL_RT")
     for prefix in dict.fromkeys((sys.prefix, sys.base_prefix)):
         yield from sorted(glob.glob(os.path.join(prefix, "lib", "libmkl_rt.so*")), key=len)
@@ -75,26 +82,31 @@ def _mkl_candidates():
 
 
 def _mkl() -> ctypes.CDLL | None:
-    """MKL's runtime library (libmkl_rt), looked for once (_mkl_candidates)."""
+    """MKL's runtime library (libmkl_rt) with the prototypes of the two functions used,
+    looked for once (_mkl_candidates).  Nothing process-wide is set: MKL's OpenMP threads
+    keep their default KMP_BLOCKTIME unless the user's environment says otherwise (below
+    PARALLEL_MIN unknowns PARDISO runs on one thread, which leaves nothing spinning)."""
     global _MKL
     if _MKL is not False:
         return _MKL
-    # MKL's OpenMP threads otherwise spin 200 ms after each factorization, on the core that
-    # the evaluation between two factorizations needs (on a loaded machine the plate's solve
-    # took twice as long); read when the runtime starts, so set before the library loads
-    os.environ.setdefault("KMP_BLOCKTIME", "0")
     _MKL = None
     for path in filter(None, _mkl_candidates()):
         try:
             lib = ctypes.CDLL(path)
-            lib.pardiso.restype = None
-            lib.pardiso.argtypes = [ctypes.c_void_p] * 16  # addresses, passed as Python ints
-            lib.MKL_Set_Num_Threads_Local.restype = ctypes.c_int
-            lib.MKL_Set_Num_Threads_Local.argtypes = [ctypes.c_int]
-            _MKL = lib
-            break
+            pardiso, threads = lib.pardiso, lib.MKL_Set_Num_Threads_Local
         except (OSError, AttributeError):
             continue
+        # void pardiso(void *pt[64], const MKL_INT *maxfct, *mnum, *mtype, *phase, *n,
+        #              const void *a, const MKL_INT *ia, *ja, MKL_INT *perm, const MKL_INT *nrhs,
+        #              MKL_INT *iparm, const MKL_INT *msglvl, void *b, void *x, MKL_INT *error)
+        # with MKL_INT 32-bit (mkl_rt's default LP64 interface)
+        pardiso.argtypes = [ctypes.POINTER(ctypes.c_void_p), _I32P, _I32P, _I32P, _I32P, _I32P,
+                            _F64P, _I32P, _I32P, _I32P, _I32P, _I32P, _I32P, _F64P, _F64P, _I32P]
+        pardiso.restype = None
+        threads.argtypes = [ctypes.c_int]  # int MKL_Set_Num_Threads_Local(int): this thread only
+        threads.restype = ctypes.c_int
+        _MKL = lib
+        break
     return _MKL
 
 
@@ -102,21 +114,27 @@ def _address(a: np.ndarray) -> tuple[int, int]:
     return a.__array_interface__["data"][0], a.size
 
 
-# the scalar arguments of pardiso(), by their place in _Pardiso.scalars
-_MAXFCT, _MNUM, _MTYPE, _PHASE, _N, _NRHS, _MSGLVL, _ERROR = range(8)
+def _int32(a: np.ndarray, what: str) -> np.ndarray:
+    """a as a contiguous int32 array; ValueError where a value does not fit (PARDISO's LP64
+    interface takes 32-bit indices)."""
+    if a.size and (a.max() > _INT32_MAX or a.min() < 0):
+        raise ValueError(f"{what}: values up to {a.max()} do not fit PARDISO's 32-bit indices")
+    return np.ascontiguousarray(a, dtype=np.int32)
 
 
 class _Pardiso:
     """One PARDISO handle (real non-symmetric, zero-based CSR): analyse() once per pattern,
-    factor() per matrix, solve() per right-hand side.  Below PARALLEL_MIN unknowns
-    every phase runs on one thread (MKL's threads gain nothing there: benchmarks/README.md
-    § 3.2); the number of threads is chosen at the analysis and kept for its phases.
-    The arguments are passed as addresses of arrays held here (scalars included), set once
-    per pattern: building ctypes pointers on every call cost 10 to 20 us a call."""
+    factor() per matrix, solve() per set of right-hand sides, release() (phase -1).  Below
+    PARALLEL_MIN unknowns every phase runs on one thread (MKL's threads gain nothing there:
+    benchmarks/README.md § 3.2); the number of threads is chosen at the analysis and kept
+    for its phases.  The arguments are typed (_mkl: argtypes); the pointers to the scalars,
+    the handle and the pattern are made once per pattern, those to the values and the
+    right-hand sides per call (building every pointer on every call cost 10 to 20 us a call,
+    as pypardiso does: benchmarks/README.md § 3.9)."""
 
     def __init__(self, lib: ctypes.CDLL):
         self.lib = lib
-        self.pt = np.zeros(64, dtype=np.int64)
+        self.pt = (ctypes.c_void_p * 64)()  # PARDISO's handle, zero before the first call
         self.iparm = np.zeros(64, dtype=np.int32)
         self.iparm[0] = 1  # the values below, not the defaults
         self.iparm[1] = 2  # nested dissection (METIS); minimum degree (0) for small n: analyse()
@@ -125,9 +143,13 @@ class _Pardiso:
         self.iparm[10] = 1  # scaling and
         self.iparm[12] = 1  # weighted matching, for non-symmetric matrices
         self.iparm[34] = 1  # zero-based indices
-        self.scalars = np.array([1, 1, 11, 0, 0, 1, 0, 0], dtype=np.int32)
+        self.maxfct, self.mnum, self.mtype = ctypes.c_int32(1), ctypes.c_int32(1), ctypes.c_int32(11)
+        self.phase, self.n, self.nrhs = ctypes.c_int32(0), ctypes.c_int32(0), ctypes.c_int32(1)
+        self.msglvl, self.error = ctypes.c_int32(0), ctypes.c_int32(0)
+        self._scalars = [ctypes.pointer(c) for c in (self.maxfct, self.mnum, self.mtype, self.phase, self.n)]
+        self._p_nrhs, self._p_msglvl, self._p_error = (ctypes.pointer(c) for c in (self.nrhs, self.msglvl, self.error))
+        self._p_iparm = self.iparm.ctypes.data_as(_I32P)
         self._dummy = np.zeros(1)
-        self.n = 0
         self.threads = 0  # 0: MKL's own setting
         self.indptr = self.indices = None
         self.token: object | None = None
@@ -142,36 +164,38 @@ class _Pardiso:
         return self._pardiso(phase, data, b, x)
 
     def _pardiso(self, phase: int, data: np.ndarray, b: np.ndarray | None, x: np.ndarray | None) -> int:
-        """One call of pardiso(); b, x: the right-hand sides and the solutions (scalars[_NRHS]
-        columns, each contiguous)."""
-        c = self.scalars
-        c[_PHASE], c[_ERROR] = phase, 0
-        at = self._at
-        self.lib.pardiso(at[0], at[1] + 4 * _MAXFCT, at[1] + 4 * _MNUM, at[1] + 4 * _MTYPE,
-                         at[1] + 4 * _PHASE, at[1] + 4 * _N, data.ctypes.data, at[2], at[3], None,
-                         at[1] + 4 * _NRHS, at[4], at[1] + 4 * _MSGLVL,
-                         (self._dummy if b is None else b).ctypes.data,
-                         (self._dummy if x is None else x).ctypes.data, at[1] + 4 * _ERROR)
-        return int(c[_ERROR])
+        """One call of pardiso(); data: K's values (float64, contiguous); b, x: the right-hand
+        sides and the solutions (self.nrhs columns, each contiguous, float64)."""
+        self.phase.value, self.error.value = phase, 0
+        b = self._dummy if b is None else b
+        x = self._dummy if x is None else x
+        self.lib.pardiso(self.pt, *self._scalars, data.ctypes.data_as(_F64P), self._p_indptr, self._p_indices, None,
+                         self._p_nrhs, self._p_iparm, self._p_msglvl, b.ctypes.data_as(_F64P),
+                         x.ctypes.data_as(_F64P), self._p_error)
+        return self.error.value
 
     def same_pattern(self, K: sp.csr_matrix) -> bool:
-        if self.indptr is None or K.shape[0] != self.n:
+        if self.indptr is None or K.shape[0] != self.n.value:
             return False
         if _address(K.indices) == _address(self._src_indices) and _address(K.indptr) == _address(self._src_indptr):
             return True  # the arrays of the analysed matrix (kept alive here), not a copy
         return np.array_equal(K.indptr, self.indptr) and np.array_equal(K.indices, self.indices)
 
     def analyse(self, K: sp.csr_matrix) -> None:
-        """Phase 11: ordering and symbolic factorization of K's pattern."""
+        """Phase 11: ordering and symbolic factorization of K's pattern.  ValueError where K
+        is too large for 32-bit indices."""
         self.release()
-        self.n = K.shape[0]
-        self.threads = 1 if self.n < PARALLEL_MIN else 0
-        self.iparm[1] = 0 if self.n <= MINIMUM_DEGREE_MAX else 2
+        n = K.shape[0]
+        if n > _INT32_MAX:
+            raise ValueError(f"K has {n} unknowns: more than PARDISO's 32-bit indices can count")
+        indptr = _int32(K.indptr, f"K's row pointers ({K.nnz} non-zeros)")
+        indices = _int32(K.indices, "K's column indices")
+        self.threads = 1 if n < PARALLEL_MIN else 0
+        self.iparm[1] = 0 if n <= MINIMUM_DEGREE_MAX else 2
         self._src_indptr, self._src_indices = K.indptr, K.indices
-        self.indptr = np.ascontiguousarray(K.indptr, dtype=np.int32)
-        self.indices = np.ascontiguousarray(K.indices, dtype=np.int32)
-        self.scalars[_N] = self.n
-        self._at = [a.ctypes.data for a in (self.pt, self.scalars, self.indptr, self.indices, self.iparm)]
+        self.indptr, self.indices = indptr, indices
+        self._p_indptr, self._p_indices = indptr.ctypes.data_as(_I32P), indices.ctypes.data_as(_I32P)
+        self.n.value = n
         error = self._call(11, np.ascontiguousarray(K.data, dtype=float))
         if error:
             self.indptr = None
@@ -190,10 +214,12 @@ class _Pardiso:
         unknowns; above, all in one call, which reads the factors once (benchmarks/README.md
         § 3.7)."""
         columns = np.ascontiguousarray(b.T if b.ndim == 2 else b[None], dtype=float)  # (k, n)
+        if columns.shape[1] != self.n.value or len(columns) > _INT32_MAX:
+            raise ValueError(f"right-hand sides of shape {b.shape} for K with {self.n.value} unknowns")
         x = np.empty_like(columns)
-        blocks = zip(columns, x) if self.n < PARALLEL_MIN else ((columns, x),)
+        blocks = zip(columns, x) if self.n.value < PARALLEL_MIN else ((columns, x),)
         for bk, xk in blocks:
-            self.scalars[_NRHS] = 1 if bk.ndim == 1 else len(bk)
+            self.nrhs.value = 1 if bk.ndim == 1 else len(bk)
             error = self._call(33, data, bk, xk)
             if error:
                 raise SingularTangentError(f"PARDISO solve failed (error {error})")

@@ -1,0 +1,101 @@
+"""What a results folder says, for its pictures: summary.json (FolderInfo: the title, units,
+the loaded quantity and each monitor's quantity), history.csv (read_history) and the VTU
+files of fields.pvd (written_steps, last_vtu) with the moulds of their steps (surfaces_of)."""
+
+from __future__ import annotations
+
+import csv
+import json
+from dataclasses import dataclass, field as dc_field
+from pathlib import Path
+from typing import Any
+from xml.etree import ElementTree as ET
+
+import numpy as np
+
+from .labels import load_values, short, unit_of, with_unit
+
+
+class FieldError(ValueError):
+    """A field (or component) that the results folder does not have."""
+
+
+@dataclass
+class FolderInfo:
+    """What summary.json says about the numbers: the case title, its units, the quantity the
+    load factor scales (labels.loaded_quantity) and each monitor's quantity."""
+
+    title: str = ""
+    units: dict[str, str] = dc_field(default_factory=dict)
+    load: dict[str, Any] | None = None
+    monitor_quantities: dict[str, str] = dc_field(default_factory=dict)
+    contacts: list[str] = dc_field(default_factory=list)  # the mould pieces' names, pair by pair
+
+    @classmethod
+    def read(cls, folder: Path) -> "FolderInfo":
+        path = Path(folder) / "summary.json"
+        if not path.exists():
+            return cls()
+        s = json.loads(path.read_text())
+        contacts = [c.get("name", f"contact[{k}]") for k, c in enumerate(s.get("contact") or [])]
+        return cls(s.get("title", ""), s.get("units") or {}, s.get("load"), s.get("monitor_quantities") or {},
+                   contacts)
+
+    def contact_name(self, k: int) -> str:
+        """The name of mould piece k (pair k of contact.csv)."""
+        return self.contacts[k] if k < len(self.contacts) else f"contact[{k}]"
+
+    def load_label(self) -> str:
+        """The load axis: the loaded quantity with its unit, or the load factor."""
+        if self.load is None:
+            return "load factor λ"
+        return with_unit(self.load.get("name", self.load["quantity"]), self.load["quantity"], self.units)
+
+    def load_of(self, history: dict[str, np.ndarray]) -> np.ndarray:
+        """The loaded quantity at each row of history.csv."""
+        if self.load is None:
+            return history["load_factor"]
+        if "monitor" in self.load:
+            return history[self.load["monitor"]]
+        return load_values(self.load, history["load_factor"])
+
+    def state(self, step: int, history: dict[str, np.ndarray]) -> str:
+        """'step 40, p = 33.4 psi': the step and its load, rounded."""
+        rows = np.flatnonzero(history.get("step", np.array([])) == step) if history else []
+        if len(rows) == 0:
+            return f"step {step}"
+        value = self.load_of(history)[rows[0]]
+        if self.load is None:
+            return f"step {step}, λ = {short(value)}"
+        symbol = {"pressure": "p", "force": "F"}.get(self.load["quantity"], "")
+        name = symbol if self.load.get("name") in ("pressure", "force") else self.load.get("name", symbol)
+        unit = unit_of(self.load["quantity"], self.units)
+        return f"step {step}, {name} = {short(value)}" + (f" {unit}" if unit else "")
+
+
+def read_history(path: Path) -> dict[str, np.ndarray]:
+    """history.csv as columns (step, load_factor, iterations, monitors...)."""
+    with open(path) as fh:
+        rows = list(csv.DictReader(fh))
+    if not rows:
+        return {}
+    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
+
+
+def written_steps(folder: Path) -> list[Path]:
+    """The VTU files of fields.pvd, in order."""
+    pvd = Path(folder) / "fields.pvd"
+    if not pvd.exists():
+        return []
+    return [Path(folder) / d.get("file") for d in ET.parse(pvd).getroot().iter("DataSet")]
+
+
+def last_vtu(folder: Path) -> Path | None:
+    files = written_steps(folder)
+    return files[-1] if files else None
+
+
+def surfaces_of(vtu: Path) -> Path:
+    """The moulds at the step of a VTU file (fields/surfaces_NNNN.csv), else the last ones."""
+    own = vtu.parent / f"surfaces_{vtu.stem.split('_')[-1]}.csv"
+    return own if own.exists() else vtu.parent.parent / "surfaces.csv"
