@@ -100,8 +100,10 @@ SURFACES = {
 
 
 @pytest.mark.parametrize("law", [{}, {"friction": 0.05}, {"friction": 50.0}, {"sticky": True},
-                                 {"penalty": None, "modulus": 4.0, "friction": 0.05}],
-                         ids=["frictionless", "slip", "stick", "sticky", "default penalty"])
+                                 {"penalty": None, "modulus": 4.0, "friction": 0.05},
+                                 {"stabilization": 0.05}, {"stabilization": 0.05, "friction": 0.05}],
+                         ids=["frictionless", "slip", "stick", "sticky", "default penalty", "stabilized",
+                              "stabilized slip"])
 @pytest.mark.parametrize("surface", list(SURFACES))
 def test_contact_tangent_matches_difference_of_residual(element, surface, law):
     model, pair = _contact_model(element, SURFACES[surface](), **law)

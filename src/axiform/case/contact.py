@@ -105,6 +105,9 @@ class ContactSpec(Strict):
     motion: MotionSpec = MotionSpec()
     depth: PositiveFloat | None = None
     search: Literal["buckets", "binary", "brute"] = "buckets"
+    # contact stabilization, a fraction of the normal penalty (ContactPair); absent: on for a
+    # body held only by contact, off elsewhere
+    stabilization: Annotated[float, Field(ge=0, le=1)] | None = None
 
     @model_validator(mode="after")
     def _law(self):
@@ -190,7 +193,7 @@ def contact_pair(mesh: Mesh, model: Model, spec: ContactSpec, base: Path, where:
     try:
         pair = ContactPair(mesh, surface, slaves, spec.penalty, friction=spec.friction, sticky=spec.sticky,
                            tangential_penalty=spec.tangential_penalty, depth=spec.depth, search=spec.search,
-                           modulus=youngs_modulus(model.material))
+                           modulus=youngs_modulus(model.material), stabilization=spec.stabilization)
     except ValueError as exc:
         raise CaseError(f"{where}.slaves: {exc}") from None
     pair.name = spec.name or (spec.surface.layer.lower() if spec.surface.layer else None)

@@ -22,6 +22,9 @@ Z_SATURATED = 3.0
 # the mid-point of a straight slave edge is held this fraction of the reference wall height
 # behind the surface: a convex tool does not cut through the wall between two nodes
 GUARD_ALLOWANCE = 0.25
+# contact stabilization of a body held only by contact: the damping per unit current area
+# and unit normal motion, as a fraction of the normal penalty (ContactPair, stabilization)
+STABILIZATION = 1e-4
 
 
 def _normal_law(g: np.ndarray, touching: np.ndarray, kn, d: float):
@@ -99,6 +102,17 @@ class ContactPair:
     coarse blown bottle's final wall (misfit to a uniform wall 0.0580 against 0.0575) and made
     the optimisation of its parison take 5 forward solves instead of 3.
 
+    Contact stabilization (`stabilization` > 0, a fraction of the normal penalty; None: the
+    model decides, STABILIZATION for a body held only by contact, else 0): a body that no
+    support holds along z (a gasket between two plates, a ring dropped into a groove) has no
+    stiffness against that motion until it touches, and Newton cannot start.  Every slave
+    node that is not pressed into the surface gets a normal damping traction
+    -c s(g) ((x - x_prev) . n) n, c = stabilization kn: it resists the node's normal motion
+    relative to the surface since the last converged step, and fades out over the rounding
+    band of the normal law (s = 1 for g >= 0, 0 for g <= -smoothing, a cubic between), so it
+    vanishes as contact closes.  The energy it dissipates, 1/2 c s delta^2 per unit area a
+    step, is summed in the state (`damping_work`) and reported.
+
     The pair keeps nothing between calls: its history (`ContactState`: stick points, sticky
     nodes, and `first_contact` (n,): the process time t of the step in which each node first
     touched (for sticky contact: froze), NaN where it never did) is handed to `evaluate`,
@@ -108,7 +122,7 @@ class ContactPair:
     def __init__(self, mesh: Mesh, surface: RigidSurface, slaves: np.ndarray, penalty: float | None = None,
                  friction: float = 0.0, sticky: bool = False, tangential_penalty: float | None = None,
                  depth: float | None = None, search: str = "buckets", smoothing: float | None = None,
-                 modulus: float | None = None):
+                 modulus: float | None = None, stabilization: float | None = None):
         edges = slave_edges(mesh, np.asarray(slaves))
         if len(edges) == 0:
             raise ValueError("the slave nodes hold no boundary edge (select a face, not single nodes)")
@@ -160,6 +174,7 @@ class ContactPair:
         self.depth = depth if depth is not None else 0.5 * mesh.size()
         self.smoothing = smoothing if smoothing is not None else 1e-3 * mesh.size()
         self.search = search
+        self.stabilization = stabilization  # None: decided by the model (Model.finalize)
         self.name: str | None = None  # a label for plots and summary.json (case file: [[contact]] name)
 
     def initial_state(self) -> ContactState:
@@ -191,6 +206,12 @@ class ContactPair:
         ratio = np.where(self.on_axis, 1.0, a / np.where(self.on_axis, 1.0, self.area0)) ** self.thinning
         w, dw = a * ratio, np.where(self.on_axis, 1.0, (1.0 + self.thinning) * ratio)
         t, dt, status, proj, x, slip = self._traction(xa - self.surface.offset(lam), state, predicting)
+        work = state.damping_work
+        if self.stabilization:
+            ts, dts, energy = self._damping(x, state, proj)
+            t += ts
+            dt += dts
+            work += float(w @ energy)
         f = w[:, None] * t
         K = w[:, None, None] * dt
         e = self.edges
@@ -200,7 +221,28 @@ class ContactPair:
         if guard_force is None:
             guard_force = np.zeros((len(e) if self.guarded else 1, 2))
         seen = ContactSeen(x, proj, f, status, a, ratio[:, None] * t, guard_force)
-        return ContactTrial(f, K, C.reshape(m, 2 * k, 2 * k), pole_rate, self._next(state, seen, slip, lam))
+        return ContactTrial(f, K, C.reshape(m, 2 * k, 2 * k), pole_rate, self._next(state, seen, slip, lam, work))
+
+    def _damping(self, x: np.ndarray, state: ContactState, proj):
+        """The stabilization's traction per unit of w (n, 2), its derivative d/dx (n, 2, 2)
+        and the energy it dissipates over the step per unit of w (n,), at positions x
+        relative to the surface (the class: contact stabilization)."""
+        c = self.stabilization * self.kn0
+        d = self.smoothing
+        free = proj.active & ~state.stuck
+        xi = np.clip(-proj.g / d, 0.0, 1.0)  # 0 at the surface, 1 at the depth of the rounding
+        s = np.where(free, 1.0 - xi * xi * (3.0 - 2.0 * xi), 0.0)
+        ds = np.where(free, 6.0 * xi * (1.0 - xi) / d, 0.0)  # ds/dg
+        step = x - state.x_prev  # the motion relative to the surface since the last converged step
+        nv, tv = proj.n, proj.t
+        delta = np.einsum("ij,ij->i", step, nv)
+        along = np.einsum("ij,ij->i", step, tv)
+        fs = -c * s * delta
+        # d(fs n)/dx = n (dfs/dx)^T + fs dn/dx, dn/dx = kappa t t^T, d delta/dx = n + kappa (step . t) t
+        K = -(c * ds * delta)[:, None, None] * outer(nv, nv)
+        K -= (c * s)[:, None, None] * outer(nv, nv + (proj.kappa * along)[:, None] * tv)
+        K += (fs * proj.kappa)[:, None, None] * outer(tv, tv)
+        return fs[:, None] * nv, K, 0.5 * c * s * delta * delta
 
     def _poles(self, x, t, dt, f, C):
         """Add to the forces f (n, 2) and to the coupling C (m, k, 2, k, 2), in place, the
@@ -325,7 +367,7 @@ class ContactPair:
             status[tied] = 3
         return f, K, status, proj, x, slip_state
 
-    def _next(self, state: ContactState, seen: ContactSeen, slip_state, lam: float) -> ContactState:
+    def _next(self, state: ContactState, seen: ContactSeen, slip_state, lam: float, work: float) -> ContactState:
         """The history after a step that ends at the evaluation `seen` from `state`: positions
         for the crossing test, stick points, newly stuck nodes, the time of first contact."""
         x, proj, status = seen.x, seen.proj, seen.status
@@ -346,7 +388,7 @@ class ContactPair:
             stuck_point[new] = x[new] - proj.g[new, None] * proj.n[new]
             stuck = stuck | new
         first = np.where((status > 0) & np.isnan(state.first_contact), lam, state.first_contact)
-        return ContactState(self.nodes, x.copy(), s_stick, stuck, stuck_point, first, seen)
+        return ContactState(self.nodes, x.copy(), s_stick, stuck, stuck_point, first, seen, work)
 
     def report(self, state: ContactState) -> dict:
         """Per node of the committed `state`'s evaluation: current (r, z) in the global frame, gap, contact

@@ -30,7 +30,8 @@ class ContactState:
     """The history of a pair, per slave node (n,), as of one converged step: positions for
     the crossing test x_prev (n, 2) (surface frame), friction stick points s_stick (NaN:
     none), sticky nodes and their points, the time of first contact (NaN: never); and what
-    the step's evaluation found (`seen`, None before the first step and after a restart).
+    the step's evaluation found (`seen`, None before the first step and after a restart),
+    and the energy the contact stabilization has dissipated.
     Immutable: an evaluation returns a new (trial) state, the solver keeps the committed one."""
 
     nodes: np.ndarray
@@ -40,22 +41,23 @@ class ContactState:
     stuck_point: np.ndarray
     first_contact: np.ndarray
     seen: ContactSeen | None = None
+    damping_work: float = 0.0  # the energy the contact stabilization dissipated so far
 
-    HISTORY = ("x_prev", "s_stick", "stuck", "stuck_point", "first_contact")
+    HISTORY = ("x_prev", "s_stick", "stuck", "stuck_point", "first_contact", "damping_work")
 
     def to_dict(self) -> dict[str, np.ndarray]:
         """The history arrays (a checkpoint)."""
-        return {k: getattr(self, k).copy() for k in self.HISTORY}
+        return {k: np.array(getattr(self, k), copy=True) for k in self.HISTORY}
 
     def from_dict(self, saved: dict[str, np.ndarray]) -> "ContactState":
         """This state with the history arrays of `saved` (ContactState.to_dict), checked."""
         values = {}
         for k in self.HISTORY:
             v = np.asarray(saved[k])
-            ref = getattr(self, k)
+            ref = np.asarray(getattr(self, k))
             if v.shape != ref.shape:
                 raise ValueError(f"contact state '{k}' has shape {v.shape}, not {ref.shape}")
-            values[k] = v.astype(ref.dtype, copy=True)
+            values[k] = v.astype(ref.dtype, copy=True) if ref.ndim else float(v)
         return replace(self, seen=None, **values)
 
 

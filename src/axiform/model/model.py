@@ -21,6 +21,8 @@ from ..fem.graphs import connected_components
 from ..fem.loads import FollowerPressure
 from ..fem.mixed import MixedAssembly
 from ..fem.mesh import Mesh
+from ..contact.pair import STABILIZATION
+from .guards import bodies, free_to_slide
 from .state import CavityState, ModelState
 from .terms import CavityTerm, Constraint, ContactTerm, PointLoadTerm, PressureTerm, SolidTerm
 
@@ -193,10 +195,23 @@ class Model:
                 fixed[int(self.dof(node, "rot"))] = 0.0
         return ties
 
+    def _stabilize(self) -> None:
+        """Contact stabilization where a pair leaves it to the model (stabilization None):
+        STABILIZATION on the pairs whose slaves lie on a body that no prescribed uz holds
+        (held only by contact), none elsewhere."""
+        held_uz = [d // self.dpn for d in self.fixed if d % self.dpn == 1]
+        free = set(free_to_slide(self.mesh.n_nodes, self.mesh.cells, np.array(held_uz, np.int64), np.zeros(0, np.int64)))
+        body = bodies(self.mesh.n_nodes, self.mesh.cells) if free else None
+        for pair in self.contacts:
+            if pair.stabilization is None:
+                on_free = free and bool(set(body[pair.nodes].tolist()) & free)
+                pair.stabilization = STABILIZATION if on_free else 0.0
+
     def finalize(self) -> "Model":
         """Number the equations, make the terms of the residual (model.terms) and build the
         sparse pattern (once)."""
         fixed = dict(self.fixed)
+        self._stabilize()
         ties = self._sfr_constraints(fixed) if self.dpn == 3 else []
         self.dofmap = DofMap(self.n_full, fixed, ties)
         n = self.n_full
@@ -223,12 +238,19 @@ class Model:
         index = {c: i for i, c in enumerate(self._presc_curves)}
         self._presc_curve = np.array([index[curve_of_eq[k]] for k in range(dm.np)], dtype=np.int64)
         self._unknown = [c for c in self.cavities if c.unknown]  # cavities whose pressure is solved for
-        # round-off floor of the residual from the model's own force scale 2 pi mu L^2, which
-        # is not zero at u = 0 (a state in equilibrium converges whatever the load)
-        span = float(np.ptp(self.mesh.points, axis=0).max())
-        mu = float(getattr(self.material, "shear_modulus", 1.0))
-        self._noise_floor = 16 * np.finfo(float).eps * 2 * np.pi * mu * span**2 * np.sqrt(dm.nf)
+        # round-off floor of the residual from the model's own force scale 2 pi k L R, which
+        # is not zero at u = 0 (a state in equilibrium converges whatever the load); k the
+        # larger of the shear and bulk moduli: the stresses carry kappa (J - 1), J to round-off
+        k = max(float(getattr(self.material, "shear_modulus", 1.0)), float(getattr(self.material, "kappa", 0.0)))
+        self._noise_floor = 16 * np.finfo(float).eps * 2 * np.pi * k * self.ring_size() * np.sqrt(dm.nf)
         return self
+
+    def ring_size(self) -> float:
+        """L R_max: the body's span L times its largest radius (at least L), the area by which
+        2 pi mu scales its forces (a ring far from the axis carries 2 pi mu R L, not mu L^2)."""
+        points = self.mesh.points
+        span = float(np.ptp(points, axis=0).max())
+        return span * max(span, float(np.abs(points[:, 0]).max()))
 
     @property
     def n_free(self) -> int:
@@ -273,6 +295,11 @@ class Model:
     def expand(self, u_f: np.ndarray, t: float) -> np.ndarray:
         """Full displacement vector (n_full,) from the unknowns and the time t."""
         return self.dofmap.expand(u_f, self.prescribed(t)[0])
+
+    def strain_energy(self, u_full: np.ndarray) -> float:
+        """The strain energy stored in the body at the displacements u_full (n_full,): the
+        law's W at every quadrature point, integrated over the revolved body."""
+        return float((self.material.energy(self.solid.gradient(u_full)) * self.solid.dV).sum())
 
     def external_load(self, u_full: np.ndarray, t: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         """The applied external load at time t (pressures and point loads, full vector) and

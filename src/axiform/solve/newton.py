@@ -31,8 +31,7 @@ def force_floor(model: Model) -> float:
     """A force too small to matter: 1e-12 of mu * L^2 for the body's size L."""
     m = model.material
     mu = getattr(m, "shear_modulus", 1.0)
-    span = np.ptp(model.mesh.points, axis=0).max()
-    return 1e-12 * mu * span**2 * 2 * np.pi
+    return 1e-12 * mu * model.ring_size() * 2 * np.pi
 
 
 
