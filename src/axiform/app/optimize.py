@@ -513,8 +513,9 @@ def run(case_path: str, target_path: str, out: str, max_iter: int = 20, method: 
     """`axiform optimize`: returns the exit code (0 finished, 1 stopped short, 2 invalid input)."""
     import sys
 
-    from ..cli import _prepare, _say
-    from ..cli import run as run_case
+    from .console import say as _say
+    from .run import prepare_folder as _prepare
+    from .run import run as run_case
 
     case_file = Path(case_path)
     try:

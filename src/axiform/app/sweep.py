@@ -142,10 +142,8 @@ def run_case(case_file: str, overrides: list[str], out: str) -> dict[str, Any]:
     of sweep.csv from the exit code and OUT/summary.json."""
     import numpy as np
 
-    from ..cli import run
-    from ..solve.malloc import keep_freed_memory
+    from .run import run
 
-    keep_freed_memory()
     t0 = time.perf_counter()
     said = io.StringIO()
     try:

@@ -73,14 +73,13 @@ class ResultsWriter:
                  vtu: bool = True, gid_files: bool = False, revolved: int = 0, plots: bool = True,
                  thickness_every: int | None = None, labels: dict | None = None,
                  case: dict | None = None, restart_every: int = 0, restart_meta: dict | None = None,
-                 resume: dict | None = None, plotter=None, flush_every_s: float = 0.0):
+                 resume: dict | None = None, flush_every_s: float = 0.0):
         """labels: units, load and monitor_quantities for summary.json (labels.case_labels);
         case: where the case came from and its fingerprint.  restart_every: write the step's
         checkpoint to restart/ every k steps (and at the end of the run, whatever stopped it),
         with restart_meta beside it.  resume: the checkpoint a resumed run starts from: the
-        folder's rows and files up to its step are kept, later ones dropped.  plotter: draws
-        the plots at the end, folder -> files (plot_process.PlotProcess.plot); by default
-        plots.plot_folder in this process.  flush_every_s: history.csv, summary.json,
+        folder's rows and files up to its step are kept, later ones dropped.  plots: draw the
+        PNG plots at the end (plots.plot_folder, in this process).  flush_every_s: history.csv, summary.json,
         thickness.csv and fields.pvd are rewritten after a step when that long has passed
         since they last were (0: after every step), before every checkpoint and by `finish`,
         whatever ended the run: a run that never reaches `finish` (kill -9) loses at most
@@ -94,7 +93,6 @@ class ResultsWriter:
         self.gid = gid_files
         self.revolved = revolved
         self.plots = plots
-        self.plotter = plotter
         self.flush_every_s = flush_every_s
         self._flushed = -np.inf  # time of the last flush: the first step is written at once
         self._thickness = None  # the table of the last field step, not yet in thickness.csv
@@ -351,11 +349,9 @@ class ResultsWriter:
             self._vtu_writer.shutdown()
             self._vtu_writer = None
         if self.plots and self.steps:
-            if self.plotter is None:
-                from ..post.plots import plot_folder
+            from ..post.plots import plot_folder
 
-                self.plotter = plot_folder
-            self.plotter(self.out)
+            plot_folder(self.out)
         if failure is not None:
             raise failure
 
