@@ -251,7 +251,9 @@ class ResultsWriter:
         """contact.csv: every slave node of every pair at this step; totals in the summary."""
         from ..contact.pair import STATUS
 
-        lines = ["pair,node,r,z,gap,pressure,status,first_contact"]  # header first (DESIGN 10.12)
+        text = io.StringIO()
+        table = csv.writer(text, lineterminator="\n")
+        table.writerow(["pair", "node", "r", "z", "gap", "pressure", "status", "first_contact"])  # header first
         totals = []
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
         for k, pair in enumerate(self.model.contacts):
@@ -260,10 +262,10 @@ class ResultsWriter:
             for node, (r, z), g, p, st, t in zip(rep["node"], x, rep["gap"], rep["pressure"], rep["status"],
                                                   rep["first_contact"]):
                 first = "" if np.isnan(t) else repr(float(t))
-                lines.append(f"{k},{node},{r:.10g},{z:.10g},{g:.6g},{p:.6g},{STATUS[int(st)]},{first}")
+                table.writerow([k, node, f"{r:.10g}", f"{z:.10g}", f"{g:.6g}", f"{p:.6g}", STATUS[int(st)], first])
             totals.append({"name": pair.name or f"contact[{k}]"}
                           | {q: rep[q] for q in ("force_r", "force_z", "contact_area", "penetration")})
-        write_atomic(self.out / "contact.csv", "\n".join(lines) + "\n")
+        write_atomic(self.out / "contact.csv", text.getvalue())
         write_atomic(self.out / "surfaces.csv", mould_outlines(self.model.contacts, float(step.lam)))
         self.summary["contact"] = totals
 
@@ -365,8 +367,10 @@ class ResultsWriter:
 
 def mould_outlines(pairs, lam: float) -> str:
     """The rigid surfaces at load factor lam as CSV text: pair, r, z per outline point."""
-    outline = ["pair,r,z"]
+    text = io.StringIO()
+    table = csv.writer(text, lineterminator="\n")
+    table.writerow(["pair", "r", "z"])
     for k, pair in enumerate(pairs):
         pts = pair.surface.polyline() + pair.surface.offset(lam)
-        outline += [f"{k},{r:.10g},{z:.10g}" for r, z in pts]
-    return "\n".join(outline) + "\n"
+        table.writerows([k, f"{r:.10g}", f"{z:.10g}"] for r, z in pts)
+    return text.getvalue()
