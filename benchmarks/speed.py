@@ -79,18 +79,13 @@ print(f"FELUPE w {field[0].values[centre, 0]:.6f} iterations {its}")
 '''
 
 # the opening of the scripts run in a subprocess on a given source tree (argv[1]): the
-# imports, and the allocator setting `axiform run` makes (after issue 9; none before)
+# imports (axiform sets no allocator option any more: solve/malloc.py is gone)
 SCRIPT_PRELUDE = r'''
 import json, resource, sys, time
 sys.path.insert(0, sys.argv[1])
 import numpy as np
 import axiform as af
 from axiform.fem.mesh import edges_on_nodes
-try:
-    from axiform.solve.malloc import keep_freed_memory
-    keep_freed_memory()
-except ImportError:
-    pass
 '''
 
 # one Newton iteration (works on both APIs)

@@ -103,3 +103,43 @@ def test_plot_command(tmp_path, capsys):
     assert main(["plot", str(out), "--field", "J"]) == 0
     assert (out / "load_curve.png").exists() and (out / "deformed.png").exists()
     assert main(["plot", str(tmp_path)]) == 2
+
+
+PNGS = ["load_curve.png", "thickness.png", "deformed.png"]
+
+
+def test_a_run_draws_its_plots_and_a_case_without_plots_none(tmp_path):
+    """The PNG plots of `axiform run` are drawn in its own process at the end of the run."""
+    from axiform.app.run import run
+
+    out = tmp_path / "plate"
+    assert run(str(EXAMPLES / "hughes_carnoy_plate.toml"), str(out), quiet=True,
+               overrides=["solver.steps=3", "solver.target=1.0"]) == 0
+    for png in PNGS:
+        assert (out / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    none = tmp_path / "none"
+    assert run(str(EXAMPLES / "hughes_carnoy_plate.toml"), str(none), quiet=True,
+               overrides=["solver.steps=2", "solver.target=0.5", "output.plots=false"]) == 0
+    assert (none / "summary.json").exists() and not list(none.glob("*.png"))
+
+
+def test_the_command_from_a_shell(tmp_path):
+    """`axiform run` as a process: the plots, the exit code and the last line (the streams
+    flushed by the interpreter's own teardown); an invalid case exits 2."""
+    import os
+    import subprocess
+    import sys
+
+    src = Path(__file__).resolve().parents[1] / "src"
+    out = tmp_path / "plate"
+    env = {**os.environ, "PYTHONPATH": str(src)}
+    proc = subprocess.run([sys.executable, "-m", "axiform.cli", "run", str(EXAMPLES / "hughes_carnoy_plate.toml"),
+                           "--out", str(out), "-q", "--set", "solver.steps=2", "--set", "solver.target=0.5"],
+                          env=env, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert all((out / png).exists() for png in PNGS)
+    assert "axiform: finished after 2 steps" in proc.stderr
+    bad = subprocess.run([sys.executable, "-m", "axiform.cli", "run", str(EXAMPLES / "hughes_carnoy_plate.toml"),
+                          "--out", str(tmp_path / "bad"), "-q", "--set", "solver.steps=-1"],
+                         env=env, capture_output=True, text=True, timeout=120)
+    assert bad.returncode == 2 and "solver.steps" in bad.stderr

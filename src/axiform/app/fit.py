@@ -300,18 +300,17 @@ def fit(data: Data, model: str, terms: int = 3, kappa: float | None = None) -> F
     return FitResult(model, terms if model == "ogden" else None, law, table, rms, stable, points)
 
 
-def _toml_value(v) -> str:
-    if isinstance(v, list):
-        return "[" + ", ".join(f"{x:.6g}" for x in v) + "]"
-    return f"{v:.6g}"
+def _six_digits(v):
+    """A constant (or a list of them) to 6 significant digits, as the fit reports them."""
+    return [float(f"{x:.6g}") for x in v] if isinstance(v, list) else float(f"{v:.6g}")
 
 
 def material_table(result: FitResult) -> str:
-    """The [material] table, ready to paste into a case file."""
-    lines = ["[material]", f'model = "{result.model}"']
-    lines += [f"{key} = {_toml_value(v)}" for key, v in result.table.items()]
-    lines.append(f"kappa = {result.law.kappa:.6g}")
-    return "\n".join(lines) + "\n"
+    """The [material] table (tomli-w), ready to paste into a case file."""
+    import tomli_w
+
+    table = {"model": result.model} | {key: _six_digits(v) for key, v in result.table.items()}
+    return tomli_w.dumps({"material": table | {"kappa": _six_digits(result.law.kappa)}})
 
 
 def combined_range(result: FitResult) -> tuple[float, float] | None:

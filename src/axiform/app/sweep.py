@@ -29,7 +29,6 @@ import csv
 import io
 import itertools
 import json
-import math
 import os
 import sys
 import time
@@ -37,10 +36,13 @@ import tomllib
 from contextlib import redirect_stderr
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
+
+from pydantic import BaseModel, ConfigDict, Field, StrictStr, ValidationError, field_validator, model_validator
 
 from ..case.schema import CaseError, fingerprint, parse, read
 from ..post.sweep_plots import plot_sweep
+from .console import ProgressLine
 
 SWEEP_KEYS = ("case", "vary", "cases", "report")
 FIXED_COLUMNS = ("status", "exit_code", "steps", "wall_time_s", "message")
@@ -49,18 +51,56 @@ WORKER_ENV = {v: "1" for v in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_N
 
 
 def toml_value(value: Any) -> str:
-    """A value (as tomllib reads it) written back as TOML text, for KEY=VALUE overrides."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, (int, float)):
-        return repr(value) if math.isfinite(value) else {math.inf: "inf", -math.inf: "-inf"}.get(value, "nan")
-    if isinstance(value, str):
-        return json.dumps(value)
-    if isinstance(value, list):
-        return "[" + ", ".join(toml_value(v) for v in value) + "]"
-    if isinstance(value, dict):
-        return "{ " + ", ".join(f"{json.dumps(k)} = {toml_value(v)}" for k, v in value.items()) + " }"
-    raise TypeError(f"not a TOML value: {value!r}")
+    """A value (as tomllib reads it) as one line of TOML, for KEY=VALUE overrides and labels:
+    tomli-w's text of it, its arrays joined on one line (a string of tomli-w's has no line
+    break: it writes one as the escape \\n)."""
+    import tomli_w
+
+    text = tomli_w.dumps({"v": [value]}, indent=0)  # in an array: a table is written inline
+    text = text.removeprefix("v = [\n").removesuffix(",\n]\n")
+    return text.replace("[\n", "[").replace(",\n]", "]").replace(",\n", ", ")
+
+
+class _Report(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    monitor: StrictStr | None = None
+
+
+class SweepFile(BaseModel):
+    """The keys of a sweep file (module docstring): `case`, then [vary] (a table of case keys,
+    each with a non-empty list of values) or [[cases]] (tables of overrides), and [report]."""
+
+    model_config = ConfigDict(extra="forbid")
+    case: StrictStr
+    vary: Annotated[dict[str, Annotated[list[Any], Field(min_length=1)]], Field(min_length=1)] | None = None
+    cases: Annotated[list[dict[str, Any]], Field(min_length=1)] | None = None
+    report: _Report = _Report()
+
+    @field_validator("case")
+    @classmethod
+    def _named(cls, value: str) -> str:
+        if not value.strip():
+            raise ValueError("the case file (a string, relative to the sweep file) is required")
+        return value
+
+    @model_validator(mode="after")
+    def _one_of(self) -> "SweepFile":
+        if (self.vary is None) == (self.cases is None):
+            raise ValueError("vary / cases: give exactly one of [vary] (a full factorial) and [[cases]]")
+        return self
+
+
+def _schema_error(exc: ValidationError) -> CaseError:
+    """The first error of a sweep file's validation, naming its key."""
+    err = exc.errors(include_url=False)[0]
+    key = ".".join(str(p) for p in err["loc"])
+    if err["type"] == "extra_forbidden":
+        known = ", ".join(SWEEP_KEYS) if len(err["loc"]) == 1 else "monitor"
+        return CaseError(f"{key}: not a key of a sweep file (expected {known})")
+    if err["type"] == "missing" and key == "case":
+        return CaseError("case: the case file (a string, relative to the sweep file) is required")
+    message = str(err["ctx"]["error"]) if err["type"] == "value_error" else err["msg"]
+    return CaseError(f"{key}: {message}" if key else message)
 
 
 @dataclass
@@ -91,39 +131,22 @@ def load_sweep(path: str | Path) -> Sweep:
         raise CaseError(f"{path}: cannot read it ({exc})") from None
     except tomllib.TOMLDecodeError as exc:
         raise CaseError(f"{path}: not valid TOML ({exc})") from None
-    unknown = [k for k in data if k not in SWEEP_KEYS]
-    if unknown:
-        raise CaseError(f"{unknown[0]}: not a key of a sweep file (expected {', '.join(SWEEP_KEYS)})")
-    if not isinstance(data.get("case"), str) or not data["case"].strip():
-        raise CaseError("case: the case file (a string, relative to the sweep file) is required")
-    case_file = (path.parent / data["case"]).resolve()
+    try:
+        spec = SweepFile.model_validate(data)
+    except ValidationError as exc:
+        raise _schema_error(exc) from None
+    case_file = (path.parent / spec.case).resolve()
     if not case_file.is_file():
         raise CaseError(f"case: no such file {case_file}")
-    if ("vary" in data) == ("cases" in data):
-        raise CaseError("vary / cases: give exactly one of [vary] (a full factorial) and [[cases]]")
-    if "vary" in data:
-        vary = data["vary"]
-        if not isinstance(vary, dict) or not vary:
-            raise CaseError("vary: a table of case keys, each with a list of values")
-        for key, values in vary.items():
-            if not isinstance(values, list) or not values:
-                raise CaseError(f"vary.{key}: a non-empty list of values")
-        keys = list(vary)
-        cases = [dict(zip(keys, combo)) for combo in itertools.product(*vary.values())]
+    if spec.vary is not None:
+        keys = list(spec.vary)
+        cases = [dict(zip(keys, combo)) for combo in itertools.product(*spec.vary.values())]
     else:
-        table = data["cases"]
-        if not isinstance(table, list) or not table or not all(isinstance(c, dict) for c in table):
-            raise CaseError("cases: an array of tables [[cases]] of { key = value } overrides")
-        cases = [dict(c) for c in table]
+        cases = [dict(c) for c in spec.cases]
         keys = list(dict.fromkeys(k for c in cases for k in c))
-    report = data.get("report", {})
-    if not isinstance(report, dict) or set(report) - {"monitor"}:
-        raise CaseError("report: a table with the key 'monitor'")
-    monitor = report.get("monitor")
-    if monitor is not None and not isinstance(monitor, str):
-        raise CaseError("report.monitor: the name of a monitor of the case")
+    monitor = spec.report.monitor
     monitors = None
-    where = "vary" if "vary" in data else "cases"
+    where = "vary" if spec.vary is not None else "cases"
     for k, case in enumerate(cases):
         sets = [f"{key}={toml_value(v)}" for key, v in case.items()]
         try:
@@ -143,10 +166,8 @@ def run_case(case_file: str, overrides: list[str], out: str) -> dict[str, Any]:
     of sweep.csv from the exit code and OUT/summary.json."""
     import numpy as np
 
-    from ..cli import run
-    from ..solve.malloc import keep_freed_memory
+    from .run import run
 
-    keep_freed_memory()
     t0 = time.perf_counter()
     said = io.StringIO()
     try:
@@ -177,34 +198,25 @@ def summary_row(folder: Path) -> dict[str, Any]:
 
 
 class SweepProgress:
-    """A bar rewritten in place on a terminal, else one line per finished case."""
+    """The progress of a sweep (console.ProgressLine): a bar of the cases done on a terminal,
+    else one line per finished case."""
 
     def __init__(self, stream, total: int):
-        self.stream = stream
-        self.tty = stream.isatty()
+        self.line = ProgressLine(stream, total)
         self.total = total
         self.done = self.failed = 0
-        self.t0 = time.perf_counter()
 
     def __call__(self, name: str, row: dict, skipped: bool = False) -> None:
         self.done += 1
         self.failed += row.get("status") != "finished"
-        elapsed = time.perf_counter() - self.t0
-        if self.tty:
-            frac = self.done / self.total
-            bar = "#" * int(30 * frac) + "-" * (30 - int(30 * frac))
-            self.stream.write(f"\r[{bar}] {self.done}/{self.total} cases, {self.failed} not finished, "
-                              f"{elapsed:.1f} s\x1b[K")
-        else:
-            what = "skipped (finished before)" if skipped else f"{row.get('status')} (exit {row.get('exit_code')})"
-            self.stream.write(f"case {name} {what}  [{self.done}/{self.total}, {elapsed:.1f} s]"
-                              + (f": {row['message']}" if row.get("status") != "finished" and row.get("message") else "")
-                              + "\n")
-        self.stream.flush()
+        elapsed = self.line.elapsed
+        what = "skipped (finished before)" if skipped else f"{row.get('status')} (exit {row.get('exit_code')})"
+        why = f": {row['message']}" if row.get("status") != "finished" and row.get("message") else ""
+        self.line.show(self.done, f"{self.done}/{self.total} cases, {self.failed} not finished, {elapsed:.1f} s",
+                       f"case {name} {what}  [{self.done}/{self.total}, {elapsed:.1f} s]{why}")
 
     def close(self) -> None:
-        if self.tty:
-            self.stream.write("\n")
+        self.line.close()
 
 
 def write_table(path: Path, sweep: Sweep, rows: list[dict | None]) -> None:

@@ -73,14 +73,13 @@ class ResultsWriter:
                  vtu: bool = True, gid_files: bool = False, revolved: int = 0, plots: bool = True,
                  thickness_every: int | None = None, labels: dict | None = None,
                  case: dict | None = None, restart_every: int = 0, restart_meta: dict | None = None,
-                 resume: dict | None = None, plotter=None, flush_every_s: float = 0.0):
+                 resume: dict | None = None, flush_every_s: float = 0.0):
         """labels: units, load and monitor_quantities for summary.json (labels.case_labels);
         case: where the case came from and its fingerprint.  restart_every: write the step's
         checkpoint to restart/ every k steps (and at the end of the run, whatever stopped it),
         with restart_meta beside it.  resume: the checkpoint a resumed run starts from: the
-        folder's rows and files up to its step are kept, later ones dropped.  plotter: draws
-        the plots at the end, folder -> files (plot_process.PlotProcess.plot); by default
-        plots.plot_folder in this process.  flush_every_s: history.csv, summary.json,
+        folder's rows and files up to its step are kept, later ones dropped.  plots: draw the
+        PNG plots at the end (plots.plot_folder, in this process).  flush_every_s: history.csv, summary.json,
         thickness.csv and fields.pvd are rewritten after a step when that long has passed
         since they last were (0: after every step), before every checkpoint and by `finish`,
         whatever ended the run: a run that never reaches `finish` (kill -9) loses at most
@@ -94,7 +93,6 @@ class ResultsWriter:
         self.gid = gid_files
         self.revolved = revolved
         self.plots = plots
-        self.plotter = plotter
         self.flush_every_s = flush_every_s
         self._flushed = -np.inf  # time of the last flush: the first step is written at once
         self._thickness = None  # the table of the last field step, not yet in thickness.csv
@@ -254,7 +252,9 @@ class ResultsWriter:
         """contact.csv: every slave node of every pair at this step; totals in the summary."""
         from ..contact.pair import STATUS
 
-        lines = ["pair,node,r,z,gap,pressure,status,first_contact"]  # header first (DESIGN 10.12)
+        text = io.StringIO()
+        table = csv.writer(text, lineterminator="\n")
+        table.writerow(["pair", "node", "r", "z", "gap", "pressure", "status", "first_contact"])  # header first
         totals = []
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
         for k, (pair, held) in enumerate(zip(self.model.contacts, step.state.contacts)):
@@ -263,10 +263,10 @@ class ResultsWriter:
             for node, (r, z), g, p, st, t in zip(rep["node"], x, rep["gap"], rep["pressure"], rep["status"],
                                                   rep["first_contact"]):
                 first = "" if np.isnan(t) else repr(float(t))
-                lines.append(f"{k},{node},{r:.10g},{z:.10g},{g:.6g},{p:.6g},{STATUS[int(st)]},{first}")
+                table.writerow([k, node, f"{r:.10g}", f"{z:.10g}", f"{g:.6g}", f"{p:.6g}", STATUS[int(st)], first])
             totals.append({"name": pair.name or f"contact[{k}]"}
                           | {q: rep[q] for q in ("force_r", "force_z", "contact_area", "penetration")})
-        write_atomic(self.out / "contact.csv", "\n".join(lines) + "\n")
+        write_atomic(self.out / "contact.csv", text.getvalue())
         write_atomic(self.out / "surfaces.csv", mould_outlines(self.model.contacts, float(step.lam)))
         self.summary["contact"] = totals
 
@@ -352,11 +352,9 @@ class ResultsWriter:
             self._vtu_writer.shutdown()
             self._vtu_writer = None
         if self.plots and self.steps:
-            if self.plotter is None:
-                from ..post.plots import plot_folder
+            from ..post.plots import plot_folder
 
-                self.plotter = plot_folder
-            self.plotter(self.out)
+            plot_folder(self.out)
         if failure is not None:
             raise failure
 
@@ -370,8 +368,10 @@ class ResultsWriter:
 
 def mould_outlines(pairs, lam: float) -> str:
     """The rigid surfaces at load factor lam as CSV text: pair, r, z per outline point."""
-    outline = ["pair,r,z"]
+    text = io.StringIO()
+    table = csv.writer(text, lineterminator="\n")
+    table.writerow(["pair", "r", "z"])
     for k, pair in enumerate(pairs):
         pts = pair.surface.polyline() + pair.surface.offset(lam)
-        outline += [f"{k},{r:.10g},{z:.10g}" for r, z in pts]
-    return "\n".join(outline) + "\n"
+        table.writerows([k, f"{r:.10g}", f"{z:.10g}"] for r, z in pts)
+    return text.getvalue()

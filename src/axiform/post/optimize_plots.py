@@ -11,7 +11,8 @@ import numpy as np
 from .figures import new_figure, save
 
 if TYPE_CHECKING:
-    from ..app.optimize import OptimizeResult, ThicknessDesign
+    from ..app.design import ThicknessDesign
+    from ..app.optimize import OptimizeResult
 
 GREY, BLUE = "0.55", "C0"
 

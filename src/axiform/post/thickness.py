@@ -13,6 +13,7 @@ contact.csv), first_contact being the earliest of them.
 
 from __future__ import annotations
 
+import csv
 from pathlib import Path
 from typing import Sequence
 
@@ -109,6 +110,7 @@ def write_thickness_csv(path: str | Path, table: dict[str, np.ndarray]) -> None:
     rows = np.column_stack([table[n] for n in names])
     text = np.char.mod("%.10g", rows)
     text[np.isnan(rows)] = ""
-    lines = [",".join(names)]
-    lines += [",".join(row) for row in text]
-    Path(path).write_text("\n".join(lines) + "\n")
+    with open(path, "w", newline="") as fh:
+        out = csv.writer(fh, lineterminator="\n")
+        out.writerow(names)
+        out.writerows(text.tolist())

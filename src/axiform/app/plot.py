@@ -1,0 +1,49 @@
+"""`axiform plot DIR [--field F] [--animate]`: (re)write the PNG plots of a results folder."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .console import failed, say
+
+
+def fields_of(folder: Path) -> set[str] | None:
+    """The nodal fields of the last VTU file of a results folder (None: no VTU file)."""
+    from xml.etree import ElementTree as ET
+
+    from ..post.plots import last_vtu
+
+    vtu = last_vtu(folder)
+    if vtu is None or not vtu.exists():
+        return None
+    return {a.get("Name") for a in ET.parse(vtu).getroot().iter("DataArray")
+            if a.get("Name") and a.get("Name") not in ("types", "offsets", "connectivity", "Points")}
+
+
+def plot(folder: str, field: str, animate: bool = False) -> int:
+    """(Re)write the PNG plots of a results folder; returns the exit code."""
+    from ..post.plots import FieldError, plot_folder, read_history
+
+    path = Path(folder)
+    if not (path / "history.csv").is_file():
+        say(f"axiform: {folder} is not a results folder (no history.csv)")
+        return 2
+    try:
+        read_history(path / "history.csv")
+        fields = fields_of(path)
+    except (OSError, ValueError, KeyError, IndexError, SyntaxError) as exc:  # SyntaxError: XML
+        say(f"axiform: {folder}: unreadable results ({type(exc).__name__}: {exc})")
+        return 2
+    if fields is not None and field.split(":")[0] not in fields:
+        say(f"axiform: --field: no field '{field}' in {folder}; there are: {', '.join(sorted(fields))}")
+        return 2
+    try:
+        pngs = plot_folder(path, field, animate)
+    except FieldError as exc:
+        say(f"axiform: --field: {exc}")
+        return 2
+    except Exception as exc:  # noqa: BLE001 - a fault of axiform's: exit 3
+        return failed(exc, f"failed while plotting {folder}")
+    for png in pngs:
+        print(png)
+    return 0

@@ -1,0 +1,300 @@
+"""`axiform run`: read, check, solve and write a case (or resume a run in its folder), with
+SIGINT / SIGTERM winding the run up (`Stops`), the default results folder (`results_folder`)
+and the checks of a resumed run (`resume_state`).  The PNG plots are drawn in this process
+by the results writer at the end of the run (`plots.plot_folder`).
+
+Exit codes: 0 finished, 1 stopped (converged steps kept), 2 invalid case (refused before any
+work), 3 failed (an unexpected error), 130 / 143 interrupted by SIGINT / SIGTERM.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import sys
+import threading
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Self
+
+from .. import __version__
+from .console import ProgressLine, failed, invalid, say, trace
+
+EXIT = {"finished": 0, "stopped": 1, "failed": 3}
+# history.csv, summary.json, thickness.csv and fields.pvd are rewritten at most every half
+# second (and whenever the run ends): four atomic rewrites a step (benchmarks/README.md § 3.1)
+FLUSH_EVERY_S = 0.5
+# the case tables a resumed run may not change (DESIGN 10.9): the model must be the same
+FROZEN_ON_RESUME = ("mesh", "material")
+
+
+class Interrupted(Exception):
+    """SIGINT or SIGTERM arrived; signum says which."""
+
+    def __init__(self, signum: int):
+        self.signum = signum
+        super().__init__(f"interrupted by {signal.Signals(signum).name}")
+
+
+class Stops:
+    """While active (a `with` block), SIGINT and SIGTERM raise Interrupted where the program
+    is, except inside `held()` blocks (a result file being written): there the signal waits
+    for the block's end.  Later signals are ignored while the run winds up."""
+
+    def __init__(self):
+        self.signum: int | None = None
+        self.raised = False
+        self.depth = 0
+        self._old = {}
+
+    def __enter__(self) -> Self:
+        if threading.current_thread() is threading.main_thread():
+            for s in (signal.SIGINT, signal.SIGTERM):
+                self._old[s] = signal.signal(s, self._handle)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        for s, handler in self._old.items():
+            signal.signal(s, handler)
+
+    def _handle(self, signum, frame) -> None:
+        self.signum = self.signum or signum
+        if not self.depth and not self.raised:
+            self.raised = True
+            raise Interrupted(signum)
+
+    @contextmanager
+    def held(self):
+        self.depth += 1
+        try:
+            yield
+        finally:
+            self.depth -= 1
+        if not self.depth and self.signum is not None and not self.raised:
+            self.raised = True
+            raise Interrupted(self.signum)
+
+
+def results_folder(case_file: Path, digest: str, root: Path = Path("results")) -> tuple[Path, str]:
+    """The default results folder: root/<case name>/, or root/<case name>-<n>/ (n = 2, 3, ...)
+    when that one holds the results of another case (another fingerprint in its summary.json,
+    or no readable one).  Returns the folder and, when it is not the first choice, why."""
+    name = case_file.stem
+    for n in range(1, 10**6):
+        folder = root / (name if n == 1 else f"{name}-{n}")
+        if not folder.exists():
+            break
+        try:
+            held = json.loads((folder / "summary.json").read_text())["case"]["sha256"]
+        except (OSError, ValueError, KeyError, TypeError):
+            continue
+        if held == digest:
+            break
+    note = "" if n == 1 else f" ({root / name} holds the results of another case text)"
+    return folder, note
+
+
+def prepare_folder(folder: Path) -> str | None:
+    """Create an output folder; the reason it cannot be, or None."""
+    for up in (folder, *folder.parents):
+        if up.exists() and not up.is_dir():
+            return f"{up} is a file, not a folder"
+        if up.exists():
+            break
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        probe = folder / ".axiform-write-test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as exc:
+        return f"cannot create or write {folder} ({exc.strerror or exc})"
+    return None
+
+
+def resume_state(folder: Path, data: dict) -> dict:
+    """The checkpoint of a results folder to resume, after checking that the case's mesh and
+    material are the ones it was made with; CaseError (exit 2) otherwise."""
+    from ..case.schema import CaseError, fingerprint
+    from ..io.checkpoint import load as load_checkpoint
+
+    if not folder.is_dir():
+        raise CaseError(f"--resume: {folder} is not a results folder")
+    try:
+        state, meta = load_checkpoint(folder / "restart")
+    except ValueError as exc:
+        raise CaseError(f"--resume: {exc}") from None
+    for key in FROZEN_ON_RESUME:
+        if meta.get(key) != fingerprint(data.get(key, {})):
+            raise CaseError(f"{key}: differs from the run being resumed ([{key}] cannot change on --resume)")
+    return state
+
+
+@dataclass
+class Job:
+    """A case read and built for a run: its tree, the validated case, the built model,
+    the checkpoint it resumes (or None), and where its results go."""
+
+    case_file: Path
+    overrides: list[str]
+    data: dict[str, Any]
+    case: Any
+    built: Any
+    state: dict | None
+    out: str | None
+    digest: str = field(init=False)
+
+    def __post_init__(self):
+        from ..case.schema import fingerprint
+
+        self.digest = fingerprint(self.data)
+
+    @classmethod
+    def read(cls, case_file: Path, overrides: list[str], out: str | None, resume: str | None) -> "Job":
+        """Read, validate and build the case (CaseError: exit 2)."""
+        from ..case.schema import CaseError, build, parse, read
+
+        data = read(case_file, overrides)
+        case = parse(data)
+        state = None
+        if resume is not None:
+            if out is not None and Path(out).resolve() != Path(resume).resolve():
+                raise CaseError("--out: a resumed run writes in the folder it resumes (--resume)")
+            out = resume
+            state = resume_state(Path(resume), data)
+        return cls(case_file, overrides, data, case, build(case, case_file.parent), state, out)
+
+    def folder(self) -> tuple[Path, str]:
+        """The results folder (--out, or the default) and a note when it is not the first choice."""
+        return (Path(self.out), "") if self.out else results_folder(self.case_file, self.digest)
+
+    def writer(self, out_dir: Path):
+        """The results writer of this run in out_dir (a resumed run keeps the folder's rows and files
+        up to its checkpoint)."""
+        from ..case.schema import fingerprint
+        from ..io.results import ResultsWriter
+        from ..post.labels import case_labels
+
+        o, case = self.case.output, self.case
+        return ResultsWriter(out_dir, self.built.model, self.built.monitors, case.title, every=o.every, vtu=o.vtu,
+                             gid_files=o.gid, revolved=o.revolved, plots=o.plots,
+                             thickness_every=o.thickness_every, labels=case_labels(case),
+                             case={"file": str(self.case_file), "overrides": self.overrides, "sha256": self.digest},
+                             restart_every=case.restart.every,
+                             restart_meta={key: fingerprint(self.data.get(key, {})) for key in FROZEN_ON_RESUME},
+                             resume=self.state, flush_every_s=FLUSH_EVERY_S)
+
+
+def run(case_path: str, out: str | None, quiet: bool = False, overrides: list[str] = (),
+        resume: str | None = None) -> int:
+    """Read, check, solve and write a case (or resume a run in its folder); returns the exit code."""
+    with Stops() as stops:
+        try:
+            return _run(Path(case_path), out, quiet, list(overrides), stops, resume)
+        except Interrupted as exc:  # before the results folder was there
+            say(f"axiform: {exc} before the first step")
+            return 128 + exc.signum
+
+
+def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], stops: Stops,
+         resume: str | None) -> int:
+    from ..case.schema import CaseError
+
+    try:
+        job = Job.read(case_file, overrides, out, resume)
+    except CaseError as exc:
+        return invalid(case_file, exc)
+    except Exception as exc:  # noqa: BLE001 - a fault of axiform's, not of the case: exit 3
+        return failed(exc, f"failed while building the model of {case_file}")
+    out_dir, note = job.folder()
+    problem = prepare_folder(out_dir)
+    if problem:
+        say(f"axiform: invalid output folder:\n--out: {problem}")
+        return 2
+    writer = None
+    if job.state is not None:
+        try:  # the checkpoint must fit this model and folder before anything is rewritten
+            job.built.model.restore(job.state["model"])
+            with stops.held():
+                writer = job.writer(out_dir)
+        except (ValueError, KeyError) as exc:
+            return invalid(case_file, CaseError(f"--resume: {exc}"))
+    return _solve(job, out_dir, note, writer, quiet, stops)
+
+
+def _step_progress(job: Job, quiet: bool):
+    """The progress of a run, called with each converged step and its monitor values: the
+    driven dof, the stop dof of an arc length, or the load factor, against its goal."""
+    control = job.built.control
+    driven, goal = getattr(control, "dof", None), control.target
+    if getattr(control, "stop_dof", None) is not None:
+        driven, goal = control.stop_dof, control.stop_value
+    line = ProgressLine(sys.stderr, 1.0, quiet)
+
+    def show(step, values: dict[str, float]) -> None:
+        frac = (step.u[driven] if driven is not None else step.lam) / goal
+        mon = "  ".join(f"{k} {v:.4g}" for k, v in list(values.items())[:3])
+        text = (f"step {step.number}  lambda {step.lam:.5g}  its {step.iterations}  {mon}  "
+                f"{line.elapsed:.1f} s")
+        line.show(frac, f"{100 * min(max(frac, 0.0), 1.0):5.1f}%  {text}", text)
+
+    return show, line
+
+
+def _solve(job: Job, out_dir: Path, note: str, writer, quiet: bool, stops: Stops) -> int:
+    """Solve with the results written step by step, then wind up: the status, the files, the
+    last line; returns the exit code."""
+    from ..io.results import NonFiniteResult
+    from ..solve.solver import StepFailed, solve
+
+    model = job.built.model
+    show, line = _step_progress(job, quiet)
+
+    def on_step(step):
+        with stops.held():
+            values = writer.step(step)
+        show(step, values)
+
+    t0 = time.perf_counter()
+    result = None
+    try:
+        with stops.held():
+            writer = writer or job.writer(out_dir)
+        if not quiet:
+            say(f"axiform {__version__}: {job.case.title or job.case_file.name}: {model.mesh.n_cells} "
+                f"{model.mesh.element.name} elements, {model.n_free} free dofs -> {out_dir}{note}")
+        result = solve(model, job.built.control, job.built.options, on_step=on_step, keep=1, resume=job.state)
+        status, message = result.status, result.message
+    except Interrupted as exc:
+        if writer is None:
+            raise
+        status, message = "interrupted", f"{exc}; every converged step is kept"
+    except NonFiniteResult as exc:
+        status, message = "stopped", str(exc)
+    except StepFailed as exc:  # the path could not even start (arc length's first tangent)
+        status, message = "stopped", f"before the first step: {exc}"
+    except Exception as exc:  # noqa: BLE001 - any other error: status "failed", exit 3
+        if writer is None:  # the results folder could not be started
+            return failed(exc, f"failed while starting {out_dir}")
+        status, message = "failed", f"{type(exc).__name__}: {exc}"
+        trace(exc)
+    line.close()
+    stops.raised = True  # wind up whatever comes now
+    status, message = _finish(writer, status, message)
+    wall = result.wall_time_s if result is not None else time.perf_counter() - t0
+    say(f"axiform: {status} after {writer.steps} steps, {writer.newton_iterations} Newton iterations, "
+        f"{wall:.2f} s -> {out_dir}" + (f": {message}" if message else ""))
+    if status == "interrupted":
+        return 128 + stops.signum
+    return EXIT.get(status, 1)
+
+
+def _finish(writer, status: str, message: str) -> tuple[str, str]:
+    """The results writer's last files and plots; the status and message after them."""
+    try:
+        writer.finish(status, message)
+    except Exception as exc:  # noqa: BLE001 - e.g. a full disk: status "failed", exit 3
+        status, message = "failed", f"{message}; then writing the results failed ({type(exc).__name__}: {exc})"
+        trace(exc)
+    return status, message
