@@ -50,15 +50,43 @@ class PathFollowing:
             setattr(self, key, v.copy() if isinstance(v, np.ndarray) else v)
 
     def diagnosis(self) -> str:
-        """Why the path stopped, where the state tells (appended to the stop message): an
-        element folded at one of its nodes in the last converged state."""
+        """Why the path stopped, where the last converged state tells (the start of the stop
+        message, "" where it does not): the body at the open end of a mould it touches (it
+        slid off), or an element folded at one of its nodes."""
+        return self._off_a_mould() or self._folded()
+
+    def _off_a_mould(self) -> str:
+        """At the last converged step, a slave node of a mould touching it within a hundredth
+        of an element of one of its open ends, or one that touched it before and is now
+        free within an element of that end: the body is sliding off that end."""
+        size = self.model.mesh.size()
+        u = self.model.expand(self.u_f, self.lam).reshape(-1, self.model.dpn)
+        for k, (pair, held) in enumerate(zip(self.model.contacts, self.history.contacts)):
+            ends = _open_ends(pair.surface)
+            if held.seen is None or not len(ends):
+                continue
+            touching = held.seen.status > 0
+            left = np.isfinite(held.first_contact) & ~touching
+            gap_at_end = np.linalg.norm(held.seen.proj.point[:, None, :] - ends[None], axis=2).min(axis=1)
+            node_to_end = np.linalg.norm(held.seen.x[:, None, :] - ends[None], axis=2).min(axis=1)
+            off = (touching & (gap_at_end < 1e-2 * size)) | (left & (node_to_end < size))
+            if off.any():
+                i = int(np.flatnonzero(off)[0])
+                r, z = pair.X[i] + u[pair.nodes[i], :2]
+                name = pair.name or f"contact[{k}]"
+                return (f"the body reached the end of the mould {name} at (r, z) = ({r:.6g}, {z:.6g}) and slid "
+                        "off it: extend the mould's outline past where the body goes")
+        return ""
+
+    def _folded(self) -> str:
+        """An element folded at one of its nodes in the last converged state."""
         folds = folded_nodes(self.model.mesh, self.model.expand(self.u_f, self.lam))
         if not folds:
             return ""
         element, node, j = folds[0]
         r, z = self.model.mesh.points[node]
         more = f" ({len(folds)} element nodes folded in all)" if len(folds) > 1 else ""
-        return (f"; element {element} is folded at its node {node} (r, z = {r:.6g}, {z:.6g}; in-plane J = {j:.2g} "
+        return (f"element {element} is folded at its node {node} (r, z = {r:.6g}, {z:.6g}; in-plane J = {j:.2g} "
                 f"there at the last converged step){more}: the mesh there no longer maps the body one to one, "
                 "and other elements there (larger or finer) move the stop")
 
@@ -125,9 +153,9 @@ class LoadPath(PathFollowing):
     def diagnosis(self):
         ratio = self._stiffness_ratio() if self.lam != 0 else None
         if ratio is not None and ratio < 0.05:
-            return (f"; this is a limit point of the load: the structure's stiffness against it has fallen to "
-                    f"{100 * ratio:.2g} % of its initial value, so it carries no more load; follow the path "
-                    "past it with control = \"arc-length\" or \"displacement\", or a cavity under volume control")
+            return (f"the load passed the largest the structure carries (a limit point of the load: its stiffness "
+                    f"against it has fallen to {100 * ratio:.2g} % of its initial value); follow the path past it "
+                    "with control = \"arc-length\" or \"displacement\", or a cavity under volume control")
         return super().diagnosis()
 
 
@@ -164,3 +192,15 @@ class DisplacementPath(PathFollowing):
         self.previous = (u_f - self.u_f, lam - self.lam, size)
         super().accept(u_f, lam, size)
         self.reached += size
+
+
+def _open_ends(surface) -> np.ndarray:
+    """The open ends (k, 2) of a mould's outline in its own frame: the first and last points of
+    a polyline or profile that does not close on itself; none for a circle."""
+    points = getattr(surface, "points", None)
+    if points is None or len(points) < 2:
+        return np.zeros((0, 2))
+    points = np.asarray(points, float)
+    if np.allclose(points[0], points[-1]):
+        return np.zeros((0, 2))
+    return points[[0, -1]]

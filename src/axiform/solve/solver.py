@@ -58,14 +58,14 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
             u_new, lam_new, its, res, ev = path.attempt(trial)
         except PathEnded as exc:
             result.status = "stopped"
-            result.message = f"step {first + result.n_steps}: {exc}" + path.diagnosis()
+            result.message = _stop_message(first + result.n_steps, str(exc), path.diagnosis())
             break
         except StepFailed as exc:
             size = trial / 2.0
             if abs(size) < opts.min_step * abs(path.nominal):
                 result.status = "stopped"
-                result.message = f"step {first + result.n_steps}: no convergence with the step cut below the minimum ({exc})"
-                result.message += path.diagnosis()
+                result.message = _stop_message(first + result.n_steps, "no convergence with the step cut below the "
+                                               f"minimum ({exc})", path.diagnosis())
                 break
             continue
         path.accept(u_new, lam_new, trial)
@@ -92,3 +92,9 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
             break
     result.wall_time_s = time.perf_counter() - t0
     return result
+
+
+def _stop_message(step: int, failure: str, cause: str) -> str:
+    """The stop's message: the cause a user can act on first (path.diagnosis), then what failed
+    (the element, the iterations)."""
+    return f"step {step}: {cause}; {failure}" if cause else f"step {step}: {failure}"
