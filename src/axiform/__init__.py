@@ -14,12 +14,15 @@ _WHERE = {
     "Model": "model.model",
     "select_edges": "fem.selectors", "select_nodes": "fem.selectors",
     "Sensitivity": "app.sensitivity", "sensitivity": "app.sensitivity",
-    "DisplacementControl": "solve.solver", "LoadControl": "solve.solver", "NewtonOptions": "solve.solver",
+    "ArcLengthControl": "solve.controls", "DisplacementControl": "solve.controls", "LoadControl": "solve.controls",
+    "NewtonOptions": "solve.controls", "ContactPair": "contact.pair", "Circle": "contact.surfaces",
+    "Polyline": "contact.surfaces",
 }
 
 __all__ = [
     "ELEMENTS", "Q4", "Q8", "SFR", "MooneyRivlin", "NeoHooke", "Mesh", "read_gmsh", "rectangle",
-    "Model", "select_edges", "select_nodes", "DisplacementControl", "LoadControl",
+    "Model", "select_edges", "select_nodes", "ArcLengthControl", "DisplacementControl", "LoadControl",
+    "ContactPair", "Circle", "Polyline",
     "NewtonOptions", "solve", "Yeoh", "Ogden", "Gent", "ArrudaBoyce", "sensitivity", "Sensitivity",
 ]
 __version__ = "0.1.0"
