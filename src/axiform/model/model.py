@@ -280,16 +280,20 @@ class Model:
         """The history before the first step (t = 0): contact pairs untouched, cavities at
         their initial volume and no gauge pressure."""
         return ModelState(0.0, tuple(pair.initial_state() for pair in self.contacts),
-                          tuple(CavityState(0.0, c.V0) for c in self.cavities))
+                          tuple(CavityState(0.0, c.V0) for c in self.cavities), self.loads[0].initial_state())
 
     def restore(self, saved: dict) -> ModelState:
         """The state saved by ModelState.to_dict (a checkpoint), checked against this model."""
         if len(saved["contacts"]) != len(self.contacts) or len(saved["cavities"]) != len(self.cavities):
             raise ValueError("the saved state has other contact pairs or cavities than this model")
         start = self.initial_state()
+        solid = {k: np.asarray(v) for k, v in saved.get("solid", {}).items()}
+        if solid.keys() != start.solid.keys() or any(v.shape != start.solid[k].shape for k, v in solid.items()):
+            raise ValueError("the saved state has another history of the solid than this model's material")
         return ModelState(float(saved.get("t", 0.0)),
                           tuple(s.from_dict(d) for s, d in zip(start.contacts, saved["contacts"])),
-                          tuple(CavityState(float(d["pressure"]), float(d["volume"])) for d in saved["cavities"]))
+                          tuple(CavityState(float(d["pressure"]), float(d["volume"])) for d in saved["cavities"]),
+                          solid)
 
     # ---- evaluation ------------------------------------------------------------------------
     def expand(self, u_f: np.ndarray, t: float) -> np.ndarray:
@@ -326,7 +330,8 @@ class Model:
         nf = dm.nf
         presc, dpresc = self.prescribed(t)
         u = dm.expand(u_f, presc)
-        parts = [(term, term.evaluate(u, t, None, tangent)) for term in self.loads]
+        parts = [(self.loads[0], self.loads[0].evaluate(u, t, state.solid, tangent))]
+        parts += [(term, term.evaluate(u, t, None, tangent)) for term in self.loads[1:]]
         parts += [(term, term.evaluate(u, t, held, tangent, predicting))
                   for term, held in zip(self.contact_terms, state.contacts)]
         constraints = []
@@ -362,7 +367,8 @@ class Model:
             constraint_error = float(np.max([abs(c.value) / c.scale for c in constraints]))
         scale = float(np.linalg.norm(parts[0][1].magnitude) + np.linalg.norm(f_ext))
         trial = ModelState(float(t), tuple(part.trial for term, part in parts if isinstance(term, ContactTerm)),
-                           tuple(part.trial for term, part in parts if isinstance(term, CavityTerm)))
+                           tuple(part.trial for term, part in parts if isinstance(term, CavityTerm)),
+                           parts[0][1].trial)
         return Evaluation(r, dr_dt, K, r_full, f_ext, scale, self._noise_floor, nf, constraint_error,
                           float(np.linalg.norm(u)), trial)
 

@@ -9,7 +9,9 @@ by a failed attempt, changes nothing that is written or reported.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+import numpy as np
 
 from ..contact.state import ContactState
 
@@ -25,13 +27,17 @@ class CavityState:
 @dataclass(frozen=True)
 class ModelState:
     """The committed (or trial) history of a model at process time t: one ContactState per
-    contact pair, one CavityState per cavity, in the model's order."""
+    contact pair, one CavityState per cavity, in the model's order, and the solid's history
+    per quadrature point (`solid`: a dict of arrays (e, q, ...), empty for elastic laws,
+    which have none).  dt = t_trial - t_committed is what a term integrates over."""
 
     t: float
     contacts: tuple[ContactState, ...] = ()
     cavities: tuple[CavityState, ...] = ()
+    solid: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """Plain arrays and numbers (a checkpoint)."""
         return {"t": float(self.t), "contacts": [c.to_dict() for c in self.contacts],
-                "cavities": [{"pressure": c.pressure, "volume": c.volume} for c in self.cavities]}
+                "cavities": [{"pressure": c.pressure, "volume": c.volume} for c in self.cavities],
+                "solid": {k: np.array(v, copy=True) for k, v in self.solid.items()}}

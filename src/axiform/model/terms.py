@@ -51,7 +51,8 @@ def assemble(dofs: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
 class SolidTerm:
     """The body's internal forces f_int (eqs. 17-30) and material tangent, by the assembly
     of its formulation (fem.assembly.SolidAssembly or fem.mixed.MixedAssembly).  Elastic
-    laws carry no history: its state is None.  The element arrays are written into scratch
+    laws carry no history: its state is an empty dict (a law with memory keeps its arrays
+    per quadrature point there, (e, q, ...)).  The element arrays are written into scratch
     buffers reused from call to call (work space, not state: nothing of one call is read by
     the next)."""
 
@@ -61,13 +62,17 @@ class SolidTerm:
         self.blocks = (assembly.dofs,)
         self._scratch: dict[bool, tuple] = {}
 
-    def evaluate(self, u: np.ndarray, t: float, state=None, tangent: bool = True) -> Contribution:
+    def initial_state(self) -> dict:
+        """The history per quadrature point before the first step: none for elastic laws."""
+        return {}
+
+    def evaluate(self, u: np.ndarray, t: float, state: dict | None = None, tangent: bool = True) -> Contribution:
         if tangent not in self._scratch:
             self._scratch[tangent] = self.assembly.buffers(tangent)
         fe, Ke = self.assembly.evaluate(u, tangent, self._scratch[tangent])
         dofs = self.assembly.dofs
         return Contribution(assemble(dofs, fe, self.n_full), K=(Ke,) if tangent else (),
-                            magnitude=assemble(dofs, np.abs(fe), self.n_full))
+                            magnitude=assemble(dofs, np.abs(fe), self.n_full), trial={})
 
 
 class PressureTerm:
