@@ -28,7 +28,7 @@ from xml.etree import ElementTree as ET
 import numpy as np
 
 from . import gid
-from ..post.fields import point_fields
+from ..post.fields import point_fields, with_components
 from ..post.thickness import thickness_table, write_thickness_csv
 from .run_report import RunRecord, thickness_summary
 
@@ -62,16 +62,6 @@ def _write_vtu(path: Path, mesh, data: dict[str, np.ndarray]) -> None:
     pts = np.column_stack([mesh.points, np.zeros(mesh.n_nodes)])
     with atomic(path) as tmp:
         meshio.write(tmp, meshio.Mesh(pts, [(cell_type, mesh.cells)], point_data=data), file_format="vtu")
-
-
-def with_components(data: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-    """The point data for a VTU file: the fields, and the Cauchy stress's components besides
-    as the scalars cauchy_stress_rr, _zz, _tt, _rz (meshio writes no ComponentName attributes:
-    ParaView would call them 0..3)."""
-    if "cauchy_stress" not in data:
-        return data
-    sig = data["cauchy_stress"]
-    return data | {f"cauchy_stress_{c}": np.ascontiguousarray(sig[:, k]) for k, c in enumerate(("rr", "zz", "tt", "rz"))}
 
 
 class NonFiniteResult(ArithmeticError):

@@ -77,3 +77,12 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
             out[f"first_contact_{k}"] = np.nan_to_num(contact_times(mesh, [pair]), nan=-1.0)
     return out
 
+
+def with_components(data: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The point data for a VTU file: the fields, and the Cauchy stress's components besides
+    as the scalars cauchy_stress_rr, _zz, _tt, _rz (meshio writes no ComponentName attributes:
+    ParaView would call them 0..3)."""
+    if "cauchy_stress" not in data:
+        return data
+    sig = data["cauchy_stress"]
+    return data | {f"cauchy_stress_{c}": np.ascontiguousarray(sig[:, k]) for k, c in enumerate(("rr", "zz", "tt", "rz"))}
