@@ -159,3 +159,17 @@ def test_stabilization_work_above_1_percent_of_the_strain_energy_is_a_warning():
     assert stab == {"work": 0.2, "strain_energy": 10.0, "ratio": pytest.approx(0.02)}
     (line,) = rec.warnings(step, stab)  # touched (first_contact), no penetration
     assert line.startswith("contact stabilization dissipated 0.2, 2.0 % of the strain energy 10")
+
+
+def test_the_units_of_the_csv_columns_are_in_the_summary():
+    """The headers stay bare names (every reader keys on them); summary.json maps them to units."""
+    from axiform.io.run_report import column_units
+
+    units = column_units({"units": {"length": "mm", "pressure": "MPa", "force": "N"},
+                          "monitor_quantities": {"travel": "displacement", "F": "force", "A": "area",
+                                                 "phi": "rotation", "V": "volume", "p": "pressure"}})
+    assert units["history.csv"] == {"travel": "mm", "F": "N", "A": "mm^2", "phi": "rad", "V": "mm^3", "p": "MPa"}
+    assert units["thickness.csv"]["thickness"] == "mm" and "ratio" not in units["thickness.csv"]
+    assert units["contact.csv"] == {"r": "mm", "z": "mm", "gap": "mm", "pressure": "MPa"}
+    assert column_units({"units": {}, "monitor_quantities": {"F": "force"}}) == {
+        "history.csv": {}, "thickness.csv": {}, "contact.csv": {}}

@@ -30,7 +30,7 @@ import numpy as np
 from . import gid
 from ..post.fields import point_fields, with_components
 from ..post.thickness import thickness_table, write_thickness_csv
-from .run_report import RunRecord, thickness_summary
+from .run_report import RunRecord, column_units, thickness_summary
 
 
 @contextmanager
@@ -92,6 +92,7 @@ def initial_summary(model, title: str, labels: dict | None, case: dict | None, w
     summary.update(labels or {})
     if case is not None:  # where the case came from and its fingerprint (the folder rule)
         summary["case"] = case
+    summary["column_units"] = column_units(summary)
     return summary
 
 

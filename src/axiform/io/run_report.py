@@ -2,7 +2,7 @@
 pair the largest force and the largest penetration against the local wall over the run,
 whether it ever touched; the thinnest wall of the last thickness table; the work of the
 contact stabilization against the strain energy; and the warnings drawn from them at the
-end of the run.
+end of the run; and the units of the CSV files' columns (`column_units`).
 
 The penetration of a slave node is measured against the wall thickness at that node where
 the mesh has a wall (mesh.fibres: the thickness table), else against the height of the
@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..post.labels import QUANTITY_UNIT
 from ..post.thickness import nodal_thickness
 
 PENETRATION_LIMIT = 0.05  # of the local wall thickness
@@ -116,3 +117,29 @@ class RunRecord:
                          f"(above {100 * STABILIZATION_LIMIT:g} %): the result leans on the damping; "
                          "lower contact stabilization or support the body")
         return lines
+
+
+LENGTH_COLUMNS = {"thickness.csv": ("s", "r", "z", "thickness", "initial_thickness", "s_current"),
+                  "contact.csv": ("r", "z", "gap")}
+
+
+def column_units(summary: dict) -> dict[str, dict[str, str]]:
+    """The unit of every CSV column that has one in the case's [units] (summary's `units`
+    and `monitor_quantities`), per file: {"history.csv": {monitor: unit}, "thickness.csv":
+    {...}, "contact.csv": {...}}.  The CSV headers stay the bare column names (every reader
+    keys on them); this map is where a reader finds the units."""
+    units = summary.get("units") or {}
+    length = units.get("length")
+    derived = {"area": f"{length}^2" if length else None, "volume": f"{length}^3" if length else None,
+               "rotation": "rad"}
+    history = {}
+    for name, quantity in (summary.get("monitor_quantities") or {}).items():
+        unit = derived.get(quantity) if quantity in derived else units.get(QUANTITY_UNIT.get(quantity, ""))
+        if unit:
+            history[name] = unit
+    out = {"history.csv": history}
+    for file, columns in LENGTH_COLUMNS.items():
+        out[file] = {c: length for c in columns} if length else {}
+    if units.get("pressure"):
+        out["contact.csv"]["pressure"] = units["pressure"]
+    return out
