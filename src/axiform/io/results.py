@@ -183,9 +183,7 @@ class ResultsWriter:
         self._history = io.StringIO()
         self._csv = csv.writer(self._history, lineterminator="\n")
         self._csv.writerow(header)
-        earlier = None
-        if resume is not None:
-            earlier = _read_summary(self.out).get("contact")
+        earlier = _read_summary(self.out).get("contact") if resume is not None else None  # the run's maxima so far
         kept = self._resume(resume, header) if resume is not None else 0
         self.record = RunRecord(self.model, earlier if kept else None)
         write_atomic(self.out / "history.csv", self._history.getvalue())
