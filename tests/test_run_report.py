@@ -173,3 +173,22 @@ def test_the_units_of_the_csv_columns_are_in_the_summary():
     assert units["contact.csv"] == {"r": "mm", "z": "mm", "gap": "mm", "pressure": "MPa"}
     assert column_units({"units": {}, "monitor_quantities": {"F": "force"}}) == {
         "history.csv": {}, "thickness.csv": {}, "contact.csv": {}}
+
+
+def test_a_resumed_run_keeps_the_maxima_of_its_first_part(tmp_path):
+    built = build(parse(ring_case()), tmp_path)
+    writer = ResultsWriter(tmp_path, built.model, plots=False, vtu=False)
+    steps = []
+    solve(built.model, built.control, built.options, on_step=lambda s: (writer.step(s), steps.append(s)))
+    writer.finish("finished")
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    summary["contact"][1]["max_force_z"] = 1e9  # as if an earlier step had pressed harder
+    (tmp_path / "summary.json").write_text(json.dumps(summary))
+    again = build(parse(ring_case()), tmp_path)
+    resumed = ResultsWriter(tmp_path, again.model, plots=False, vtu=False, resume=steps[1].checkpoint)
+    solve(again.model, again.control, again.options, on_step=resumed.step, resume=steps[1].checkpoint)
+    with contextlib.redirect_stderr(io.StringIO()):
+        resumed.finish("finished")
+    after = json.loads((tmp_path / "summary.json").read_text())
+    assert after["steps"] == len(steps) and after["contact"][1]["max_force_z"] == 1e9
+    assert after["contact"][0]["max_force_z"] == summary["contact"][0]["max_force_z"]
