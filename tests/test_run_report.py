@@ -15,8 +15,11 @@ import pytest
 
 from axiform import rectangle
 from axiform.case.schema import build, parse
+from axiform.fem.mesh import layered
+from axiform.fem.profile import Arc, Line, Profile
 from axiform.io.results import ResultsWriter
-from axiform.io.run_report import RunRecord
+from axiform.io.run_report import RunRecord, column_units
+from axiform.post.thickness import _corners, thickness_table
 from axiform.solve.solver import solve
 
 A, B, H = 18.0, 22.0, 4.0  # a square ring pressed between two plates (as test_stabilization)
@@ -132,8 +135,6 @@ def test_a_penetration_above_5_percent_of_the_wall_is_a_warning():
     state = SimpleNamespace(contacts=[SimpleNamespace(first_contact=np.full(len(top), np.nan), damping_work=0.0)])
     gap = np.zeros(len(top))
     gap[2] = -0.018  # 6 % of 0.3
-    from axiform.post.thickness import thickness_table
-
     table = thickness_table(model.mesh, np.zeros_like(x))
     rec.contact_step(SimpleNamespace(number=3), [report(top, gap, np.ones(len(top)))], x, table)
     gap[2] = -0.006
@@ -163,8 +164,6 @@ def test_stabilization_work_above_1_percent_of_the_strain_energy_is_a_warning():
 
 def test_the_units_of_the_csv_columns_are_in_the_summary():
     """The headers stay bare names (every reader keys on them); summary.json maps them to units."""
-    from axiform.io.run_report import column_units
-
     units = column_units({"units": {"length": "mm", "pressure": "MPa", "force": "N"},
                           "monitor_quantities": {"travel": "displacement", "F": "force", "A": "area",
                                                  "phi": "rotation", "V": "volume", "p": "pressure"}})
@@ -192,3 +191,17 @@ def test_a_resumed_run_keeps_the_maxima_of_its_first_part(tmp_path):
     after = json.loads((tmp_path / "summary.json").read_text())
     assert after["steps"] == len(steps) and after["contact"][1]["max_force_z"] == 1e9
     assert after["contact"][0]["max_force_z"] == summary["contact"][0]["max_force_z"]
+
+
+def test_the_wall_at_a_corner_of_a_layered_profile_is_not_the_mitre():
+    """Two lines meeting at 90 degrees, a wall 0.1 thick: the corner's fibre is the mitre
+    (0.1 sqrt 2), the thickness is 0.1 there too, before and after a rigid rotation; a
+    coarsely divided arc (30 degrees a station) is no corner."""
+    mesh = layered(Profile((1.0, 0.0), (Line((1.0, 2.0), 8), Line((3.0, 2.0), 8))), 0.1, 2, "q4")
+    c, s = np.cos(0.3), np.sin(0.3)
+    rotated = mesh.points @ np.array([[c, s], [-s, c]]) - mesh.points
+    for u in (np.zeros((mesh.n_nodes, 2)), rotated):
+        t = thickness_table(mesh, u)
+        assert np.allclose(t["thickness"], 0.1) and np.allclose(t["ratio"], 1.0)
+    arc = layered(Profile((1.0, 0.0), (Line((1.0, 2.0), 8), Arc((0.0, 2.0), (0.0, 3.0), 3, ccw=True))), 0.1, 2, "q4")
+    assert not _corners(arc.points, arc.fibres).any() and _corners(mesh.points, mesh.fibres).sum() == 1
