@@ -92,4 +92,4 @@ def test_pressure_field_of_a_uniform_compression(element, formulation):
     u[:, :2] = a * mesh.points
     fields = point_fields(model, u.ravel())
     expected = -kappa * ((1 + a) ** 3 - 1)
-    assert fields["pressure"] == pytest.approx(np.full(mesh.n_nodes, expected), rel=1e-10)
+    assert fields["hydrostatic_pressure"] == pytest.approx(np.full(mesh.n_nodes, expected), rel=1e-10)

@@ -6,6 +6,7 @@ import csv
 import json
 import tomllib
 
+import numpy as np
 import pytest
 
 from axiform.cli import main
@@ -87,7 +88,8 @@ def test_sweep_failure_recorded_and_resume(sweep_dir, capsys):
     assert main(args) == 1  # one case did not finish
     rows = stress_rows(out / "sweep.csv")
     assert list(rows[0]) == ["case", "material.C1", "solver.steps", "solver.max_iterations", "solver.min_step",
-                             "status", "exit_code", "steps", "wall_time_s", "message", "w_center", "rim_force_z"]
+                             "status", "exit_code", "steps", "wall_time_s", "message", "w_center", "rim_force_z",
+                             "thickness_min", "w_center_min", "w_center_max", "rim_force_z_min", "rim_force_z_max"]
     assert [r["case"] for r in rows] == ["0001", "0002", "0003"]
     assert [r["status"] for r in rows] == ["finished", "stopped", "finished"]
     assert [r["exit_code"] for r in rows] == ["0", "1", "0"]
@@ -101,6 +103,12 @@ def test_sweep_failure_recorded_and_resume(sweep_dir, capsys):
         assert float(r["w_center"]) == pytest.approx(1.0, rel=1e-12)
         assert float(r["rim_force_z"]) == summary["monitors"]["rim_force_z"]
         assert int(r["steps"]) == summary["steps"] == 4
+        # over the run, from history.csv: not only the last value (a monitor back at 0 at the end)
+        history = np.genfromtxt(out / "cases" / r["case"] / "history.csv", delimiter=",", names=True)
+        assert float(r["w_center_min"]) == history["w_center"].min() < float(r["w_center_max"])
+        assert float(r["w_center_max"]) == pytest.approx(1.0, rel=1e-12)
+        assert float(r["rim_force_z_min"]) == history["rim_force_z"].min()
+        assert float(r["thickness_min"]) == summary["thickness"]["min"] > 0
     # a stiffer plate needs a larger rim force for the same deflection
     assert float(rows[2]["rim_force_z"]) < float(rows[0]["rim_force_z"]) < 0
     assert (out / "sweep.png").stat().st_size > 0

@@ -13,7 +13,8 @@ Case k (k = 1, 2, ...; the last key of [vary] varies fastest) runs in DIR/cases/
 (NNNN = k, four digits) through the same code as `axiform run CASE --set KEY=VALUE ... --out
 DIR/cases/NNNN`: a normal results folder.  DIR/sweep.csv has one row per case (case, the
 varied keys, status, exit_code, steps, wall_time_s, message, the last value of every
-monitor), rewritten as cases finish; DIR/sweep.png plots the report monitor against the
+monitor, thickness_min (the thinnest wall at the end, meshes with a wall), then M_min and
+M_max of every monitor M over the run, from the case's history.csv), rewritten as cases finish; DIR/sweep.png plots the report monitor against the
 varied keys.  A case that fails or stops keeps its row; a second run of the same command
 skips the cases whose summary.json says "finished" for the same case text (resume).
 
@@ -187,14 +188,33 @@ def run_case(case_file: str, overrides: list[str], out: str) -> dict[str, Any]:
 
 
 def summary_row(folder: Path) -> dict[str, Any]:
-    """status, steps, wall_time_s, message and the monitors of a results folder's summary.json
-    ({} when it has none)."""
+    """status, steps, wall_time_s, message, the monitors and the thinnest wall of a results
+    folder's summary.json, and every monitor's (min, max) over the run from its history.csv
+    ({} when it has no summary.json)."""
     try:
         s = json.loads((folder / "summary.json").read_text())
     except (OSError, ValueError):
         return {}
     return {"status": s.get("status"), "steps": s.get("steps"), "wall_time_s": s.get("wall_time_s"),
-            "message": s.get("message", ""), "monitors": s.get("monitors", {}), "sha256": s.get("case", {}).get("sha256")}
+            "message": s.get("message", ""), "monitors": s.get("monitors", {}), "sha256": s.get("case", {}).get("sha256"),
+            "thickness_min": (s.get("thickness") or {}).get("min"), "extremes": monitor_extremes(folder / "history.csv")}
+
+
+def monitor_extremes(history: Path) -> dict[str, tuple[float, float]]:
+    """(min, max) of every monitor column of a history.csv over its rows; {} without one."""
+    try:
+        with open(history, newline="") as fh:
+            rows = list(csv.reader(fh))
+    except OSError:
+        return {}
+    if len(rows) < 2:
+        return {}
+    extremes = {}
+    for k, name in enumerate(rows[0][3:], start=3):
+        values = [float(r[k]) for r in rows[1:] if len(r) > k and r[k]]
+        if values:
+            extremes[name] = (min(values), max(values))
+    return extremes
 
 
 class SweepProgress:
@@ -225,15 +245,18 @@ def write_table(path: Path, sweep: Sweep, rows: list[dict | None]) -> None:
 
     text = io.StringIO()
     w = csv.writer(text, lineterminator="\n")
-    w.writerow(["case", *sweep.keys, *FIXED_COLUMNS, *sweep.monitors])
+    w.writerow(["case", *sweep.keys, *FIXED_COLUMNS, *sweep.monitors, "thickness_min",
+                *[f"{m}_{end}" for m in sweep.monitors for end in ("min", "max")]])
     for k, row in enumerate(rows):
         row = row or {"status": "pending"}
         values = [v if isinstance(v, str) else toml_value(v) for v in (sweep.cases[k].get(key, "") for key in sweep.keys)]
         wall = row.get("wall_time_s")
-        monitors = row.get("monitors", {})
+        monitors, extremes, thinnest = row.get("monitors", {}), row.get("extremes", {}), row.get("thickness_min")
         w.writerow([f"{k + 1:04d}", *values, row.get("status", ""), row.get("exit_code", ""), row.get("steps", ""),
                     "" if wall is None else f"{wall:.3f}", " ".join(str(row.get("message", "")).split()),
-                    *[repr(monitors[m]) if m in monitors else "" for m in sweep.monitors]])
+                    *[repr(monitors[m]) if m in monitors else "" for m in sweep.monitors],
+                    "" if thinnest is None else repr(thinnest),
+                    *[repr(v) for m in sweep.monitors for v in extremes.get(m, ("", ""))]])
     write_atomic(path, text.getvalue())
 
 

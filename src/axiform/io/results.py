@@ -17,7 +17,9 @@ import io
 import json
 import os
 import shutil
+import sys
 import time
+from collections.abc import Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import contextmanager
 from pathlib import Path
@@ -26,8 +28,9 @@ from xml.etree import ElementTree as ET
 import numpy as np
 
 from . import gid
-from ..post.fields import point_fields
+from ..post.fields import point_fields, with_components
 from ..post.thickness import thickness_table, write_thickness_csv
+from .run_report import RunRecord, column_units, thickness_summary
 
 
 @contextmanager
@@ -65,6 +68,66 @@ class NonFiniteResult(ArithmeticError):
     """A converged step holds NaN or inf: it is not written; the message names the place."""
 
 
+def initial_summary(model, title: str, labels: dict | None, case: dict | None, warnings: Sequence[str]) -> dict:
+    """summary.json before the first step: the model's size, the labels (units, load,
+    monitor_quantities), the case's origin and fingerprint, the pre-run warnings."""
+    summary = {
+        "title": title,
+        "status": "running",
+        "steps": 0,
+        "newton_iterations": 0,
+        "wall_time_s": 0.0,
+        "dofs": int(model.dofmap.n_eq),
+        "free_dofs": int(model.n_free),
+        "elements": int(model.mesh.n_cells),
+        "nodes": int(model.mesh.n_nodes),
+        "element": model.mesh.element.name,
+        "load_factor": 0.0,
+        "monitors": {},
+        "units": {},
+        "load": None,
+        "monitor_quantities": {},
+        "warnings": list(dict.fromkeys(" ".join(str(w).split()) for w in warnings)),
+    }
+    summary.update(labels or {})
+    if case is not None:  # where the case came from and its fingerprint (the folder rule)
+        summary["case"] = case
+    summary["column_units"] = column_units(summary)
+    return summary
+
+
+def _read_summary(out: Path) -> dict:
+    try:
+        return json.loads((out / "summary.json").read_text())
+    except (OSError, ValueError):
+        return {}
+
+
+STALE = ("thickness.csv", "contact.csv", "surfaces.csv", "fields.pvd", "revolved.vtu", "load_curve.png",
+         "thickness.png", "deformed.png", "forming.gif")
+
+
+def clear_folder(out: Path, kept: int, vtu: bool, thickness_steps: bool) -> list[tuple[float, str]]:
+    """Make the folders; remove the temporary files, the per-step files after step `kept`
+    and the files written at the end of a run (STALE).  Returns the fields.pvd entries of
+    the VTU files kept (a resumed run)."""
+    for tmp in out.glob(".*.tmp"):
+        tmp.unlink()
+    if vtu:
+        (out / "fields").mkdir(exist_ok=True)
+    for old in [*(out / "fields").glob("step_*.vtu"), *(out / "fields").glob("surfaces_*.csv"),
+                *(out / "thickness").glob("step_*.csv")]:
+        if int(old.stem.split("_")[-1]) > kept:
+            old.unlink()
+    if thickness_steps:
+        (out / "thickness").mkdir(exist_ok=True)
+    for stale in STALE:
+        (out / stale).unlink(missing_ok=True)
+    if not (kept and vtu):
+        return []
+    return [(float(int(f.stem.split("_")[-1])), f"fields/{f.name}") for f in sorted((out / "fields").glob("step_*.vtu"))]
+
+
 class ResultsWriter:
     """Writes the results folder step by step, so that a run stopped midway keeps every
     converged step."""
@@ -73,7 +136,7 @@ class ResultsWriter:
                  vtu: bool = True, gid_files: bool = False, revolved: int = 0, plots: bool = True,
                  thickness_every: int | None = None, labels: dict | None = None,
                  case: dict | None = None, restart_every: int = 0, restart_meta: dict | None = None,
-                 resume: dict | None = None, flush_every_s: float = 0.0):
+                 resume: dict | None = None, flush_every_s: float = 0.0, warnings: Sequence[str] = ()):
         """labels: units, load and monitor_quantities for summary.json (labels.case_labels);
         case: where the case came from and its fingerprint.  restart_every: write the step's
         checkpoint to restart/ every k steps (and at the end of the run, whatever stopped it),
@@ -83,7 +146,8 @@ class ResultsWriter:
         thickness.csv and fields.pvd are rewritten after a step when that long has passed
         since they last were (0: after every step), before every checkpoint and by `finish`,
         whatever ended the run: a run that never reaches `finish` (kill -9) loses at most
-        that long of rows."""
+        that long of rows.  warnings: the pre-run warnings (one line each) for summary.json's
+        `warnings` (the caller has printed them; `warn` adds more, `finish` its own)."""
         self.out = Path(out)
         self.out.mkdir(parents=True, exist_ok=True)
         self.model = model
@@ -105,56 +169,39 @@ class ResultsWriter:
         self._vtu_writer: ThreadPoolExecutor | None = None  # writes the VTU files (_write_vtu)
         self._vtu_pending: list[tuple[float, str, Future]] = []  # submitted, not yet in _pvd
         self._last_written = 0
-        self.summary = {
-            "title": title,
-            "status": "running",
-            "steps": 0,
-            "newton_iterations": 0,
-            "wall_time_s": 0.0,
-            "dofs": int(model.dofmap.n_eq),
-            "free_dofs": int(model.n_free),
-            "elements": int(model.mesh.n_cells),
-            "nodes": int(model.mesh.n_nodes),
-            "element": model.mesh.element.name,
-            "load_factor": 0.0,
-            "monitors": {},
-            "units": {},
-            "load": None,
-            "monitor_quantities": {},
-        }
-        self.summary.update(labels or {})
-        if case is not None:  # where the case came from and its fingerprint (the folder rule)
-            self.summary["case"] = case
+        self._unsaid: list[str] = []  # warnings to print to stderr at the end (not the pre-run ones)
+        self.summary = initial_summary(model, title, labels, case, warnings)
         self.restart_every = restart_every
         self.restart_meta = restart_meta or {}
         self._checkpoint = None
+        self._start_folder(resume)
+
+    def _start_folder(self, resume: dict | None) -> None:
+        """history.csv (with the kept rows of a resumed run), the folders, no stale files,
+        the GiD mesh, and a first summary.json."""
         header = ["step", "load_factor", "iterations"] + [m.name for m in self.monitors]
         self._history = io.StringIO()
         self._csv = csv.writer(self._history, lineterminator="\n")
         self._csv.writerow(header)
+        earlier = _read_summary(self.out).get("contact") if resume is not None else None  # the run's maxima so far
         kept = self._resume(resume, header) if resume is not None else 0
+        self.record = RunRecord(self.model, earlier if kept else None)
         write_atomic(self.out / "history.csv", self._history.getvalue())
-        for tmp in self.out.glob(".*.tmp"):
-            tmp.unlink()
-        if vtu:
-            (self.out / "fields").mkdir(exist_ok=True)
-        for old in [*(self.out / "fields").glob("step_*.vtu"), *(self.out / "fields").glob("surfaces_*.csv"),
-                    *(self.out / "thickness").glob("step_*.csv")]:
-            if int(old.stem.split("_")[-1]) > kept:
-                old.unlink()
-        self._pvd = [(float(n), f"fields/{f.name}") for f in sorted((self.out / "fields").glob("step_*.vtu"))
-                     for n in [int(f.stem.split("_")[-1])]] if kept and vtu else []
-        if thickness_every and model.mesh.fibres is not None:
-            (self.out / "thickness").mkdir(exist_ok=True)
-        for stale in ("thickness.csv", "contact.csv", "surfaces.csv", "fields.pvd", "revolved.vtu", "load_curve.png",
-                      "thickness.png", "deformed.png", "forming.gif"):
-            (self.out / stale).unlink(missing_ok=True)
+        self._pvd = clear_folder(self.out, kept, self.vtu, bool(self.thickness_every and self.model.mesh.fibres is not None))
         if self.gid:
             with atomic(self.out / "axiform.post.msh") as tmp:
-                gid.write_mesh(tmp, model.mesh.points, model.mesh.cells)
+                gid.write_mesh(tmp, self.model.mesh.points, self.model.mesh.cells)
             with atomic(self.out / "axiform.post.res") as tmp:
                 gid.start_results(tmp)
         self._write_summary()
+
+    def warn(self, line: str) -> None:
+        """Add a warning (one line) to summary.json's `warnings`; printed to stderr as
+        `warning: <line>` by `finish`.  A line already there is not added again."""
+        line = " ".join(str(line).split())
+        if line and line not in self.summary["warnings"]:
+            self.summary["warnings"].append(line)
+            self._unsaid.append(line)
 
     def _resume(self, checkpoint: dict, header: list[str]) -> int:
         """Keep history.csv's rows up to the checkpoint's step; returns that step."""
@@ -249,26 +296,31 @@ class ResultsWriter:
         return values
 
     def _write_contact(self, step):
-        """contact.csv: every slave node of every pair at this step; totals in the summary."""
+        """contact.csv: every slave node of every pair at this step (gap left empty where the
+        node sees no surface); the totals, and the run's largest force and penetration against
+        the wall (RunRecord), in the summary."""
         from ..contact.pair import STATUS
 
         text = io.StringIO()
         table = csv.writer(text, lineterminator="\n")
         table.writerow(["pair", "node", "r", "z", "gap", "pressure", "status", "first_contact"])  # header first
-        totals = []
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
-        for k, (pair, held) in enumerate(zip(self.model.contacts, step.state.contacts)):
-            rep = pair.report(held)
-            x = self.model.mesh.points[rep["node"]] + u[rep["node"]]
-            for node, (r, z), g, p, st, t in zip(rep["node"], x, rep["gap"], rep["pressure"], rep["status"],
-                                                  rep["first_contact"]):
+        x = self.model.mesh.points + u
+        reports = [pair.report(held) for pair, held in zip(self.model.contacts, step.state.contacts)]
+        for k, rep in enumerate(reports):
+            for node, g, p, st, t in zip(rep["node"], rep["gap"], rep["pressure"], rep["status"], rep["first_contact"]):
+                r, z = x[node]
+                gap = "" if np.isnan(g) else f"{g:.6g}"
                 first = "" if np.isnan(t) else repr(float(t))
-                table.writerow([k, node, f"{r:.10g}", f"{z:.10g}", f"{g:.6g}", f"{p:.6g}", STATUS[int(st)], first])
-            totals.append({"name": pair.name or f"contact[{k}]"}
-                          | {q: rep[q] for q in ("force_r", "force_z", "contact_area", "penetration")})
+                table.writerow([k, node, f"{r:.10g}", f"{z:.10g}", gap, f"{p:.6g}", STATUS[int(st)], first])
         write_atomic(self.out / "contact.csv", text.getvalue())
         write_atomic(self.out / "surfaces.csv", mould_outlines(self.model.contacts, float(step.lam)))
-        self.summary["contact"] = totals
+        self.record.contact_step(step, reports, x, thickness_table(self.model.mesh, u) if self.model.mesh.fibres
+                                 is not None else None)
+        self.summary["contact"] = [{"name": rec.name} | {q: rep[q] for q in ("force_r", "force_z", "contact_area",
+                                                                           "penetration")}
+                                   | rec.summary() | {"touched": rec.touched}
+                                   for rec, rep in zip(self.record.pairs, reports)]
 
     def _write_fields(self, step):
         """Field output of one step: VTU (+ .pvd), GiD results, thickness.csv."""
@@ -276,6 +328,8 @@ class ResultsWriter:
         self._last_written = step.number
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
         self._thickness = thickness_table(mesh, u, step.state.contacts)
+        if self._thickness is not None:
+            self.summary["thickness"] = thickness_summary(self._thickness)
         if self.vtu and self.model.contacts:
             write_atomic(self.out / "fields" / f"surfaces_{step.number:04d}.csv",
                          mould_outlines(self.model.contacts, float(step.lam)))
@@ -292,7 +346,7 @@ class ResultsWriter:
         name = f"step_{step.number:04d}.vtu"
         if self._vtu_writer is None:
             self._vtu_writer = ThreadPoolExecutor(max_workers=1, thread_name_prefix="axiform-vtu")
-        job = self._vtu_writer.submit(_write_vtu, self.out / "fields" / name, mesh, data)
+        job = self._vtu_writer.submit(_write_vtu, self.out / "fields" / name, mesh, with_components(data))
         self._vtu_pending.append((float(step.number), f"fields/{name}", job))
 
     def _wait_for_vtu(self, wait: bool = True) -> None:
@@ -336,6 +390,9 @@ class ResultsWriter:
         self.summary["status"] = status
         if message:
             self.summary["message"] = message
+        if hasattr(self, "_last_step"):
+            self._end_of_run(self._last_step)
+        self._say_warnings()
         self._flush()
         if self.restart_every:
             self.save_checkpoint()
@@ -357,6 +414,21 @@ class ResultsWriter:
             plot_folder(self.out)
         if failure is not None:
             raise failure
+
+    def _end_of_run(self, step) -> None:
+        """The run's checks on its last step (run_report.RunRecord): the stabilization's work
+        in the summary, and the warnings."""
+        stabilization = self.record.stabilization(step) if self.model.contacts else None
+        if stabilization is not None:
+            self.summary["stabilization"] = stabilization
+        for line in self.record.warnings(step, stabilization) if self.model.contacts else ():
+            self.warn(line)
+
+    def _say_warnings(self) -> None:
+        """Print the warnings added since the run began to stderr, once each."""
+        for line in self._unsaid:
+            print(f"warning: {line}", file=sys.stderr)
+        self._unsaid = []
 
     def save_checkpoint(self) -> None:
         """restart/checkpoint.npz: the state after the last recorded step (if it has one)."""

@@ -1,5 +1,6 @@
 """Nodal fields for output: displacement, fibre rotation, J, Cauchy and von Mises stress,
-pressure (-tr sigma / 3, volume-averaged over each element), principal stretches, contact
+hydrostatic_pressure (-tr sigma / 3, volume-averaged over each element; not the applied
+pressure), principal stretches, contact
 pressure, time of first contact.
 
 Quadrature-point values are averaged to the nodes (each element's mean, then the mean over
@@ -21,7 +22,7 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
     """Nodal fields (n,) or (n, k) of the state u_full (all dofs) with the committed history
     `state` (model.state.ModelState; None: the initial one): displacement (ur, uz, 0),
     J, cauchy_stress (rr, zz, tt, rz), von_mises, principal_stretches (in-plane major, minor,
-    hoop); fibre_rotation (SFR); thickness (meshes with fibres); contact_pressure and
+    hoop), hydrostatic_pressure (-tr sigma / 3); fibre_rotation (SFR); thickness (meshes with fibres); contact_pressure and
     first_contact (the time a slave node first touched, -1 where never) with contact, and
     first_contact_K per piece K where several record it."""
     mesh = model.mesh
@@ -55,7 +56,7 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
         "cauchy_stress": nodal[:, 1:5],  # rr, zz, tt, rz
         "von_mises": nodal[:, 5],
         "principal_stretches": nodal[:, 6:9],  # in-plane major, minor, hoop
-        "pressure": nodal[:, 9],
+        "hydrostatic_pressure": nodal[:, 9],
     }
     if dpn == 3:
         out["fibre_rotation"] = u[:, 2].copy()
@@ -76,3 +77,12 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
             out[f"first_contact_{k}"] = np.nan_to_num(contact_times(mesh, [pair]), nan=-1.0)
     return out
 
+
+def with_components(data: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The point data for a VTU file: the fields, and the Cauchy stress's components besides
+    as the scalars cauchy_stress_rr, _zz, _tt, _rz (meshio writes no ComponentName attributes:
+    ParaView would call them 0..3)."""
+    if "cauchy_stress" not in data:
+        return data
+    sig = data["cauchy_stress"]
+    return data | {f"cauchy_stress_{c}": np.ascontiguousarray(sig[:, k]) for k, c in enumerate(("rr", "zz", "tt", "rz"))}

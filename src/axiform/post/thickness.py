@@ -34,8 +34,9 @@ def thickness_table(mesh: Mesh, u: np.ndarray, contacts: Sequence = ()) -> dict[
     if mesh.fibres is None:
         return None
     f = mesh.fibres
-    t0, _ = _normal_thickness(mesh.points, f)
-    t, mid = _normal_thickness(mesh.points + u, f)
+    corners = _corners(mesh.points, f)
+    t0, _ = _normal_thickness(mesh.points, f, corners)
+    t, mid = _normal_thickness(mesh.points + u, f, corners)
     s_current = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(mid, axis=0), axis=1))])
     table = {"s": mesh.fibre_s, "r": mid[:, 0], "z": mid[:, 1], "thickness": t,
              "initial_thickness": t0, "ratio": t / t0,
@@ -52,13 +53,42 @@ def pieces(contacts: Sequence) -> list[tuple[int, object]]:
     return timed if len(timed) > 1 else []
 
 
-def _normal_thickness(x: np.ndarray, fibres: np.ndarray):
+CORNER = np.radians(15.0)  # a station of the reference wall turning more (and more than twice its neighbours)
+
+
+def _normal_thickness(x: np.ndarray, fibres: np.ndarray, corners: np.ndarray):
+    """(stations,) the fibres' chords projected on the normal of the mid-surface (its
+    gradient: the bisector of the two segments at a station), and the mid-surface points.
+    At a corner of the reference wall (`corners`) the chord is the mitre of the two
+    segments, longer than the wall by 1 / cos(half the turn): there the mean of its
+    projections on the two segments' own normals (exact for a wall of uniform thickness)."""
     bottom, top = x[fibres[:, 0]], x[fibres[:, -1]]
     mid = 0.5 * (bottom + top)
+    chord = top - bottom
     tangent = np.gradient(mid, axis=0)
     normal = np.column_stack([-tangent[:, 1], tangent[:, 0]])
     normal /= np.linalg.norm(normal, axis=1)[:, None]
-    return np.abs(np.einsum("ij,ij->i", top - bottom, normal)), mid
+    t = np.abs(np.einsum("ij,ij->i", chord, normal))
+    if corners.any():
+        seg = np.diff(mid, axis=0)
+        seg_normal = np.column_stack([-seg[:, 1], seg[:, 0]]) / np.linalg.norm(seg, axis=1)[:, None]
+        k = np.flatnonzero(corners)
+        t[k] = 0.5 * (np.abs(np.einsum("ij,ij->i", chord[k], seg_normal[k - 1]))
+                      + np.abs(np.einsum("ij,ij->i", chord[k], seg_normal[k])))
+    return t, mid
+
+
+def _corners(x: np.ndarray, fibres: np.ndarray) -> np.ndarray:
+    """(stations,) True at the interior stations where the reference mid-surface turns by
+    more than CORNER and by more than twice as much as at either neighbour: a corner of the
+    wall (two lines meeting), not a coarsely divided arc (which turns alike at every station)."""
+    mid = 0.5 * (x[fibres[:, 0]] + x[fibres[:, -1]])
+    seg = np.diff(mid, axis=0)
+    angle = np.arctan2(seg[:, 1], seg[:, 0])
+    turn = np.zeros(len(mid))
+    turn[1:-1] = np.abs((np.diff(angle) + np.pi) % (2 * np.pi) - np.pi)
+    before, after = np.r_[0.0, turn[:-1]], np.r_[turn[1:], 0.0]
+    return (turn > CORNER) & (turn > 2 * np.maximum(before, after))
 
 
 def contact_times(mesh: Mesh, contacts: Sequence) -> np.ndarray | None:
