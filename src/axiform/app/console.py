@@ -130,7 +130,7 @@ def failed(exc: Exception, what: str) -> int:
 
 
 class ProgressLine:
-    """Progress: on a terminal a tqdm bar of 20 characters rewritten in place, followed by a
+    """Progress: on a terminal a tqdm bar of 16 characters rewritten in place, followed by a
     text, the whole within COLUMNS (or the terminal's width); elsewhere (a log, CI) one line
     per update; nothing when quiet.  `elapsed` counts from the creation."""
 
@@ -162,7 +162,7 @@ class ProgressLine:
                 width, height = min(size.columns or COLUMNS, COLUMNS), size.lines or 10**4
             except (OSError, ValueError, AttributeError):
                 width, height = COLUMNS, None
-            self._bar = tqdm(total=self.total, file=self.stream, bar_format="[{bar:20}] {desc}", ascii="-#",
+            self._bar = tqdm(total=self.total, file=self.stream, bar_format="[{bar:16}] {desc}", ascii="-#",
                              ncols=width, nrows=height, mininterval=0, leave=True)
         self._bar.n = min(max(done, 0), self.total)
         self._bar.set_description_str(bar_text, refresh=False)

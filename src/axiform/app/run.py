@@ -254,8 +254,8 @@ def fitted(head: str, tail: list[str], width: int) -> str:
     return text
 
 
-# the bar and the percentage before a progress text on a terminal: "[" 20 "] " and "100.0%  "
-BAR_COLUMNS = 31
+# the bar and the percentage before a progress text on a terminal: "[" 16 "] " and "100.0%  "
+BAR_COLUMNS = 27
 
 
 def _step_progress(job: Job, quiet: bool, stream):
