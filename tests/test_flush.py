@@ -89,7 +89,7 @@ def test_a_vtu_file_that_cannot_be_written_fails_the_run_keeping_the_steps_befor
     out = tmp_path / "out"
     assert main(["run", str(PLATE), "--out", str(out), "-q", "--set", "output.plots=false",
                  "--set", "solver.steps=6", "--set", "solver.target=1.5"]) == 3
-    err = capsys.readouterr().err
+    err = capsys.readouterr().out  # the status line (stdout) says why
     assert "No space left on device" in err
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "failed" and "No space left on device" in summary["message"]

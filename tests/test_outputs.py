@@ -138,7 +138,7 @@ def test_the_command_from_a_shell(tmp_path):
                           env=env, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert all((out / png).exists() for png in PNGS)
-    assert "axiform: finished after 2 steps" in proc.stderr
+    assert "axiform: finished after 2 steps" in proc.stdout
     bad = subprocess.run([sys.executable, "-m", "axiform.cli", "run", str(EXAMPLES / "hughes_carnoy_plate.toml"),
                           "--out", str(tmp_path / "bad"), "-q", "--set", "solver.steps=-1"],
                          env=env, capture_output=True, text=True, timeout=120)

@@ -64,7 +64,7 @@ def test_a_signal_stops_the_run_with_every_converged_step(tmp_path, sig, code):
     proc = _start(out)
     _wait_rows(proc, out, 3)
     proc.send_signal(sig)
-    _, err = proc.communicate(timeout=60)
+    out_text, err = proc.communicate(timeout=60)
     assert proc.returncode == code
     assert "Traceback" not in err
     s, h = summary(out), rows(out)
@@ -72,7 +72,7 @@ def test_a_signal_stops_the_run_with_every_converged_step(tmp_path, sig, code):
     assert s["steps"] == len(h) >= 3
     assert [int(r["step"]) for r in h] == list(range(1, len(h) + 1))
     assert s["newton_iterations"] == sum(int(r["iterations"]) for r in h)
-    assert f"interrupted after {len(h)} steps" in err.strip().splitlines()[-1]
+    assert f"interrupted after {len(h)} steps" in out_text.strip().splitlines()[-1]  # the status line: stdout
     # the last converged step has its fields
     last = ET.parse(out / "fields.pvd").getroot().findall(".//DataSet")[-1].get("file")
     assert last == f"fields/step_{len(h):04d}.vtu"
@@ -112,8 +112,8 @@ def test_an_unexpected_error_sets_failed_and_exit_3(tmp_path, monkeypatch, capsy
     monkeypatch.setattr(model_module.Model, "evaluate", crash_later)
     out = tmp_path / "out"
     assert main(["run", str(PLATE), "--out", str(out), "--set", "output.plots=false"]) == 3
-    err = capsys.readouterr().err
-    assert "Traceback" not in err and "a fault in the law" in err.splitlines()[-1]
+    cap = capsys.readouterr()
+    assert "Traceback" not in cap.err and "a fault in the law" in cap.out.splitlines()[-1]  # the status line
     s = summary(out)
     assert s["status"] == "failed" and s["message"] == "RuntimeError: a fault in the law"
     assert s["steps"] == len(rows(out)) >= 1
@@ -129,7 +129,7 @@ def test_set_without_out_never_replaces_another_case(tmp_path, monkeypatch, caps
     before = {p.name: p.read_bytes() for p in plain.iterdir() if p.is_file()}
     capsys.readouterr()
     assert main(["run", str(PLATE), *quick, "--set", "solver.target=4.0"]) == 0
-    err = capsys.readouterr().err.splitlines()
+    err = capsys.readouterr().out.splitlines()  # the header: stdout
     other = tmp_path / "results" / "hughes_carnoy_plate-2"
     assert f"-> {Path('results') / 'hughes_carnoy_plate-2'}" in err[0] and "another case" in err[0]
     assert float(rows(other)[-1]["w_center"]) == pytest.approx(4.0)
@@ -144,9 +144,9 @@ def test_quiet_prints_one_line_and_progress_goes_line_by_line(tmp_path, capsys):
     quick = ["--set", "solver.steps=4", "--set", "output.plots=false", "--set", "output.vtu=false"]
     assert main(["run", str(PLATE), "--out", str(tmp_path / "a"), "-q", *quick]) == 0
     cap = capsys.readouterr()
-    assert cap.out == "" and len(cap.err.splitlines()) == 1 and cap.err.startswith("axiform: finished after")
+    assert cap.err == "" and len(cap.out.splitlines()) == 1 and cap.out.startswith("axiform: finished after")
     assert main(["run", str(PLATE), "--out", str(tmp_path / "b"), *quick]) == 0
-    err = capsys.readouterr().err.splitlines()
+    err = capsys.readouterr().out.splitlines()  # header, progress and status: stdout
     steps = [line for line in err if line.startswith("step ")]
     assert len(steps) == len(rows(tmp_path / "b")) and len(err) == len(steps) + 2
 
@@ -385,7 +385,8 @@ def test_a_body_held_only_by_an_open_mould_stops_before_the_first_step(tmp_path,
     arc length's first tangent meets the free translation: stopped (exit 1), not a crash."""
     (tmp_path / "mould.toml").write_text(HELD_BY_A_MOULD_ONLY)
     assert main(["run", str(tmp_path / "mould.toml"), "--out", str(tmp_path / "out"), "-q"]) == 1
-    err = capsys.readouterr().err
+    cap = capsys.readouterr()
+    err = cap.out + cap.err  # the status line (stdout) says why
     assert "before the first step: a mechanism" in err and "Traceback" not in err
     assert summary(tmp_path / "out")["status"] == "stopped"
 
@@ -422,7 +423,8 @@ def test_a_step_with_nan_is_stopped_not_written(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(solver_module.Model, "expand", poisoned)
     out = tmp_path / "out"
     assert main(["run", str(PLATE), "--out", str(out), "-q", "--set", "output.plots=false"]) == 1
-    err = capsys.readouterr().err
+    cap = capsys.readouterr()
+    err = cap.out + cap.err  # the status line (stdout) says why
     assert "step 3: the displacement" in err and "of node 2" in err
     s = summary(out)
     assert s["status"] == "stopped" and s["steps"] == len(rows(out)) == 2

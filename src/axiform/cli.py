@@ -1,9 +1,13 @@
-"""`axiform run CASE.toml [--out DIR]`, `axiform check CASE.toml`, `axiform plot DIR`,
-`axiform fit DATA.csv --model MODEL` (app/fit.py), `axiform optimize CASE.toml --target T.csv
---out DIR` (app/optimize.py), `axiform sweep SWEEP.toml --out DIR` (app/sweep.py).
+"""`axiform run CASE.toml [--out DIR]`, `axiform check CASE.toml [--plot [PNG]]`, `axiform plot
+DIR`, `axiform fit DATA.csv --model MODEL` (app/fit.py), `axiform optimize CASE.toml --target
+T.csv --out DIR` (app/optimize.py), `axiform sweep SWEEP.toml --out DIR` (app/sweep.py).
 
 Exit codes: 0 finished, 1 stopped (converged steps kept), 2 invalid case (refused before any
 work), 3 failed (an unexpected error), 130 / 143 interrupted by SIGINT / SIGTERM.
+
+Streams: what a command produces (progress, the status line, check's verdict) goes to stdout,
+warnings and errors to stderr; a closed reader (`axiform run CASE | head -3`) stops neither the
+command nor its files, and its exit code stays its own (app/console.guarded_streams).
 
 This module parses the arguments and calls the command's function in axiform.app (app/run.py,
 app/check.py, app/plot.py, ...).  The modules behind the commands (NumPy, SciPy, pydantic,
@@ -19,11 +23,16 @@ import sys
 from . import __version__
 
 
+DESCRIPTION = ("Large-strain axisymmetric hyperelastic solids by finite elements: blow moulding, "
+               "thermoforming and rubber parts, described in TOML case files.")
+
+
 def build_parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
     """The parser of the `axiform` command, and its `fit` sub-parser (whose --model is checked after)."""
-    parser = argparse.ArgumentParser(prog="axiform", description=__doc__.splitlines()[0],
+    parser = argparse.ArgumentParser(prog="axiform", description=DESCRIPTION,
                                      epilog="exit codes: 0 finished, 1 stopped short, 2 invalid input, 3 failed, "
-                                            "130 / 143 interrupted (SIGINT / SIGTERM)")
+                                            "130 / 143 interrupted (SIGINT / SIGTERM). Progress and status lines "
+                                            "go to stdout, warnings and errors to stderr.")
     parser.add_argument("--version", action="version", version=f"axiform {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     p_run = sub.add_parser("run", help="run a case file and write its results folder",
@@ -37,8 +46,12 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
                             "[mesh] and [material] must be unchanged, a later target or more output may be set")
     p_check = sub.add_parser("check", help="validate a case file and build its model, without solving",
                              description="Validate a case file and build its model, without solving: exit 0 "
-                                         "if valid, 2 with the key path and the reason if not.")
+                                         "if valid (with a warning on stderr for what is valid but probably "
+                                         "not meant), 2 with the key path and the reason if not.")
     p_check.add_argument("case", help="the case file (TOML)")
+    p_check.add_argument("--plot", nargs="?", const="check.png", metavar="PNG",
+                         help="also draw what the case sets up (mesh, supports, loads, moulds and their "
+                              "normals) in PNG (default: check.png in the current folder)")
     for p in (p_run, p_check):
         p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                        help="override a key, VALUE in TOML syntax: --set mesh.element='\"q8\"' "
@@ -54,7 +67,13 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
     p_plot.add_argument("--animate", action="store_true",
                         help="also write forming.gif: the deformed wall, moulds and thickness, one frame "
                              "per written step")
-    p_fit = sub.add_parser("fit", help="fit a hyperelastic law to uniaxial / equibiaxial / planar test data")
+    p_fit = sub.add_parser("fit", help="fit a hyperelastic law to uniaxial / equibiaxial / planar test data",
+                           description="Fit the constants of a hyperelastic law to uniaxial, equibiaxial and "
+                                       "planar (pure shear) test data by least squares on the relative errors, "
+                                       "and check the law's Drucker stability at stretches 0.1 to 10. Writes "
+                                       "material.toml (a [material] table for a case), fit.json and one "
+                                       "fit_<mode>.png per mode.",
+                           epilog="exit codes: 0 fitted, 1 no admissible constants, 2 a bad data file or argument")
     p_fit.add_argument("data", nargs="+", help="CSV files with the header mode,stretch,stress")
     p_fit.add_argument("--model", required=True, help="the law: neo-hooke, mooney-rivlin, yeoh, ogden, gent, "
                                                       "arruda-boyce")
@@ -64,8 +83,9 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
     p_opt = sub.add_parser("optimize", help="program a parison / preform: the thickness table that gives a target "
                                             "final wall",
                            description="Find the mesh.thickness table of a layered case whose final wall meets "
-                                       "a target thickness (DESIGN 10.10); writes optimized.toml, optimize.csv, "
-                                       "optimize.json, optimize.png and final/ (the results of the optimized case).")
+                                       "a target thickness; writes optimized.toml, optimize.csv, "
+                                       "optimize.json, optimize.png and final/ (the results of the optimized case).",
+                           epilog="exit codes: 0 the tolerance was reached, 1 stopped short, 2 invalid input")
     p_opt.add_argument("case", help="the case file (TOML): a layered mesh with a thickness table, load control")
     p_opt.add_argument("--target", required=True, help="CSV with the header s,thickness: the wanted final thickness "
                                                        "against the reference arc length s")
@@ -113,29 +133,33 @@ def dispatch(args: argparse.Namespace) -> int:
     if args.command == "run":
         from .app.run import run
 
-        return run(args.case, args.out, args.quiet, args.set, args.resume)
+        return run(args.case, args.out, args.quiet, args.set, args.resume, stream=sys.stdout)
     from .app.check import check
 
-    return check(args.case, args.set)
+    return check(args.case, args.set, args.plot)
 
 
 def main(argv: list[str] | None = None) -> int:
-    """The `axiform` command line; returns the exit code."""
-    parser, p_fit = build_parser()
-    args = parser.parse_args(argv)
-    if args.command == "fit":
-        from .case.material import KEYS
+    """The `axiform` command line; returns the exit code.  stdout and stderr are guarded while
+    it runs: a reader that closes them early (`| head`) costs the command nothing."""
+    from .app.console import guarded_streams
 
-        if args.model not in KEYS:
-            p_fit.error(f"argument --model: invalid choice: {args.model!r} (choose from {', '.join(KEYS)})")
-    import numpy as np
+    with guarded_streams():
+        parser, p_fit = build_parser()
+        args = parser.parse_args(argv)
+        if args.command == "fit":
+            from .case.material import KEYS
 
-    try:
-        with np.errstate(all="ignore"):  # overflow and NaN are caught by the guards, not printed
-            return dispatch(args)
-    except KeyboardInterrupt:
-        print("axiform: interrupted", file=sys.stderr)
-        return 130
+            if args.model not in KEYS:
+                p_fit.error(f"argument --model: invalid choice: {args.model!r} (choose from {', '.join(KEYS)})")
+        import numpy as np
+
+        try:
+            with np.errstate(all="ignore"):  # overflow and NaN are caught by the guards, not printed
+                return dispatch(args)
+        except KeyboardInterrupt:
+            print("axiform: interrupted", file=sys.stderr)
+            return 130
 
 
 def entry() -> None:

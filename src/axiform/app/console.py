@@ -1,19 +1,113 @@
-"""What the commands print on the console: messages on stderr (`say`, `invalid`, `failed`),
-the traceback of an unexpected error on request (`trace`), and the progress line of a run or
-a sweep (`ProgressLine`: a tqdm bar on a terminal, one line per update elsewhere)."""
+"""What the commands print on the console.  Two streams: stdout carries what a command
+produces (a run's progress lines and its final status line, check's verdict, the files
+written); stderr the warnings (`warn`) and errors (`say`, `invalid`, `failed`); the traceback
+of an unexpected error on request (`trace`); the progress line of a run or a sweep
+(`ProgressLine`: a tqdm bar on a terminal, one line per update elsewhere, at most 80 columns).
+
+A closed reader never stops a command (`guarded_streams`): `axiform run CASE | head -3` goes
+on, writes every file and exits with the run's own code; what it would still print is dropped.
+"""
 
 from __future__ import annotations
 
+import errno
+import io
 import os
 import sys
 import time
 import traceback
+from contextlib import contextmanager
 from pathlib import Path
+
+# the widest progress line (a terminal's width when it is narrower)
+COLUMNS = 80
+
+
+class Guarded:
+    """A text stream that a closed reader cannot break: the first write or flush that finds
+    the pipe closed (BrokenPipeError, EPIPE) points the stream's file descriptor at os.devnull
+    (so that the interpreter's own flush at exit finds nothing to complain about, as Python's
+    documentation on SIGPIPE suggests) and every later write is dropped.  All else is the
+    wrapped stream's."""
+
+    def __init__(self, stream):
+        self._stream = stream
+        self.broken = False
+
+    def _drop(self) -> None:
+        self.broken = True
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            try:
+                os.dup2(devnull, self._stream.fileno())
+            finally:
+                os.close(devnull)
+        except (OSError, ValueError, AttributeError, io.UnsupportedOperation):
+            pass  # no descriptor (a StringIO, pytest's capture): dropping the writes is enough
+
+    def _guard(self, call, *args):
+        if self.broken:
+            return None
+        try:
+            return call(*args)
+        except OSError as exc:  # BrokenPipeError, or EPIPE / EINVAL on a closed pipe elsewhere
+            if not isinstance(exc, BrokenPipeError) and exc.errno not in (errno.EPIPE, errno.EINVAL):
+                raise
+            self._drop()
+            return None
+        except ValueError:  # "I/O operation on closed file": the stream itself was closed
+            self.broken = True
+            return None
+
+    def write(self, text: str) -> int:
+        self._guard(self._stream.write, text)
+        return len(text)
+
+    def writelines(self, lines) -> None:
+        for line in lines:
+            self.write(line)
+
+    def flush(self) -> None:
+        self._guard(self._stream.flush)
+
+    def isatty(self) -> bool:
+        return not self.broken and bool(self._guard(self._stream.isatty))
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
+@contextmanager
+def guarded_streams():
+    """sys.stdout and sys.stderr Guarded while the block runs (a command); both flushed at
+    its end, still guarded, then the originals put back."""
+    old = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = Guarded(old[0]), Guarded(old[1])
+    try:
+        yield
+    finally:
+        for stream in (sys.stdout, sys.stderr):
+            if stream is not None:
+                stream.flush()
+        sys.stdout, sys.stderr = old
 
 
 def say(*lines: str) -> None:
-    """Print lines on stderr (the channel of every message of the commands)."""
+    """Print lines on stderr (the channel of errors and warnings)."""
     print(*lines, sep="\n", file=sys.stderr)
+
+
+def warn(*lines: str) -> None:
+    """Each line on stderr as `warning: <line>`."""
+    for line in lines:
+        print(f"warning: {line}", file=sys.stderr)
+
+
+def tell(*lines: str, stream=None) -> None:
+    """Print lines on stdout (or stream), flushed: what the command produces (a status line)."""
+    stream = stream or sys.stdout
+    print(*lines, sep="\n", file=stream)
+    stream.flush()
 
 
 def trace(exc: BaseException) -> None:
@@ -36,9 +130,9 @@ def failed(exc: Exception, what: str) -> int:
 
 
 class ProgressLine:
-    """Progress: on a terminal a tqdm bar of 30 characters rewritten in place, followed by a
-    text; elsewhere (a log, CI) one line per update; nothing when quiet.  `elapsed` counts
-    from the creation."""
+    """Progress: on a terminal a tqdm bar of 16 characters rewritten in place, followed by a
+    text, the whole within COLUMNS (or the terminal's width); elsewhere (a log, CI) one line
+    per update; nothing when quiet.  `elapsed` counts from the creation."""
 
     def __init__(self, stream, total: float, quiet: bool = False):
         self.stream = stream
@@ -63,12 +157,12 @@ class ProgressLine:
         if self._bar is None:  # at the first update: messages before it stay above the bar
             from tqdm import tqdm
 
-            try:  # a terminal that says no size (0 x 0, as a pseudo-terminal may): the whole line
+            try:  # a terminal that says no size (0 x 0, as a pseudo-terminal may): COLUMNS
                 size = os.get_terminal_size(self.stream.fileno())
-                width, height = size.columns or 10**4, size.lines or 10**4
+                width, height = min(size.columns or COLUMNS, COLUMNS), size.lines or 10**4
             except (OSError, ValueError, AttributeError):
-                width = height = None
-            self._bar = tqdm(total=self.total, file=self.stream, bar_format="[{bar:30}] {desc}", ascii="-#",
+                width, height = COLUMNS, None
+            self._bar = tqdm(total=self.total, file=self.stream, bar_format="[{bar:16}] {desc}", ascii="-#",
                              ncols=width, nrows=height, mininterval=0, leave=True)
         self._bar.n = min(max(done, 0), self.total)
         self._bar.set_description_str(bar_text, refresh=False)

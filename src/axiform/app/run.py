@@ -3,6 +3,11 @@ SIGINT / SIGTERM winding the run up (`Stops`), the default results folder (`resu
 and the checks of a resumed run (`resume_state`).  The PNG plots are drawn in this process
 by the results writer at the end of the run (`plots.plot_folder`).
 
+What it prints: the header, one progress line per converged step (at most 80 columns) and the
+final status line on the stream given (the command line's stdout); the pre-run warnings of
+case.preflight (`warning: ...`) and the errors on stderr, the warnings also with -q.  A run
+that stops names those warnings first in its status line: the likely cause a user can act on.
+
 Exit codes: 0 finished, 1 stopped (converged steps kept), 2 invalid case (refused before any
 work), 3 failed (an unexpected error), 130 / 143 interrupted by SIGINT / SIGTERM.
 """
@@ -10,6 +15,7 @@ work), 3 failed (an unexpected error), 130 / 143 interrupted by SIGINT / SIGTERM
 from __future__ import annotations
 
 import json
+import re
 import signal
 import sys
 import threading
@@ -20,7 +26,7 @@ from pathlib import Path
 from typing import Any, Self
 
 from .. import __version__
-from .console import ProgressLine, failed, invalid, say, trace
+from .console import COLUMNS, ProgressLine, failed, invalid, say, tell, trace, warn
 
 EXIT = {"finished": 0, "stopped": 1, "failed": 3}
 # history.csv, summary.json, thickness.csv and fields.pvd are rewritten at most every half
@@ -144,11 +150,14 @@ class Job:
     state: dict | None
     out: str | None
     digest: str = field(init=False)
+    warnings: list[str] = field(init=False)
 
     def __post_init__(self):
+        from ..case.preflight import preflight
         from ..case.schema import fingerprint
 
         self.digest = fingerprint(self.data)
+        self.warnings = preflight(self.built)
 
     @classmethod
     def read(cls, case_file: Path, overrides: list[str], out: str | None, resume: str | None) -> "Job":
@@ -183,22 +192,24 @@ class Job:
                              case={"file": str(self.case_file), "overrides": self.overrides, "sha256": self.digest},
                              restart_every=case.restart.every,
                              restart_meta={key: fingerprint(self.data.get(key, {})) for key in FROZEN_ON_RESUME},
-                             resume=self.state, flush_every_s=FLUSH_EVERY_S)
+                             resume=self.state, flush_every_s=FLUSH_EVERY_S, warnings=self.warnings)
 
 
 def run(case_path: str, out: str | None, quiet: bool = False, overrides: list[str] = (),
-        resume: str | None = None) -> int:
-    """Read, check, solve and write a case (or resume a run in its folder); returns the exit code."""
+        resume: str | None = None, stream=None) -> int:
+    """Read, check, solve and write a case (or resume a run in its folder); returns the exit code.
+    stream: where the header, the progress and the status line go (the command line gives
+    sys.stdout); None: sys.stderr, as for a caller that captures stderr (a sweep's worker)."""
     with Stops() as stops:
         try:
-            return _run(Path(case_path), out, quiet, list(overrides), stops, resume)
+            return _run(Path(case_path), out, quiet, list(overrides), stops, resume, stream or sys.stderr)
         except Interrupted as exc:  # before the results folder was there
             say(f"axiform: {exc} before the first step")
             return 128 + exc.signum
 
 
 def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], stops: Stops,
-         resume: str | None) -> int:
+         resume: str | None, stream) -> int:
     from ..case.schema import CaseError
 
     try:
@@ -220,36 +231,78 @@ def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], st
                 writer = job.writer(out_dir)
         except (ValueError, KeyError) as exc:
             return invalid(case_file, CaseError(f"--resume: {exc}"))
-    return _solve(job, out_dir, note, writer, quiet, stops)
+    return _solve(job, out_dir, note, writer, quiet, stops, stream)
 
 
-def _step_progress(job: Job, quiet: bool):
+def time_name(model) -> str:
+    """What the progress calls the load factor: `t` where it is the process time (load curves
+    or moving tools follow it), else `lambda`."""
+    import numpy as np
+
+    timed = bool(model.knots().size) or any(np.any(np.asarray(c.surface.motion, float) != 0)
+                                            for c in model.contacts)
+    return "t" if timed else "lambda"
+
+
+def fitted(head: str, tail: list[str], width: int) -> str:
+    """head, then as many of the parts in tail as fit within width columns (two spaces apart)."""
+    text = head
+    for part in tail:
+        if len(text) + 2 + len(part) > width:
+            break
+        text += "  " + part
+    return text
+
+
+# the bar and the percentage before a progress text on a terminal: "[" 16 "] " and "100.0%  "
+BAR_COLUMNS = 27
+
+
+def _step_progress(job: Job, quiet: bool, stream):
     """The progress of a run, called with each converged step and its monitor values: the
-    driven dof, the stop dof of an arc length, or the load factor, against its goal."""
+    driven dof, the stop dof of an arc length, or the load factor, against its goal.  A line
+    within COLUMNS: step, t (or lambda), Newton iterations, seconds, then the monitors that fit."""
     control = job.built.control
     driven, goal = getattr(control, "dof", None), control.target
     if getattr(control, "stop_dof", None) is not None:
         driven, goal = control.stop_dof, control.stop_value
-    line = ProgressLine(sys.stderr, 1.0, quiet)
+    line = ProgressLine(stream, 1.0, quiet)
+    lam = time_name(job.built.model)
 
     def show(step, values: dict[str, float]) -> None:
         frac = (step.u[driven] if driven is not None else step.lam) / goal
-        mon = "  ".join(f"{k} {v:.4g}" for k, v in list(values.items())[:3])
-        text = (f"step {step.number}  lambda {step.lam:.5g}  its {step.iterations}  {mon}  "
-                f"{line.elapsed:.1f} s")
-        line.show(frac, f"{100 * min(max(frac, 0.0), 1.0):5.1f}%  {text}", text)
+        head = f"step {step.number}  {lam} {step.lam:.4g}  its {step.iterations}  {line.elapsed:.1f} s"
+        mon = [f"{k} {v:.4g}" for k, v in list(values.items())[:3]]
+        line.show(frac, f"{100 * min(max(frac, 0.0), 1.0):5.1f}%  " + fitted(head, mon, COLUMNS - BAR_COLUMNS),
+                  fitted(head, mon, COLUMNS))
 
     return show, line
 
 
-def _solve(job: Job, out_dir: Path, note: str, writer, quiet: bool, stops: Stops) -> int:
+def status_line(status: str, message: str, warnings: list[str], steps: int, iterations: int, wall: float,
+                out_dir: Path) -> str:
+    """The final line of a run.  A stopped run with pre-run warnings says them first, as the
+    likely cause, then the solver's message: `stopped at step N ...: likely cause: W; then M`."""
+    head = f"axiform: {status}"
+    if status == "stopped" and warnings:
+        at = re.match(r"step (\d+): ", message)
+        if at:
+            head += f" at step {at.group(1)}"
+            message = message[at.end():]
+        message = f"likely cause: {'; '.join(warnings)}; then {message}" if message else \
+            f"likely cause: {'; '.join(warnings)}"
+    return (f"{head} after {steps} steps, {iterations} Newton iterations, {wall:.2f} s -> {out_dir}"
+            + (f": {message}" if message else ""))
+
+
+def _solve(job: Job, out_dir: Path, note: str, writer, quiet: bool, stops: Stops, stream) -> int:
     """Solve with the results written step by step, then wind up: the status, the files, the
     last line; returns the exit code."""
     from ..io.results import NonFiniteResult
     from ..solve.solver import StepFailed, solve
 
     model = job.built.model
-    show, line = _step_progress(job, quiet)
+    show, line = _step_progress(job, quiet, stream)
 
     def on_step(step):
         with stops.held():
@@ -262,8 +315,9 @@ def _solve(job: Job, out_dir: Path, note: str, writer, quiet: bool, stops: Stops
         with stops.held():
             writer = writer or job.writer(out_dir)
         if not quiet:
-            say(f"axiform {__version__}: {job.case.title or job.case_file.name}: {model.mesh.n_cells} "
-                f"{model.mesh.element.name} elements, {model.n_free} free dofs -> {out_dir}{note}")
+            tell(f"axiform {__version__}: {job.case.title or job.case_file.name}: {model.mesh.n_cells} "
+                 f"{model.mesh.element.name} elements, {model.n_free} free dofs -> {out_dir}{note}", stream=stream)
+        warn(*job.warnings)
         result = solve(model, job.built.control, job.built.options, on_step=on_step, keep=1, resume=job.state)
         status, message = result.status, result.message
     except Interrupted as exc:
@@ -283,8 +337,8 @@ def _solve(job: Job, out_dir: Path, note: str, writer, quiet: bool, stops: Stops
     stops.raised = True  # wind up whatever comes now
     status, message = _finish(writer, status, message)
     wall = result.wall_time_s if result is not None else time.perf_counter() - t0
-    say(f"axiform: {status} after {writer.steps} steps, {writer.newton_iterations} Newton iterations, "
-        f"{wall:.2f} s -> {out_dir}" + (f": {message}" if message else ""))
+    tell(status_line(status, message, job.warnings, writer.steps, writer.newton_iterations, wall, out_dir),
+         stream=stream)
     if status == "interrupted":
         return 128 + stops.signum
     return EXIT.get(status, 1)
