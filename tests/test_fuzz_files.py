@@ -85,7 +85,7 @@ def judge(code: int, out: str, err: str, names: tuple[str, ...], allowed=(0, 1, 
         lines = err.strip().splitlines()
         assert lines, "exit 2 without a message"
         body = "\n".join(lines[1:] if lines[0].rstrip().endswith(":") else lines)
-        assert any(n in body for n in names) or all(KEY.match(line) for line in body.splitlines() if line), \
+        assert any(n in err for n in names) or all(KEY.match(line) for line in body.splitlines() if line), \
             f"exit 2 naming neither {names} nor a key:\n{err}"
 
 
@@ -360,7 +360,8 @@ def npz_rewrites(draw, arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     elif kind == "shape":
         arrays[k] = np.resize(arrays[k], (draw(st.integers(0, 7)),) * draw(st.integers(1, 2)))
     elif kind == "dtype":
-        arrays[k] = arrays[k].astype(draw(st.sampled_from(["U3", "complex128", "int8", "bool", "float32"])))
+        with np.errstate(invalid="ignore"):
+            arrays[k] = arrays[k].astype(draw(st.sampled_from(["U3", "complex128", "int8", "bool", "float32"])))
     elif kind == "nan":
         arrays[k] = np.full(arrays[k].shape, draw(st.sampled_from([math.nan, math.inf, 1e308])))
     elif kind in ("layout", "meta"):
@@ -373,10 +374,9 @@ def npz_rewrites(draw, arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
                                         st.just([]), st.just({"__dict__": [1, 2]})))
         layout.pop("sha256", None) if draw(st.booleans()) else None
         arrays["__layout__"] = np.array(json.dumps(layout))
-    elif kind == "nochecksum":
+    elif kind == "nochecksum":  # a file of before the checksum: resumed as it is
         layout.pop("sha256", None)
         arrays["__layout__"] = np.array(json.dumps(layout))
-        arrays[k] = np.resize(arrays[k], (draw(st.integers(0, 3)),))
     else:
         arrays["__layout__"] = np.array(draw(st.sampled_from(["", "{", "[]", "null", '{"layout": 1}',
                                                              '{"layout": {}, "meta": []}'])))
@@ -399,7 +399,7 @@ def _fuzz_checkpoint(folder, finished, data):
         arrays = data.draw(npz_rewrites(arrays))
         with open(npz, "wb") as fh:
             np.savez(fh, **arrays)
-    code, out, err = call(["run", str(case), "--resume", str(run), "-q"])
+    code, out, err = call(["run", str(case), "--resume", str(run), "-q", "--set", "solver.target=1.25"])
     judge(code, out, err, (str(npz), str(run)))
 
 
@@ -411,6 +411,6 @@ def test_an_undamaged_checkpoint_resumes(folder, finished_run):
     case, run0 = finished_run
     run = folder / "run2"
     shutil.copytree(run0, run)
-    code, out, err = call(["run", str(case), "--resume", str(run), "-q", "--set", "solver.steps=4",
-                           "--set", "pressure[0].value=6.0"])
-    assert code in (0, 1), err
+    code, out, err = call(["run", str(case), "--resume", str(run), "-q", "--set", "solver.target=1.25"])
+    assert code == 0, err
+    assert "finished after 5 steps" in err  # the 4 of the first run and one more

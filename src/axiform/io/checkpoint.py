@@ -130,8 +130,8 @@ def load(folder: str | Path) -> tuple[dict, dict]:
 def check_like(saved: Any, template: Any, where: str = "checkpoint") -> None:
     """ValueError naming the first item where a loaded checkpoint differs in form from a
     template (a checkpoint of the model at hand, e.g. its initial state): other keys, other
-    lengths of lists, other array shapes or kinds, a number where an array belongs, numbers
-    that are not finite."""
+    lengths of lists, other array shapes or kinds, a number where an array belongs, infinite
+    numbers (NaN is kept: contact states mark "not yet" with it)."""
     if isinstance(template, dict):
         if not isinstance(saved, dict):
             raise ValueError(f"{where}: a table was expected")
@@ -151,8 +151,8 @@ def check_like(saved: Any, template: Any, where: str = "checkpoint") -> None:
             raise ValueError(f"{where}: an array of shape {template.shape} was expected, not {shape}")
         if (saved.dtype.kind == "b") != (template.dtype.kind == "b"):
             raise ValueError(f"{where}: {template.dtype} values were expected, not {saved.dtype}")
-        if saved.dtype.kind == "f" and not np.isfinite(saved).all():
-            raise ValueError(f"{where}: holds values that are not finite")
+        if saved.dtype.kind == "f" and np.isinf(saved).any():  # NaN marks "none" in some states
+            raise ValueError(f"{where}: holds infinite values")
     elif isinstance(template, (int, float)) and not isinstance(template, bool):
-        if isinstance(saved, bool) or not isinstance(saved, (int, float)) or not np.isfinite(saved):
-            raise ValueError(f"{where}: a finite number was expected, not {saved!r}")
+        if isinstance(saved, bool) or not isinstance(saved, (int, float)) or np.isinf(saved):
+            raise ValueError(f"{where}: a number was expected, not {saved!r}")
