@@ -129,7 +129,7 @@ def read_dxf(path: str | Path, layer: str | None = None, reverse: bool = False,
     try:
         return _read_dxf(path, layer, reverse, tolerance, motion)
     except DxfError as exc:  # every message names the file
-        raise DxfError(str(exc) if str(path) in str(exc) else f"{path}: {exc}") from None
+        raise DxfError(str(exc) if str(path) in str(exc) else f"{exc} (in {path})") from None
     except Exception as exc:  # noqa: BLE001 - ezdxf raises anything on a damaged drawing
         why = " ".join(f"{type(exc).__name__}: {exc}".split())[:300]
         raise DxfError(f"cannot read {path} as a DXF drawing ({why})") from None
