@@ -314,3 +314,10 @@ def test_a_sweep_value_that_is_a_date_is_refused(tmp_path):
     sweep.write_text('case = "case.toml"\n[vary]\n"material.C1" = [1979-05-27]\n')
     refused(["sweep", sweep, "--out", tmp_path / "out"], "vary.material.C1")
 
+
+
+def test_a_mould_file_of_huge_coordinates_is_refused_naming_the_row(tmp_path):
+    (tmp_path / "m.csv").write_text("0.0, 0.5\n1.0, 1e308\n")
+    case = dict(copy.deepcopy(BASE), contact=[dict(copy.deepcopy(CONTACT), surface={"file": "m.csv"})])
+    refused(["check", write_case(tmp_path, case)], "contact[0].surface.file:", "row 2 of the data is not two finite",
+            "at most 1e+30")

@@ -218,6 +218,8 @@ def edges_on_nodes(mesh: Mesh, nodes: np.ndarray) -> np.ndarray:
 
 
 _MESHIO_QUADS = {"quad": "q4", "quad8": "q8"}
+# node coordinates beyond this magnitude are refused (as numbers of a case file are: case/schema.py)
+MAX_COORDINATE = 1e30
 # the other surface cells gmsh writes: a mesh holding them is not all quadrilaterals
 _SURFACE_CELLS = ("triangle", "triangle6", "triangle7", "polygon")
 
@@ -257,9 +259,10 @@ def read_gmsh(path: str | Path, element: str | None = None) -> Mesh:
     if cells.size and (cells.min() < 0 or cells.max() >= len(points)):
         raise MeshError(f"{path}: a cell names a node that is not in the file ({len(points)} nodes)")
     used = np.unique(cells)
-    bad = used[~np.isfinite(points[used]).all(axis=1)]
+    bad = used[~(np.abs(points[used]) <= MAX_COORDINATE).all(axis=1)]  # NaN compares False
     if len(bad):
-        raise MeshError(f"{path}: {len(bad)} node(s) with coordinates that are not finite numbers "
+        raise MeshError(f"{path}: {len(bad)} node(s) with coordinates that are not finite numbers, or beyond "
+                        f"{MAX_COORDINATE:g} in magnitude "
                         f"(the first: number {int(bad[0])} from 0 in the file's node list, at {points[bad[0]].tolist()})")
     # drop nodes that no quad uses (gmsh keeps geometry points)
     renumber = -np.ones(len(points), dtype=np.int64)
