@@ -321,3 +321,16 @@ def test_a_mould_file_of_huge_coordinates_is_refused_naming_the_row(tmp_path):
     case = dict(copy.deepcopy(BASE), contact=[dict(copy.deepcopy(CONTACT), surface={"file": "m.csv"})])
     refused(["check", write_case(tmp_path, case)], "contact[0].surface.file:", "row 2 of the data is not two finite",
             "at most 1e+30")
+
+
+@pytest.mark.xfail(strict=True, reason="app/optimize.py read_target: a thickness of 1e-300 (or s, thickness beyond 1e30) "
+                   "is accepted and the run reports a deviation of 6.5e+301 %; refuse magnitudes as the case's numbers "
+                   "are (case/schema.py MAX_MAGNITUDE, MIN_MAGNITUDE): TargetError(f'{path}: line {n}: ... magnitude')")
+def test_a_target_of_absurd_magnitude_is_refused_naming_the_line(tmp_path):
+    from test_fuzz_files import LAYERED
+
+    case = write_case(tmp_path, LAYERED)
+    target = tmp_path / "t.csv"
+    target.write_text("s,thickness\n0,1e-300\n20,1e-300\n")
+    refused(["optimize", case, "--target", target, "--out", tmp_path / "out", "-q", "--max-iter", "1"],
+            f"--target: {target}: line 2")
