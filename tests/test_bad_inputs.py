@@ -12,7 +12,7 @@ import meshio
 import numpy as np
 import pytest
 
-from axiform.case.mesh import MeshSpec, check_size
+from axiform.case.mesh import MeshSpec, check_size, physical_memory
 from axiform.case.schema import CaseError
 from axiform.io.checkpoint import check_like, load, save
 from test_fuzz import BASE, CONTACT, toml
@@ -76,6 +76,7 @@ def test_a_mesh_too_large_for_memory_is_refused_before_allocating(tmp_path):
 
 
 def test_the_size_check_counts_nodes_and_dofs_of_each_element():
+    assert 2**24 < physical_memory() < 2**50
     spec = MeshSpec(kind="rectangle", element="q8", r=(0.0, 1.0), z=(0.0, 1.0), divisions=(10, 2))
     check_size(spec, memory=10**9)
     with pytest.raises(CaseError, match=r"mesh.divisions: 10 x 2 q8 elements make 85 nodes, 170 dofs"):

@@ -99,11 +99,18 @@ BYTES_PER_DOF = 4096
 
 
 def physical_memory() -> int:
-    """Bytes of memory of this machine (a large number where the system does not say)."""
+    """Bytes of memory this process may use: the machine's, or its control group's limit where
+    that is lower (a container); a large number where the system does not say."""
     try:
-        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+        memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
     except (ValueError, OSError, AttributeError):
-        return 1 << 40
+        memory = 1 << 40
+    for limit in ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"):
+        try:
+            memory = min(memory, int(Path(limit).read_text().strip()))
+        except (OSError, ValueError):  # absent, or "max"
+            pass
+    return memory
 
 
 def grid_size(spec: MeshSpec) -> tuple[int, int, str] | None:
