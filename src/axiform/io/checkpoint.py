@@ -3,9 +3,9 @@
 A checkpoint (solver.Step.checkpoint) is a nested structure of dicts, lists, tuples, numbers,
 strings, None and NumPy arrays.  It is stored as the arrays of an .npz file plus, under the
 key `layout`, a JSON copy of the structure in which every array is replaced by its key; the
-JSON `meta` (the case's fingerprint, the step) sits beside it, and the SHA-256 of the arrays
-(`sha256`: their keys, dtypes, shapes and bytes), so that a damaged or altered file is refused
-on reading rather than resumed from.  No pickle: the file can be read by any NumPy.
+JSON `meta` (the case's fingerprint, the step) sits beside it, and the SHA-256 of it all
+(`sha256`: the layout, the meta, the arrays' keys, dtypes, shapes and bytes), so that a
+damaged or altered file is refused on reading rather than resumed from.  No pickle: the file can be read by any NumPy.
 
 `load` refuses (ValueError naming the file) whatever is not such a file: not a zip, truncated,
 a layout that names arrays that are not there, arrays of text or objects, a checksum that
@@ -67,9 +67,10 @@ def _unflatten(value: Any, arrays, where: str = "layout") -> Any:
     return value
 
 
-def _digest(arrays: dict[str, np.ndarray]) -> str:
-    """SHA-256 of arrays: their keys, dtypes, shapes and bytes, in key order."""
-    h = hashlib.sha256()
+def _digest(layout: Any, meta: Any, arrays: dict[str, np.ndarray]) -> str:
+    """SHA-256 of a checkpoint: its layout and meta (as sorted JSON), and its arrays' keys,
+    dtypes, shapes and bytes, in key order."""
+    h = hashlib.sha256(json.dumps([layout, meta], sort_keys=True).encode())
     for key in sorted(arrays):
         a = np.ascontiguousarray(arrays[key])
         h.update(f"{key}:{a.dtype.str}:{a.shape};".encode())
@@ -83,7 +84,7 @@ def save(folder: str | Path, checkpoint: dict, meta: dict) -> Path:
     folder.mkdir(parents=True, exist_ok=True)
     arrays: dict[str, np.ndarray] = {}
     layout = _flatten(checkpoint, arrays)
-    text = json.dumps({"layout": layout, "meta": meta, "sha256": _digest(arrays)})
+    text = json.dumps({"layout": layout, "meta": meta, "sha256": _digest(layout, meta, arrays)})
     target = folder / FILE
     tmp = folder / f".{FILE}.tmp"
     with open(tmp, "wb") as fh:
@@ -116,8 +117,8 @@ def load(folder: str | Path) -> tuple[dict, dict]:
     for key, a in arrays.items():
         if a.dtype.kind not in "biuf":
             raise ValueError(f"{path}: array {key!r} holds {a.dtype} values, not numbers")
-    if "sha256" in doc and doc["sha256"] != _digest(arrays):
-        raise ValueError(f"{path}: damaged (its arrays do not match the checksum written with them)")
+    if "sha256" in doc and doc["sha256"] != _digest(doc["layout"], doc["meta"], arrays):
+        raise ValueError(f"{path}: damaged (its contents do not match the checksum written with them)")
     try:
         checkpoint = _unflatten(doc["layout"], arrays)
     except (ValueError, TypeError, RecursionError) as exc:
