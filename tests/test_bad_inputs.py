@@ -122,7 +122,7 @@ def test_gmsh_nodes_that_are_not_finite_are_refused(tmp_path):
 # ---- monitor names and the revolved copy -----------------------------------------------------
 
 
-@pytest.mark.parametrize("name", ["a,b", 'w"1', "w\n2", "w;3", "w\t4", "w\x005"])
+@pytest.mark.parametrize("name", ["a,b", 'w"1', "w\n2", "w;3", "w\t4", "w\x075"])
 def test_monitor_names_that_break_a_csv_header_are_refused(tmp_path, name):
     case = copy.deepcopy(BASE)
     case["monitor"][0]["name"] = name
@@ -240,6 +240,33 @@ def test_a_checkpoint_that_fits_no_model_is_refused_naming_the_file(finished, da
     refused(["run", path, "--resume", run, "-q", "--set", "solver.target=1.25"], "checkpoint.npz", damage)
 
 
+LONG = "x" * 300  # longer than a file name may be (255 bytes on most file systems)
+
+
+@pytest.mark.parametrize("where", ["mesh.file", "surface.file", "surface.dxf"])
+def test_file_names_longer_than_the_file_system_allows_are_refused_naming_the_key(tmp_path, where):
+    case = copy.deepcopy(BASE)
+    if where == "mesh.file":
+        case["mesh"] = {"kind": "gmsh", "file": LONG, "element": "q4"}
+    else:
+        case["contact"] = [dict(copy.deepcopy(CONTACT), surface={where.split(".")[1]: LONG})]
+    refused(["check", write_case(tmp_path, case)], f"{where}: cannot read {tmp_path / LONG}")
+
+
+def test_a_nul_character_in_a_name_is_refused_naming_the_key(tmp_path):
+    case = dict(copy.deepcopy(BASE), mesh={"kind": "gmsh", "file": "a\x00b.msh", "element": "q4"})
+    refused(["check", write_case(tmp_path, case)], "mesh.file: holds a NUL character")
+
+
+@pytest.mark.parametrize("name", [".", "sub"])
+def test_a_folder_named_as_a_mesh_or_mould_file_is_refused_as_such(tmp_path, name):
+    (tmp_path / "sub").mkdir()
+    case = dict(copy.deepcopy(BASE), contact=[dict(copy.deepcopy(CONTACT), surface={"dxf": name})])
+    refused(["check", write_case(tmp_path, case)], "is a folder, not a DXF drawing")
+    case = dict(copy.deepcopy(BASE), mesh={"kind": "gmsh", "file": name, "element": "q4"})
+    refused(["check", write_case(tmp_path, case)], "is a folder, not a gmsh file")
+
+
 # ---- families whose fix is the lead's (strict xfail: they fail now, pass once fixed) -----------
 
 
@@ -250,6 +277,17 @@ def test_a_checkpoint_that_fits_no_model_is_refused_naming_the_file(finished, da
 def test_an_output_path_longer_than_the_file_system_allows_is_refused(tmp_path):
     path = write_case(tmp_path, BASE)
     refused(["run", path, "--out", tmp_path / ("x" * 300), "-q"], "--out:", "File name too long")
+
+
+@pytest.mark.xfail(strict=True, reason="cli.py: Path.is_dir() / is_file() raise OSError ENAMETOOLONG for a name longer "
+                   "than the file system allows: in _resume_state (--resume: exit 3) and plot (a traceback); wrap "
+                   "`folder.is_dir()` in _resume_state and `(path / 'history.csv').is_file()` in plot in try/except "
+                   "OSError -> exit 2 with f'--resume: {folder}: {exc.strerror}' / f'axiform: {folder}: {exc.strerror}'")
+@pytest.mark.parametrize("command", ["resume", "plot"])
+def test_a_results_folder_name_too_long_is_refused(tmp_path, command):
+    path = write_case(tmp_path, BASE)
+    argv = ["run", path, "--resume", tmp_path / LONG, "-q"] if command == "resume" else ["plot", tmp_path / LONG]
+    refused(argv, "File name too long")
 
 
 @pytest.mark.xfail(strict=True, reason="post/plots.py read_history (or cli.plot): a ragged row of history.csv gives "

@@ -87,7 +87,7 @@ values = st.one_of(scalars, st.lists(scalars, max_size=3), st.lists(st.lists(num
 
 GMSH = {"missing.msh": None, "empty.msh": "", "corrupt.msh": "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 x\n",
         "binary.msh": bytes(range(256)), "triangles.msh": "tri", "quads.msh": "quad", "mixed.msh": "mixed",
-        "nan.msh": "nan"}
+        "nan.msh": "nan", "x" * 300 + ".msh": None}
 CSV = {"good.csv": "0.0, 1.0\n2.0, 1.2\n", "text.csv": "0.0, 1.0\nabc, 2.0\n", "nan.csv": "0.0, nan\n1.0, 2.0\n",
        "one.csv": "0.0\n1.0\n", "empty.csv": "", "repeat.csv": "0.0, 1.0\n0.0, 1.0\n",
        "huge.csv": "0.0, 1e308\n1.0, 2.0\n"}

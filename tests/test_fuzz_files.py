@@ -217,7 +217,7 @@ SWEEP = {"case": "case.toml", "vary": {"material.C1": [80.0, 90.0], "solver.step
          "report": {"monitor": "w"}}
 sweep_values = st.one_of(numbers, words, st.booleans(), st.lists(numbers, max_size=3),
                          st.dictionaries(st.sampled_from(["r", "z", "monitor", "x"]), numbers, max_size=2),
-                         st.sampled_from(["case.toml", "missing.toml", "blocker", ".", "w", "nope",
+                         st.sampled_from(["case.toml", "missing.toml", "blocker", ".", "w", "nope", "x" * 300,
                                           "material.C1", "mesh.divisions", "contact[0].friction"]))
 
 

@@ -152,8 +152,13 @@ def build_mesh(spec: MeshSpec, base: Path) -> Mesh:
             raise CaseError(f"mesh.profile: {exc}") from None
     path = Path(spec.file)
     path = path if path.is_absolute() else base / path
-    if not path.exists():
-        raise CaseError(f"mesh.file: no such file {path}")
+    try:
+        if not path.exists():
+            raise CaseError(f"mesh.file: no such file {path}")
+        if path.is_dir():
+            raise CaseError(f"mesh.file: {path} is a folder, not a gmsh file")
+    except OSError as exc:  # a name longer than the file system allows, a folder that cannot be read
+        raise CaseError(f"mesh.file: cannot read {path} ({exc.strerror or exc})") from None
     said = io.StringIO()  # meshio prints its warnings and errors itself
     try:
         with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):

@@ -104,12 +104,14 @@ MIN_MAGNITUDE = 1e-30
 
 def out_of_range(data: Any, path: list[str | int] | None = None) -> list[str]:
     """Every number of a case tree beyond MAX_MAGNITUDE or nonzero below MIN_MAGNITUDE in
-    magnitude, as 'key.path: reason' lines."""
+    magnitude, and every string holding a NUL character, as 'key.path: reason' lines."""
     path = path or []
     if isinstance(data, dict):
         return [line for k, v in data.items() for line in out_of_range(v, [*path, str(k)])]
     if isinstance(data, list):
         return [line for i, v in enumerate(data) for line in out_of_range(v, [*path, i])]
+    if isinstance(data, str) and "\x00" in data:  # no file name, label or name holds one
+        return [f"{key_path(path)}: holds a NUL character"]
     if isinstance(data, (int, float)) and not isinstance(data, bool) and math.isfinite(data):
         size = abs(data)
         if size > MAX_MAGNITUDE:

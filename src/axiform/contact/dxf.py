@@ -124,8 +124,13 @@ def read_dxf(path: str | Path, layer: str | None = None, reverse: bool = False,
     bisector of its new chord.  Raises DxfError for a missing or unreadable file, an empty
     layer, unsupported entities, and pieces that branch or leave gaps (named with the place)."""
     path = Path(path)
-    if not path.is_file():
-        raise DxfError(f"no such file {path}")
+    try:
+        if path.is_dir():
+            raise DxfError(f"{path} is a folder, not a DXF drawing")
+        if not path.is_file():
+            raise DxfError(f"no such file {path}")
+    except OSError as exc:  # a name longer than the file system allows, a folder that cannot be read
+        raise DxfError(f"cannot read {path} ({exc.strerror or exc})") from None
     try:
         return _read_dxf(path, layer, reverse, tolerance, motion)
     except DxfError as exc:  # every message names the file

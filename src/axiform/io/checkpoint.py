@@ -99,7 +99,11 @@ def load(folder: str | Path) -> tuple[dict, dict]:
     """The checkpoint and its meta from folder/checkpoint.npz; ValueError naming the file if it
     is missing, unreadable, damaged or not a checkpoint."""
     path = Path(folder) / FILE
-    if not path.is_file():
+    try:
+        there = path.is_file()
+    except OSError as exc:  # a name longer than the file system allows
+        raise ValueError(f"{path}: cannot read it ({exc.strerror or exc})") from None
+    if not there:
         raise ValueError(f"{path}: no checkpoint (no such file; the run wrote none, or restart.every = 0)")
     try:
         with np.load(path, allow_pickle=False) as data:
