@@ -151,9 +151,9 @@ def mutations(draw, case):
             case["monitor"] = copy.deepcopy(BASE["monitor"])
             case["monitor"][0]["name"] = draw(st.sampled_from(["a,b", 'w"', "w\nx", "w;", "w\t", "\x00", "ok name"]))
         elif choice == "revolved":
-            case["output"] = dict(BASE["output"], revolved=draw(st.sampled_from([1, 3600, 3601, 10**9])))
-        else:
-            case["mesh"] = dict(BASE["mesh"], divisions=draw(st.sampled_from([[10**5, 10**5], [10**9, 1]])))
+            case["output"] = dict(copy.deepcopy(BASE["output"]), revolved=draw(st.sampled_from([1, 3600, 3601, 10**9])))
+        else:  # deep copies: later mutations change lists in place
+            case["mesh"] = dict(copy.deepcopy(BASE["mesh"]), divisions=draw(st.sampled_from([[10**5, 10**5], [10**9, 1]])))
     else:  # a selector matching nothing, several nodes or a set that is not there
         sel = draw(st.sampled_from([{"r": 1.234}, {"z": 0.0}, {"set": "nowhere"}, {"box": [[0, 0], [9, 9]]}, {}]))
         where = draw(st.sampled_from(["fix", "pressure", "monitor"]))
