@@ -221,11 +221,11 @@ def test_check_like_names_the_first_item_that_differs(finished):
         check_like(other, state)
 
 
-@pytest.mark.xfail(strict=True, reason="cli.py (lead): a checkpoint that is whole (its checksum matches, or a file "
+@pytest.mark.xfail(strict=True, reason="app/run.py run (cli._run before h2): a checkpoint that is whole (its checksum matches, or a file "
                    "of before the checksum) but fits no model fails in the solve with exit 3; in _run, after build(): "
                    "check_like(state, {'path': {'u_f': np.zeros(model.n_free)}, 'model': "
                    "model.initial_state().to_dict(), 'size': 0.0, 'step': 0, 'newton_iterations': 0}) "
-                   "(io/checkpoint.py), a ValueError -> CaseError(f'--resume: {resume}/restart/checkpoint.npz: {exc}')")
+                   "(io/checkpoint.py) after build(), a ValueError -> CaseError(f'--resume: {resume}/restart/checkpoint.npz: {exc}')")
 @pytest.mark.parametrize("damage", ["u_f", "path", "contacts"])
 def test_a_checkpoint_that_fits_no_model_is_refused_naming_the_file(finished, damage):
     path, run = finished
@@ -270,7 +270,7 @@ def test_a_folder_named_as_a_mesh_or_mould_file_is_refused_as_such(tmp_path, nam
 # ---- families whose fix is the lead's (strict xfail: they fail now, pass once fixed) -----------
 
 
-@pytest.mark.xfail(strict=True, reason="cli.py _prepare: Path.exists() raises OSError ENAMETOOLONG for a name "
+@pytest.mark.xfail(strict=True, reason="app/run.py prepare_folder (cli._prepare before h2): Path.exists() raises OSError ENAMETOOLONG for a name "
                    "longer than the file system allows; wrap its loop over (folder, *folder.parents) in the same "
                    "try/except OSError as the mkdir, returning f'cannot create or write {folder} "
                    "({exc.strerror or exc})' (and results_folder's folder.exists() likewise)")
@@ -279,9 +279,9 @@ def test_an_output_path_longer_than_the_file_system_allows_is_refused(tmp_path):
     refused(["run", path, "--out", tmp_path / ("x" * 300), "-q"], "--out:", "File name too long")
 
 
-@pytest.mark.xfail(strict=True, reason="cli.py: Path.is_dir() / is_file() raise OSError ENAMETOOLONG for a name longer "
-                   "than the file system allows: in _resume_state (--resume: exit 3) and plot (a traceback); wrap "
-                   "`folder.is_dir()` in _resume_state and `(path / 'history.csv').is_file()` in plot in try/except "
+@pytest.mark.xfail(strict=True, reason="app/run.py resume_state, app/plot.py plot (cli.py before h2): Path.is_dir() / is_file() raise OSError ENAMETOOLONG for a name longer "
+                   "than the file system allows: in resume_state (--resume: exit 3) and plot (a traceback); wrap "
+                   "`folder.is_dir()` in resume_state and `(path / 'history.csv').is_file()` in plot in try/except "
                    "OSError -> exit 2 with f'--resume: {folder}: {exc.strerror}' / f'axiform: {folder}: {exc.strerror}'")
 @pytest.mark.parametrize("command", ["resume", "plot"])
 def test_a_results_folder_name_too_long_is_refused(tmp_path, command):
@@ -290,7 +290,7 @@ def test_a_results_folder_name_too_long_is_refused(tmp_path, command):
     refused(argv, "File name too long")
 
 
-@pytest.mark.xfail(strict=True, reason="post/plots.py read_history (or cli.plot): a ragged row of history.csv gives "
+@pytest.mark.xfail(strict=True, reason="post/results_folder.py read_history (post/plots.py before h1; or app/plot.py plot): a ragged row of history.csv gives "
                    "float(None) / float(list) TypeError, a traceback; read it with csv.reader, and for each row n "
                    "raise ValueError(f'{path} line {n}: {len(row)} values for {len(header)} columns') when the "
                    "lengths differ and ValueError(f'{path} line {n}: {cell!r} is not a number') for text")
@@ -327,7 +327,7 @@ def test_fit_data_that_is_not_utf8_is_refused_naming_the_file(tmp_path):
 
 
 @pytest.mark.xfail(strict=True, reason="app/fit.py run: folder.mkdir() raises FileExistsError (a traceback) when "
-                   "--out lies below a file; check it before the fit with cli._prepare(folder) and exit 2 with "
+                   "--out lies below a file; check it before the fit with app/run.prepare_folder(folder) and exit 2 with "
                    "'axiform: invalid output folder:\\n--out: {problem}'")
 def test_fit_out_below_a_file_is_refused(tmp_path):
     csv = tmp_path / "d.csv"
@@ -368,7 +368,7 @@ def test_a_mould_file_of_huge_coordinates_is_refused_naming_the_row(tmp_path):
             "at most 1e+30")
 
 
-@pytest.mark.xfail(strict=True, reason="app/optimize.py read_target: a thickness of 1e-300 (or s, thickness beyond 1e30) "
+@pytest.mark.xfail(strict=True, reason="app/design.py read_target (app/optimize.py before h2): a thickness of 1e-300 (or s, thickness beyond 1e30) "
                    "is accepted and the run reports a deviation of 6.5e+301 %; refuse magnitudes as the case's numbers "
                    "are (case/schema.py MAX_MAGNITUDE, MIN_MAGNITUDE): TargetError(f'{path}: line {n}: ... magnitude')")
 def test_a_target_of_absurd_magnitude_is_refused_naming_the_line(tmp_path):
