@@ -86,16 +86,18 @@ values = st.one_of(scalars, st.lists(scalars, max_size=3), st.lists(st.lists(num
                    st.dictionaries(st.sampled_from(["r", "z", "box", "set", "x", "to"]), scalars, max_size=2))
 
 GMSH = {"missing.msh": None, "empty.msh": "", "corrupt.msh": "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 x\n",
-        "binary.msh": bytes(range(256)), "triangles.msh": "tri", "quads.msh": "quad"}
+        "binary.msh": bytes(range(256)), "triangles.msh": "tri", "quads.msh": "quad", "mixed.msh": "mixed",
+        "nan.msh": "nan", "x" * 300 + ".msh": None}
 CSV = {"good.csv": "0.0, 1.0\n2.0, 1.2\n", "text.csv": "0.0, 1.0\nabc, 2.0\n", "nan.csv": "0.0, nan\n1.0, 2.0\n",
-       "one.csv": "0.0\n1.0\n", "empty.csv": "", "repeat.csv": "0.0, 1.0\n0.0, 1.0\n"}
+       "one.csv": "0.0\n1.0\n", "empty.csv": "", "repeat.csv": "0.0, 1.0\n0.0, 1.0\n",
+       "huge.csv": "0.0, 1e308\n1.0, 2.0\n"}
 polylines = st.lists(st.lists(numbers, min_size=2, max_size=2), min_size=0, max_size=5)
 
 
 @st.composite
 def mutations(draw, case):
     """Change one thing of the case tree in place."""
-    kind = draw(st.sampled_from(["set", "set", "set", "delete", "unknown", "mesh", "contact", "selector"]))
+    kind = draw(st.sampled_from(["set", "set", "set", "delete", "unknown", "mesh", "contact", "selector", "output"]))
     if kind in ("set", "delete"):
         path = draw(st.sampled_from(paths(case)))
         node = case
@@ -143,6 +145,15 @@ def mutations(draw, case):
         contact[draw(st.sampled_from(["penalty", "friction", "depth", "motion"]))] = draw(
             st.one_of(numbers, st.just({"uz": -0.5})))
         case["contact"] = [contact]
+    elif kind == "output":  # a monitor name that would break history.csv, a huge revolved copy or mesh
+        choice = draw(st.sampled_from(["name", "revolved", "divisions"]))
+        if choice == "name":
+            case["monitor"] = copy.deepcopy(BASE["monitor"])
+            case["monitor"][0]["name"] = draw(st.sampled_from(["a,b", 'w"', "w\nx", "w;", "w\t", "\x00", "ok name"]))
+        elif choice == "revolved":
+            case["output"] = dict(copy.deepcopy(BASE["output"]), revolved=draw(st.sampled_from([1, 3600, 3601, 10**9])))
+        else:  # deep copies: later mutations change lists in place
+            case["mesh"] = dict(copy.deepcopy(BASE["mesh"]), divisions=draw(st.sampled_from([[10**5, 10**5], [10**9, 1]])))
     else:  # a selector matching nothing, several nodes or a set that is not there
         sel = draw(st.sampled_from([{"r": 1.234}, {"z": 0.0}, {"set": "nowhere"}, {"box": [[0, 0], [9, 9]]}, {}]))
         where = draw(st.sampled_from(["fix", "pressure", "monitor"]))
@@ -175,9 +186,13 @@ def folder(tmp_path_factory):
     """The files the cases may name: gmsh and CSV files, good and bad."""
     d = tmp_path_factory.mktemp("fuzz")
     for name, content in GMSH.items():
-        if content in ("tri", "quad"):
-            pts = np.array([[0, 0, 0], [2, 0, 0], [2, 0.2, 0], [0, 0.2, 0.0]])
+        if content in ("tri", "quad", "mixed", "nan"):
+            pts = np.array([[0, 0, 0], [2, 0, 0], [2, 0.2, 0], [0, 0.2, 0.0], [3, 0, 0]])
+            pts[4, 1] = np.nan if content == "nan" else 0.0
             cells = [("triangle", np.array([[0, 1, 2]]))] if content == "tri" else [("quad", np.array([[0, 1, 2, 3]]))]
+            if content in ("mixed", "nan"):
+                cells.append(("triangle", np.array([[1, 4, 2]])) if content == "mixed" else
+                             ("quad", np.array([[1, 4, 4, 2]])))
             meshio.write(d / name, meshio.Mesh(pts, cells), file_format="gmsh22")
         elif isinstance(content, bytes):
             (d / name).write_bytes(content)

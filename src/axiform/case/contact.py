@@ -123,6 +123,10 @@ def youngs_modulus(material: Hyperelastic) -> float:
     return 9.0 * k * mu / (3.0 * k + mu)
 
 
+# the largest magnitude of a coordinate in a mould file (as of any number in a case: schema.py)
+MAX_MAGNITUDE = 1e30
+
+
 def _surface(spec: SurfaceSpec, motion: tuple[float, float], base: Path, where: str):
     surface = _path_surface(spec, motion, base, where)
     return surface.reversed() if spec.reverse else surface
@@ -163,9 +167,10 @@ def _path_surface(spec: SurfaceSpec, motion: tuple[float, float], base: Path, wh
             raise CaseError(f"{where}.surface.file: {path} holds no r, z rows")
         if points.shape[1] != 2:
             raise CaseError(f"{where}.surface.file: {path} must have two columns, r and z")
-        bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
+        bad = np.flatnonzero(~(np.abs(points) <= MAX_MAGNITUDE).all(axis=1))  # NaN compares False
         if bad.size:
-            raise CaseError(f"{where}.surface.file: {path} row {bad[0] + 1} of the data is not two finite numbers")
+            raise CaseError(f"{where}.surface.file: {path} row {bad[0] + 1} of the data is not two finite numbers "
+                            f"(of at most {MAX_MAGNITUDE:g} in magnitude)")
     try:
         return Polyline(motion=motion, points=points)
     except ValueError as exc:

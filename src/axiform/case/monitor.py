@@ -17,6 +17,8 @@ from ..model.model import Model
 from ..fem.selectors import select_nodes
 
 HISTORY_COLUMNS = ("step", "load_factor", "iterations")  # history.csv's first columns
+# characters a monitor name may not hold (besides the unprintable ones): the CSV separators and quotes
+NOT_IN_NAMES = frozenset(',;"\t')
 
 
 class MonitorSpec(Strict):
@@ -37,6 +39,10 @@ class MonitorSpec(Strict):
         if not name.strip() or name in HISTORY_COLUMNS or name != name.strip():
             raise ValueError(f"{name!r}: a monitor name must not be empty, begin or end with blanks, or be "
                              f"one of the columns {', '.join(HISTORY_COLUMNS)}")
+        bad = sorted({c for c in name if c in NOT_IN_NAMES or not c.isprintable()})
+        if bad:  # the name heads a column of history.csv (and sweep.csv) and labels the plots
+            raise ValueError(f"{name!r}: a monitor name heads a CSV column: it may not hold "
+                             f"{' '.join(repr(c) for c in bad)} (no commas, semicolons, double quotes, tabs or line breaks)")
         return name
 
     @model_validator(mode="after")

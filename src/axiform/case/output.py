@@ -9,13 +9,18 @@ from pydantic import Field
 
 from .base import Strict
 
+# output.revolved: at most this many sectors (a tenth of a degree each), and at most
+# MAX_REVOLVED_POINTS points in the 3D copy (checked against the mesh when the case is built)
+MAX_SECTORS = 3600
+MAX_REVOLVED_POINTS = 20_000_000
+
 
 class OutputSpec(Strict):
     every: Annotated[int, Field(ge=1)] = 1  # field output every k-th converged step (and the last)
     vtu: bool = True
     gid: bool = False
     plots: bool = True
-    revolved: Annotated[int, Field(ge=0)] = 0  # sectors of a 3D revolved copy of the last step
+    revolved: Annotated[int, Field(ge=0, le=MAX_SECTORS)] = 0  # sectors of a 3D revolved copy of the last step
     thickness_every: Annotated[int, Field(ge=1)] | None = None  # thickness/step_NNNN.csv every k-th step
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import math
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,10 +39,10 @@ from .loads import FixSpec, PointLoadSpec, PressureSpec, apply_loads, prescribe_
 from .material import MaterialSpec
 from .mesh import ArcPiece, LinePiece, MeshSpec, PieceSpec, build_mesh
 from .monitor import HISTORY_COLUMNS, Monitor, MonitorSpec, build_monitors
-from .output import OutputSpec, RestartSpec, Unit, UnitsSpec
+from .output import MAX_REVOLVED_POINTS, OutputSpec, RestartSpec, Unit, UnitsSpec
 from .suggest import did_you_mean
 from .solver import DofRef, SolverSpec, StopSpec, build_control
-from ..model.guards import boundary_crossing, free_to_slide, not_numbers
+from ..model.guards import boundary_crossing, free_to_slide, key_path, not_numbers
 from ..fem.mesh import MeshError
 from ..model.model import Model
 from ..fem.selectors import SelectorError
@@ -91,12 +92,43 @@ def _loc(loc: tuple) -> str:
     return out or "(case)"
 
 
+# the magnitudes a number of a case may have: the model multiplies lengths, moduli, pressures and
+# penalties together (a stiffness is a modulus x a length^2 / a length, an energy a modulus x a
+# volume, the penalty of a contact a modulus / a length x 1e3 ...), and a number beyond 1e30 in
+# magnitude (or a nonzero one below 1e-30) overflows (or underflows) in those products, to be
+# found much later as "a singular tangent" or "an overflow of the material law"; no unit
+# system needs them (a modulus of 1e11 Pa, a length of 1e-9 m)
+MAX_MAGNITUDE = 1e30
+MIN_MAGNITUDE = 1e-30
+
+
+def out_of_range(data: Any, path: list[str | int] | None = None) -> list[str]:
+    """Every number of a case tree beyond MAX_MAGNITUDE or nonzero below MIN_MAGNITUDE in
+    magnitude, and every string holding a NUL character, as 'key.path: reason' lines."""
+    path = path or []
+    if isinstance(data, dict):
+        return [line for k, v in data.items() for line in out_of_range(v, [*path, str(k)])]
+    if isinstance(data, list):
+        return [line for i, v in enumerate(data) for line in out_of_range(v, [*path, i])]
+    if isinstance(data, str) and "\x00" in data:  # no file name, label or name holds one
+        return [f"{key_path(path)}: holds a NUL character"]
+    if isinstance(data, (int, float)) and not isinstance(data, bool) and math.isfinite(data):
+        size = abs(data)
+        if size > MAX_MAGNITUDE:
+            return [f"{key_path(path)}: {data:g} is too large a magnitude (at most {MAX_MAGNITUDE:g}: the "
+                    f"products of lengths, moduli, pressures and penalties would overflow); use other units"]
+        if 0 < size < MIN_MAGNITUDE:
+            return [f"{key_path(path)}: {data:g} is too small a magnitude (nonzero values must be at least "
+                    f"{MIN_MAGNITUDE:g}: their products would underflow to zero); use 0 or other units"]
+    return []
+
+
 def parse(data: dict[str, Any]) -> Case:
     """Validate a case given as a dict (as TOML reads it); CaseError lists every problem with
     its key path.  Every number must be finite, and types are strict: no "80" for 80.0, no
     true for 1 (the tree goes through JSON, whose strict mode still takes arrays for tuples
     and integers for floats)."""
-    bad = not_numbers(data)
+    bad = not_numbers(data) or out_of_range(data)
     if bad:
         raise CaseError("\n".join(bad))
     try:
@@ -194,6 +226,10 @@ def build(case: Case, base: str | Path = ".") -> Built:
         mesh = build_mesh(case.mesh, base)
     except MeshError as exc:
         raise CaseError(f"mesh: {exc}") from None
+    sectors = case.output.revolved
+    if sectors and mesh.n_nodes * sectors > MAX_REVOLVED_POINTS:
+        raise CaseError(f"output.revolved: {sectors} sectors of a mesh of {mesh.n_nodes:,} nodes make a 3D copy of "
+                        f"{mesh.n_nodes * sectors:,} points (at most {MAX_REVOLVED_POINTS:,}): use fewer sectors")
     try:
         material = case.material.build()
     except ValueError as exc:

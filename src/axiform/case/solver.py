@@ -24,15 +24,21 @@ class StopSpec(Strict):
     value: float
 
 
+MAX_STEPS = 1_000_000
+MAX_ITERATIONS = 1000
+
+
 class SolverSpec(Strict):
     control: Literal["load", "displacement", "arc-length"] = "load"
     dof: DofRef | None = None
     target: float | None = None
-    steps: Annotated[int, Field(ge=1)] = 10
+    # the counts are bounded so that every run ends: a million steps of the smallest model take
+    # hours, a step of more Newton iterations than MAX_ITERATIONS is not converging
+    steps: Annotated[int, Field(ge=1, le=MAX_STEPS)] = 10
     arc_length: PositiveFloat | None = None
     stop: StopSpec | None = None
-    max_steps: Annotated[int, Field(ge=1)] = 1000
-    max_iterations: Annotated[int, Field(ge=1)] = 20
+    max_steps: Annotated[int, Field(ge=1, le=MAX_STEPS)] = 1000
+    max_iterations: Annotated[int, Field(ge=1, le=MAX_ITERATIONS)] = 20
     tolerance: Annotated[float, Field(gt=0, lt=1)] = 1e-8
     min_step: Annotated[float, Field(gt=0, le=1)] = 1e-4
     growth: Annotated[float, Field(ge=1)] = 1.5

@@ -107,6 +107,10 @@ def _pieces(entity, ztol: float) -> list[Piece]:
     raise DxfError(f"unsupported entity {_name(entity)}: use LINE, ARC, LWPOLYLINE or POLYLINE")
 
 
+# coordinates beyond this magnitude are refused (as numbers of a case file are: case/schema.py)
+MAX_COORDINATE = 1e30
+
+
 def _fmt(p: np.ndarray) -> str:
     return f"({p[0]:.6g}, {p[1]:.6g})"
 
@@ -119,11 +123,27 @@ def read_dxf(path: str | Path, layer: str | None = None, reverse: bool = False,
     drawing's size); joined ends meet at their mean, an arc's center is moved onto the
     bisector of its new chord.  Raises DxfError for a missing or unreadable file, an empty
     layer, unsupported entities, and pieces that branch or leave gaps (named with the place)."""
+    path = Path(path)
+    try:
+        if path.is_dir():
+            raise DxfError(f"{path} is a folder, not a DXF drawing")
+        if not path.is_file():
+            raise DxfError(f"no such file {path}")
+    except OSError as exc:  # a name longer than the file system allows, a folder that cannot be read
+        raise DxfError(f"cannot read {path} ({exc.strerror or exc})") from None
+    try:
+        return _read_dxf(path, layer, reverse, tolerance, motion)
+    except DxfError as exc:  # every message names the file
+        raise DxfError(str(exc) if str(path) in str(exc) else f"{exc} (in {path})") from None
+    except Exception as exc:  # noqa: BLE001 - ezdxf raises anything on a damaged drawing
+        why = " ".join(f"{type(exc).__name__}: {exc}".split())[:300]
+        raise DxfError(f"cannot read {path} as a DXF drawing ({why})") from None
+
+
+def _read_dxf(path: Path, layer: str | None, reverse: bool, tolerance: float | None,
+              motion: tuple[float, float]) -> Polyline:
     import ezdxf
 
-    path = Path(path)
-    if not path.is_file():
-        raise DxfError(f"no such file {path}")
     try:
         doc = ezdxf.readfile(path)
     except (OSError, ezdxf.DXFError, UnicodeDecodeError, ValueError) as exc:
@@ -140,6 +160,13 @@ def read_dxf(path: str | Path, layer: str | None = None, reverse: bool = False,
         place = "in the model space" if layer is None else f"on layer {layer!r}"
         raise DxfError(f"unsupported entities {', '.join(unsupported)} {place}: use LINE, ARC, "
                        "LWPOLYLINE or POLYLINE")
+    for e in entities:  # the drawing's numbers: finite, and not so large that their products overflow
+        pts = np.array([[p[0], p[1], p[2]] for p in _extent_points(e)], float).reshape(-1, 3)
+        values = np.concatenate([pts.ravel(), [float(e.dxf.get(k)) for k in ("radius", "start_angle", "end_angle")
+                                               if e.dxf.is_supported(k) and e.dxf.hasattr(k)]])
+        if not np.isfinite(values).all() or (np.abs(values) > MAX_COORDINATE).any():
+            raise DxfError(f"{_name(e)} has a coordinate that is not a finite number or is beyond "
+                           f"{MAX_COORDINATE:g} in magnitude")
     corners = np.array([[p[0], p[1], p[2]] for e in entities for p in _extent_points(e)])
     size = float(np.linalg.norm(np.ptp(corners[:, :2], axis=0))) or 1.0
     tol = tolerance if tolerance is not None else 1e-6 * size

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -217,6 +218,10 @@ def edges_on_nodes(mesh: Mesh, nodes: np.ndarray) -> np.ndarray:
 
 
 _MESHIO_QUADS = {"quad": "q4", "quad8": "q8"}
+# node coordinates beyond this magnitude are refused (as numbers of a case file are: case/schema.py)
+MAX_COORDINATE = 1e30
+# the other surface cells gmsh writes: a mesh holding them is not all quadrilaterals
+_SURFACE_CELLS = ("triangle", "triangle6", "triangle7", "polygon")
 
 
 def read_gmsh(path: str | Path, element: str | None = None) -> Mesh:
@@ -229,6 +234,16 @@ def read_gmsh(path: str | Path, element: str | None = None) -> Mesh:
 
     m = meshio.read(path)
     quads = [(b.type, b.data) for b in m.cells if b.type in _MESHIO_QUADS]
+    others = Counter()
+    for b in m.cells:
+        if b.type in _SURFACE_CELLS:
+            others[b.type] += len(b.data)
+    if others:  # a surface meshed partly in triangles: those would be holes in the body
+        held = ", ".join(f"{n} {t} cell{'s' * (n > 1)}" for t, n in sorted(others.items()))
+        beside = f" beside {sum(len(d) for _, d in quads)} quadrilaterals" if quads else ""
+        raise MeshError(f"{path}: holds {held}{beside}; axiform takes quadrilaterals only (quad or quad8): "
+                        f"recombine the surfaces in gmsh (Mesh.RecombineAll = 1, or Recombine Surface{{...}}; "
+                        f"with Mesh.SubdivisionAlgorithm = 1 for quads only)")
     if not quads:
         raise MeshError(f"{path}: no quadrilateral cells (quad or quad8) found")
     types = {t for t, _ in quads}
@@ -241,7 +256,14 @@ def read_gmsh(path: str | Path, element: str | None = None) -> Mesh:
         raise MeshError(f"{path}: holds {ctype} cells, which cannot be used as element '{element}'")
     cells = np.vstack([d for _, d in quads]).astype(np.int64)
     points = np.asarray(m.points[:, :2], dtype=float)
+    if cells.size and (cells.min() < 0 or cells.max() >= len(points)):
+        raise MeshError(f"{path}: a cell names a node that is not in the file ({len(points)} nodes)")
     used = np.unique(cells)
+    bad = used[~(np.abs(points[used]) <= MAX_COORDINATE).all(axis=1)]  # NaN compares False
+    if len(bad):
+        raise MeshError(f"{path}: {len(bad)} node(s) with coordinates that are not finite numbers, or beyond "
+                        f"{MAX_COORDINATE:g} in magnitude "
+                        f"(the first: number {int(bad[0])} from 0 in the file's node list, at {points[bad[0]].tolist()})")
     # drop nodes that no quad uses (gmsh keeps geometry points)
     renumber = -np.ones(len(points), dtype=np.int64)
     renumber[used] = np.arange(len(used))
