@@ -339,8 +339,8 @@ class Polyline(RigidSurface):
                     out.active[nb] = True
                     out.n[nb] = nv
                     out.t[nb] = np.column_stack([nv[:, 1], -nv[:, 0]])
-                    d = x[nb] - v
-                    out.g[nb] = d[:, 0] * nv[:, 0] + d[:, 1] * nv[:, 1]
+                    # np.dot node by node, as ever (BLAS may round a dot product otherwise): few nodes
+                    out.g[nb] = [float(np.dot(d, e)) for d, e in zip(x[nb] - v, nv)]
                     out.s[nb] = out.s_prev[nb] = self.s0[sb]
                     out.point[nb] = v
                     out.kind[nb] = 2
