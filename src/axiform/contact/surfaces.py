@@ -164,7 +164,8 @@ class Polyline(RigidSurface):
         self._any_arc = bool(arc.any())
         self._par = np.column_stack([self.a, self.tan_a, self.L, np.where(arc[:, None], self.c, 0.0),
                                      np.where(arc, self.R, 1.0), np.where(arc, self.phi0, 0.0),
-                                     np.where(arc & (self.sweep > 0), self.sweep, 1.0), self.dir])
+                                     np.where(arc & (self.sweep > 0), self.sweep, 1.0), self.dir,
+                                     -self.tan_a[:, 1], self.tan_a[:, 0]])
         self._cavity = np.zeros(m, bool)
         self._vertex_n = np.zeros((m, 2))
         for k in range(1, m):
@@ -212,8 +213,8 @@ class Polyline(RigidSurface):
         both the straight and the circular formula evaluated for every pair (the arc's only
         where the polyline has arcs), the right one picked by np.where.  full=False: xi and g
         only (the last converged positions need no more)."""
-        P = self._par[k]  # (p, 11): one gather of every piece's constants
-        ar, az, tr, tz, L, cr, cz, R, phi0, sweep, sgn = P.T
+        P = self._par[k]  # (p, 13): one gather of every piece's constants
+        ar, az, tr, tz, L, cr, cz, R, phi0, sweep, sgn = P.T[:11]
         xr, xz = x[:, 0], x[:, 1]
         dx, dz = xr - ar, xz - az
         xi = (dx * tr + dz * tz) / L
@@ -235,16 +236,22 @@ class Polyline(RigidSurface):
         if not full:
             return xi, g
         xic = np.clip(xi, 0.0, 1.0)
-        t = np.column_stack([tr, tz])
-        n = np.column_stack([-tz, tr])
-        point = np.column_stack([ar + (xic * L) * tr, az + (xic * L) * tz])
+        t, n = P[:, 2:4], P[:, 11:13]  # the line's tangent and normal
+        point = P[:, 0:2] + (xic * L)[:, None] * t
         if self._any_arc:
-            t = np.where(arc[:, None], np.column_stack([sgn * -sin, sgn * cos]), t)
-            n = np.where(arc[:, None], np.column_stack([nar, naz]), n)
+            isarc = arc[:, None]
+            sc = np.empty((len(k), 2))
+            np.negative(sin, out=sc[:, 0])
+            sc[:, 1] = cos
+            ta = sgn[:, None] * sc  # sgn (-sin, cos)
+            t = np.where(isarc, ta, t)
+            n = np.where(isarc, ta[:, ::-1] * [-1.0, 1.0], n)
             kappa = np.where(arc, -sgn / rho, 0.0)  # ccw: the body inside the arc
             m = np.where(arc, R / rho, 1.0)
             ph = phi0 + sgn * xic * sweep
-            point = np.where(arc[:, None], np.column_stack([cr + R * np.cos(ph), cz + R * np.sin(ph)]), point)
+            sc[:, 0] = np.cos(ph)
+            sc[:, 1] = np.sin(ph)
+            point = np.where(isarc, P[:, 5:7] + R[:, None] * sc, point)
         else:
             kappa, m = np.zeros(len(k)), np.ones(len(k))
         return xi, g, n, t, kappa, m, point
@@ -289,8 +296,8 @@ class Polyline(RigidSurface):
         xi, g, n, t, kappa, m, point = self._project(k, x[i])
         xi0, g0 = self._project(k, x_prev[i], full=False)
         tol = 1e-9
-        with np.errstate(divide="ignore", invalid="ignore"):
-            tau = np.where(g0 - g > 0, g0 / (g0 - g), np.inf)  # where along the path it crosses
+        dg = g0 - g
+        tau = np.divide(g0, dg, out=np.full(len(g), np.inf), where=dg > 0)  # where along the path it crosses
         crossed = (g0 >= 0) & (g < 0) & np.isfinite(tau)
         if crossed.any():
             ic = i[crossed]
