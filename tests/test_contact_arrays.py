@@ -130,3 +130,29 @@ def test_gauss_rules_are_built_once_and_read_only():
         w[0] = 1.0
     xi, wq = gauss_quad(2)
     assert xi.shape == (4, 2) and not wq.flags.writeable and np.isclose(wq.sum(), 4.0)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_many_pairs_path_is_the_reference(seed, monkeypatch):
+    """Beyond ARC_SUBSET pairs the arc formulas run on the arcs' pairs only and the best pair
+    of each node is found without a sort: the same answer."""
+    monkeypatch.setattr(surfaces, "ARC_SUBSET", 0)
+    rng = np.random.default_rng(200 + seed)
+    surf = random_polyline(rng, int(rng.integers(1, 9)))
+    x_prev = near_points(rng, surf, 500, 0.3)
+    x = x_prev + rng.normal(0, 0.1, x_prev.shape)
+    for depth in (0.05, 0.5):
+        same(surf.local(x, x_prev, depth), ref.local(surf, x, x_prev, depth))
+    k = rng.integers(0, len(surf.a), len(x))
+    for a, b in zip(surf._piece_local(k, x), ref.piece_local(surf, k, x)):
+        assert np.array_equal(a, b)
+
+
+def test_best_per_node_is_the_last_of_a_stable_sort():
+    rng = np.random.default_rng(3)
+    i = np.sort(rng.integers(0, 300, 2000))
+    score = rng.choice([-np.inf, 1.0, 2.25, 2.5], len(i))
+    rank = rng.choice([0.0, -0.0, 0.5, -1.0, 3.0], len(i))
+    order = np.lexsort((rank, score, i))
+    expected = order[np.r_[i[order][1:] != i[order][:-1], True]]
+    assert np.array_equal(surfaces._best_per_node(i, score, rank), expected)

@@ -17,8 +17,8 @@ def _boxes(a: np.ndarray, b: np.ndarray, widen: float):
 
 
 def _inside(x: np.ndarray, nodes: np.ndarray, segs: np.ndarray, lo, hi) -> np.ndarray:
-    p = x[nodes]
-    return ((p >= lo[segs]) & (p <= hi[segs])).all(axis=1)
+    p, lo, hi = x[nodes], lo[segs], hi[segs]
+    return (p[:, 0] >= lo[:, 0]) & (p[:, 0] <= hi[:, 0]) & (p[:, 1] >= lo[:, 1]) & (p[:, 1] <= hi[:, 1])
 
 
 def _sorted_pairs(nodes: np.ndarray, segs: np.ndarray) -> np.ndarray:

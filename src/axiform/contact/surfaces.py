@@ -21,6 +21,9 @@ from . import search
 # `Polyline.local` tests every node against every piece's box at once up to this many pairs
 # (N M); beyond, the global search of `search` finds the candidates
 DENSE_PAIRS = 1 << 16
+# `Polyline._project` evaluates the arc formulas on every pair up to this many pairs (fewer
+# array operations), beyond on the arcs' pairs only (less arithmetic)
+ARC_SUBSET = 4096
 
 
 @dataclass
@@ -44,6 +47,24 @@ class Projection:
         z = np.zeros(n)
         return cls(np.zeros(n, bool), z.copy(), np.zeros((n, 2)), np.zeros((n, 2)), z.copy(), z.copy(),
                    np.ones(n), np.zeros((n, 2)), z.copy(), np.zeros(n, np.int8))
+
+
+def _best_per_node(i: np.ndarray, score: np.ndarray, rank: np.ndarray) -> np.ndarray:
+    """For pairs sorted by node i: the index of the last pair of each node among those with
+    the node's largest score and, among them, its largest rank."""
+    new = np.empty(len(i), bool)
+    new[0] = True
+    np.not_equal(i[1:], i[:-1], out=new[1:])
+    start = np.flatnonzero(new)
+    group = np.cumsum(new) - 1
+    top = score == np.maximum.reduceat(score, start)[group]
+    rank = np.where(top, rank, -np.inf)
+    pick = np.flatnonzero(top & (rank == np.maximum.reduceat(rank, start)[group]))
+    gp = group[pick]
+    last = np.empty(len(pick), bool)
+    np.not_equal(gp[1:], gp[:-1], out=last[:-1])
+    last[-1] = True
+    return pick[last]
 
 
 @dataclass
@@ -208,7 +229,7 @@ class Polyline(RigidSurface):
         xi, g, n, t, kappa, m, point = self._project(k, x, True)
         return xi, g, n, t, kappa, m, point
 
-    def _project(self, k: np.ndarray, x: np.ndarray, full: bool = True):
+    def _project(self, k: np.ndarray, x: np.ndarray, full: bool = True, subset: bool = True):
         """`_piece_local` on arrays, every pair at once: the pieces' data gathered by k and
         both the straight and the circular formula evaluated for every pair (the arc's only
         where the polyline has arcs), the right one picked by np.where.  full=False: xi and g
@@ -221,6 +242,8 @@ class Polyline(RigidSurface):
         g = dx * -tz + dz * tr  # (x - a) . nor, nor = (-t_z, t_r)
         if self._any_arc:
             arc = self.is_arc[k]
+            if subset and len(k) > ARC_SUBSET:
+                return self._project_subset(k, x, full, arc, xi, g, P)
             dr, dh = xr - cr, xz - cz
             rho = np.maximum(np.sqrt(dr * dr + dh * dh), 1e-300)
             phi = np.arctan2(dh, dr)
@@ -256,6 +279,21 @@ class Polyline(RigidSurface):
             kappa, m = np.zeros(len(k)), np.ones(len(k))
         return xi, g, n, t, kappa, m, point
 
+    def _project_subset(self, k, x, full, arc, xi, g, P):
+        """`_project` for many pairs: the arc formulas on the arcs' pairs only (the same
+        numbers: every formula works element by element)."""
+        ia = np.flatnonzero(arc)
+        sub = self._project(k[ia], x[ia], full, subset=False)
+        xi[ia], g[ia] = sub[0], sub[1]
+        if not full:
+            return xi, g
+        xic = np.clip(xi, 0.0, 1.0)
+        t, n = P[:, 2:4].copy(), P[:, 11:13].copy()
+        point = P[:, 0:2] + (xic * P[:, 4])[:, None] * t
+        kappa, m = np.zeros(len(k)), np.ones(len(k))
+        n[ia], t[ia], kappa[ia], m[ia], point[ia] = sub[2:]
+        return xi, g, n, t, kappa, m, point
+
     def _candidates(self, x: np.ndarray, widen: float, method: str):
         """The (node, piece) pairs of the global search, sorted by node then piece.  For a
         few pairs in all (N M <= DENSE_PAIRS) every node is tested against every widened
@@ -287,7 +325,7 @@ class Polyline(RigidSurface):
             raise KeyError(method)
         nn = len(x)
         dxp = x - x_prev
-        moved = float(np.sqrt((dxp * dxp).sum(axis=1)).max()) if nn else 0.0
+        moved = float(np.sqrt(dxp[:, 0] * dxp[:, 0] + dxp[:, 1] * dxp[:, 1]).max()) if nn else 0.0
         widen = depth + moved
         i, k = self._candidates(x, widen, method)
         out = Projection.empty(nn)
@@ -312,12 +350,17 @@ class Polyline(RigidSurface):
         # rank the pairs of each node: crossings first (earliest), then in-range (largest gap)
         score = np.where(crossed, 2.0 + (1.0 - np.minimum(tau, 1.0)), np.where(inrange, 1.0, -np.inf))
         gap_rank = np.where(crossed | ~inrange, 0.0, g)
-        order = np.lexsort((gap_rank, score, i))  # ascending: the best pair of a node is its last
-        io = i[order]
-        last = np.empty(len(io), bool)
-        np.not_equal(io[1:], io[:-1], out=last[:-1])
-        last[-1] = True
-        best = order[last]
+        # per node the largest score, then among those the largest gap_rank, then the last such
+        # pair: the last pair of each node in a stable sort by (node, score, gap_rank)
+        if len(i) <= ARC_SUBSET:
+            order = np.lexsort((gap_rank, score, i))
+            io = i[order]
+            last = np.empty(len(io), bool)
+            np.not_equal(io[1:], io[:-1], out=last[:-1])
+            last[-1] = True
+            best = order[last]
+        else:  # the same without the sort (the pairs come sorted by node): maxima per node
+            best = _best_per_node(i, score, gap_rank)
         best = best[np.isfinite(score[best])]
         bi, bk = i[best], k[best]
         out.active[bi] = True
