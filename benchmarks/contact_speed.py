@@ -94,15 +94,22 @@ for faceted in (False, True):
         rng = np.random.default_rng(n)
         x, x_prev, depth = nodes(surf, n, rng)
         p = surf.local(x, x_prev, depth)
-        calls = max(1, int(2e4 // n))
-        times = []
+        calls = max(3, int(2e4 // n))
+        # three different last converged positions in turn: every call a new step
+        steps = [x_prev + rng.normal(0, 1e-3 * depth, x.shape) for _ in range(3)]
+        times, times_new = [], []
         for _ in range(repeat):
             t = time.perf_counter()
             for _ in range(calls):
                 surf.local(x, x_prev, depth)
             times.append((time.perf_counter() - t) / calls)
+            t = time.perf_counter()
+            for c in range(calls):
+                surf.local(x, steps[c % 3], depth)
+            times_new.append((time.perf_counter() - t) / calls)
         key = f"{len(surf.a)}/{n}"
         res[key] = {"median": float(np.median(times)), "min": float(np.min(times)),
+                    "median_new": float(np.median(times_new)), "min_new": float(np.min(times_new)),
                     "active": int(p.active.sum()), "pieces": len(surf.a)}
         for f in ("active", "g", "n", "t", "s", "kappa", "m", "point", "s_prev", "kind"):
             saved[f"{key}:{f}"] = getattr(p, f)
@@ -163,14 +170,19 @@ def section_scaling(trees: dict[str, Path], repeat: int, tmp: Path) -> str:
     for key in runs[names[0]][0]:
         diff = max(float(np.max(np.abs(a[f"{key}:{f}"].astype(float) - b[f"{key}:{f}"].astype(float)), initial=0.0))
                    for f in ("active", "g", "n", "t", "s", "kappa", "m", "point", "s_prev", "kind"))
-        med = [statistics.median(run[key]["median"] for run in runs[n]) for n in names]
-        mins = [min(run[key]["min"] for run in runs[n]) for n in names]
+        row = []
+        for suffix in ("", "_new"):
+            med = [statistics.median(run[key]["median" + suffix] for run in runs[n]) for n in names]
+            mins = [min(run[key]["min" + suffix] for run in runs[n]) for n in names]
+            row += [f"{fmt(mins[0])} / {fmt(med[0])}", f"{fmt(mins[1])} / {fmt(med[1])}", f"{med[0] / med[1]:.1f}"]
         info = runs[names[0]][0][key]
-        rows.append([info["pieces"], key.split("/")[1], info["active"], f"{fmt(mins[0])} / {fmt(med[0])}",
-                     f"{fmt(mins[1])} / {fmt(med[1])}", f"{med[0] / med[1]:.1f}", f"{diff:.1e}"])
+        rows.append([info["pieces"], key.split("/")[1], info["active"], *row, f"{diff:.1e}"])
     return ("### `Polyline.local` against the number of slave nodes\n\n"
-            f"Per call, min / median over {repeat} child processes per tree in turn (3 timings each).\n\n"
-            + table(["pieces", "N", "in contact", f"{names[0]}", f"{names[1]}", "speed-up", "max |diff|"], rows))
+            f"Per call, min / median over {repeat} child processes per tree in turn (3 timings each).  "
+            "*iteration*: the same last converged positions at every call (the iterations of a "
+            "step); *new step*: different ones at every call.\n\n"
+            + table(["pieces", "N", "in contact", f"iteration {names[0]}", f"iteration {names[1]}", "speed-up",
+                     f"new step {names[0]}", f"new step {names[1]}", "speed-up", "max |diff|"], rows))
 
 
 def section_process(trees: dict[str, Path], repeat: int, tmp: Path) -> str:

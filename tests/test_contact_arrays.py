@@ -156,3 +156,44 @@ def test_best_per_node_is_the_last_of_a_stable_sort():
     order = np.lexsort((rank, score, i))
     expected = order[np.r_[i[order][1:] != i[order][:-1], True]]
     assert np.array_equal(surfaces._best_per_node(i, score, rank), expected)
+
+
+@pytest.mark.parametrize("method", ["buckets", "binary", "brute"])
+def test_pair_cache_returns_what_a_new_search_returns(method):
+    """Iterations of a step (x near the same x_prev, small and large moves: reuse and new
+    searches), a new step, a second set of nodes (the guards) in between."""
+    from axiform.contact import search
+
+    plain = {"buckets": search.buckets, "binary": search.binary_sort, "brute": search.brute_force}[method]
+    searches = []
+
+    def finder(*args):
+        searches.append(1)
+        return plain(*args)
+
+    rng = np.random.default_rng(11)
+    surf = random_polyline(rng, 7)
+    cache = search.PairCache()
+    for step in range(4):
+        x_prev = near_points(rng, surf, 400, 0.3)
+        mids = near_points(rng, surf, 399, 0.3)
+        for it, size in enumerate([0.0, 0.02, 0.01, 0.3, 0.05, 0.001]):
+            for xp in (x_prev, mids):
+                x = xp + rng.normal(0, size, xp.shape)
+                x[::5] = xp[::5] + size  # some exactly the largest move
+                moved = float(np.linalg.norm(x - xp, axis=1).max())
+                got = cache.pairs(finder, x, xp, surf.lo, surf.hi, 0.05, moved)
+                assert np.array_equal(got, plain(x, surf.lo, surf.hi, 0.05 + moved))
+    assert 16 <= len(searches) < 48  # a new search per step and set of nodes, and after large moves
+
+
+def test_large_problems_reuse_the_search_and_agree(monkeypatch):
+    """Through Polyline.local with the dense test off: calls of a step agree with the
+    per-piece reference, whether the pairs were searched or reused."""
+    monkeypatch.setattr(surfaces, "DENSE_PAIRS", 0)
+    rng = np.random.default_rng(5)
+    surf = random_polyline(rng, 6)
+    x_prev = near_points(rng, surf, 600, 0.2)
+    for size in (0.0, 0.01, 0.02, 0.2, 0.01):
+        x = x_prev + rng.normal(0, size, x_prev.shape)
+        same(surf.local(x, x_prev, 0.05), ref.local(surf, x, x_prev, 0.05))

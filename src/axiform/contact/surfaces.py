@@ -187,6 +187,7 @@ class Polyline(RigidSurface):
                                      np.where(arc, self.R, 1.0), np.where(arc, self.phi0, 0.0),
                                      np.where(arc & (self.sweep > 0), self.sweep, 1.0), self.dir,
                                      -self.tan_a[:, 1], self.tan_a[:, 0]])
+        self._pair_cache = search.PairCache()  # `_candidates`: the pairs of a step reused
         self._cavity = np.zeros(m, bool)
         self._vertex_n = np.zeros((m, 2))
         for k in range(1, m):
@@ -294,17 +295,20 @@ class Polyline(RigidSurface):
         n[ia], t[ia], kappa[ia], m[ia], point[ia] = sub[2:]
         return xi, g, n, t, kappa, m, point
 
-    def _candidates(self, x: np.ndarray, widen: float, method: str):
-        """The (node, piece) pairs of the global search, sorted by node then piece.  For a
-        few pairs in all (N M <= DENSE_PAIRS) every node is tested against every widened
-        box at once: the very pairs every method of `search` returns, without its set-up."""
+    def _candidates(self, x: np.ndarray, x_prev: np.ndarray, depth: float, moved: float, method: str):
+        """The (node, piece) pairs of the global search (boxes widened by depth + moved),
+        sorted by node then piece.  For a few pairs in all (N M <= DENSE_PAIRS) every node
+        is tested against every widened box at once: the very pairs every method of `search`
+        returns, without its set-up.  Else the search, its pairs of x_prev reused while the
+        nodes stay near x_prev (`search.PairCache`: the same pairs)."""
         if len(x) * len(self.a) <= DENSE_PAIRS:
+            widen = depth + moved
             lo, hi = self.lo - widen, self.hi + widen
             xr, xz = x[:, 0, None], x[:, 1, None]
             inside = (xr >= lo[:, 0]) & (xr <= hi[:, 0]) & (xz >= lo[:, 1]) & (xz <= hi[:, 1])
             return np.nonzero(inside)
         finder = {"buckets": search.buckets, "binary": search.binary_sort, "brute": search.brute_force}[method]
-        pairs = finder(x, self.lo, self.hi, widen)
+        pairs = self._pair_cache.pairs(finder, x, x_prev, self.lo, self.hi, depth, moved)
         return pairs[:, 0], pairs[:, 1]
 
     def local(self, x: np.ndarray, x_prev: np.ndarray, depth: float, method: str = "buckets") -> Projection:
@@ -326,8 +330,7 @@ class Polyline(RigidSurface):
         nn = len(x)
         dxp = x - x_prev
         moved = float(np.sqrt(dxp[:, 0] * dxp[:, 0] + dxp[:, 1] * dxp[:, 1]).max()) if nn else 0.0
-        widen = depth + moved
-        i, k = self._candidates(x, widen, method)
+        i, k = self._candidates(x, x_prev, depth, moved, method)
         out = Projection.empty(nn)
         if len(i) == 0:
             return out
