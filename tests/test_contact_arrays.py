@@ -9,7 +9,7 @@ import pytest
 import contact_reference as ref
 from axiform.contact import surfaces
 from axiform.contact.surfaces import Polyline
-from axiform.fem.elements import gauss_1d, gauss_quad
+from axiform.fem.elements import edge_rule, edge_shape, gauss_1d, gauss_quad
 
 FIELDS = ("active", "g", "n", "t", "s", "kappa", "m", "point", "s_prev", "kind")
 
@@ -197,3 +197,11 @@ def test_large_problems_reuse_the_search_and_agree(monkeypatch):
     for size in (0.0, 0.01, 0.02, 0.2, 0.01):
         x = x_prev + rng.normal(0, size, x_prev.shape)
         same(surf.local(x, x_prev, 0.05), ref.local(surf, x, x_prev, 0.05))
+
+
+@pytest.mark.parametrize("k", [2, 3])
+def test_edge_rule_is_the_gauss_rule_with_the_edge_shapes(k):
+    s, w, N, dN = edge_rule(k, 3)
+    assert s is gauss_1d(3)[0] and w is gauss_1d(3)[1] and edge_rule(k, 3)[2] is N
+    N2, dN2 = edge_shape(k, s)
+    assert np.array_equal(N, N2) and np.array_equal(dN, dN2) and not dN.flags.writeable

@@ -177,6 +177,15 @@ def edge_shape(n: int, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return N, dN
 
 
+@functools.lru_cache(maxsize=None)
+def edge_rule(edge_nodes: int, npoints: int = 3) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The npoints Gauss rule on an edge of edge_nodes nodes with its shape functions there:
+    points s (p,), weights w (p,), N (p, k) and dN/ds (p, k), exactly
+    `gauss_1d(npoints)` and `edge_shape(edge_nodes, s)`; built once, shared and read-only."""
+    s, w = gauss_1d(npoints)
+    return (s, w, *_frozen(*edge_shape(int(edge_nodes), s)))
+
+
 def edge_interpolation(kind: ElementKind, X: np.ndarray, npoints: int = 3):
     """Displacement interpolation along edges, as the element itself interpolates it.
 
