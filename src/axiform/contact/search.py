@@ -135,10 +135,11 @@ class PairCache:
     step searches x_prev with W = 2 (w + moved); later calls whose w + moved fits in W only
     filter; one that does not searches again with a wider W.  Entries are keyed on the
     search method, the boxes and x_prev (compared element by element), the last `size`
-    kept (a pair of the solver searches for its nodes and for its guards' mid-points).
+    kept (a pair searches for its nodes and for its guards' mid-points; two pairs may share
+    a surface).
     Every answer is that of `finder(x, a, b, w)`: a cache, no state."""
 
-    def __init__(self, size: int = 2):
+    def __init__(self, size: int = 4):
         self.size = size
         self.entries: list[tuple] = []
 
