@@ -56,7 +56,7 @@ from scipy.spatial import cKDTree
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from _common import RESULTS, machine, table  # noqa: E402
+from _perf_common import RESULTS, machine, table  # noqa: E402
 
 from axiform.contact import search  # noqa: E402
 

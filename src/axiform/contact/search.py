@@ -17,8 +17,8 @@ def _boxes(a: np.ndarray, b: np.ndarray, widen: float):
 
 
 def _inside(x: np.ndarray, nodes: np.ndarray, segs: np.ndarray, lo, hi) -> np.ndarray:
-    p = x[nodes]
-    return ((p >= lo[segs]) & (p <= hi[segs])).all(axis=1)
+    p, lo, hi = x[nodes], lo[segs], hi[segs]
+    return (p[:, 0] >= lo[:, 0]) & (p[:, 0] <= hi[:, 0]) & (p[:, 1] >= lo[:, 1]) & (p[:, 1] <= hi[:, 1])
 
 
 def _sorted_pairs(nodes: np.ndarray, segs: np.ndarray) -> np.ndarray:
@@ -122,3 +122,45 @@ def binary_sort(x: np.ndarray, a: np.ndarray, b: np.ndarray, widen: float) -> np
     nodes = np.where(use_x[seg], by_x[np.minimum(pos, len(x) - 1)], by_y[np.minimum(pos, len(x) - 1)])
     keep = _inside(x, nodes, seg, lo, hi)
     return _sorted_pairs(nodes[keep], seg[keep])
+
+
+class PairCache:
+    """The pairs of a search reused within a step, the same pairs a new search would return.
+
+    The solver passes the same last converged positions x_prev at every iteration of a step,
+    and the nodes x stay near them.  A node whose x lies in a box widened by w = depth + moved
+    (moved >= |x - x_prev| for every node) has its x_prev in the box widened by w + moved.  So
+    the pairs of x_prev for a margin W >= w + moved hold every pair of x, and the exact box
+    test of x on those pairs gives exactly the pairs of a new search.  The first call of a
+    step searches x_prev with W = 2 (w + moved); later calls whose w + moved fits in W only
+    filter; one that does not searches again with a wider W.  Entries are keyed on the
+    search method, the boxes and x_prev (compared element by element), the last `size`
+    kept (a pair searches for its nodes and for its guards' mid-points; two pairs may share
+    a surface).
+    Every answer is that of `finder(x, a, b, w)`: a cache, no state."""
+
+    def __init__(self, size: int = 4):
+        self.size = size
+        self.entries: list[tuple] = []
+
+    def pairs(self, finder, x: np.ndarray, x_prev: np.ndarray, a: np.ndarray, b: np.ndarray, depth: float,
+              moved: float) -> np.ndarray:
+        w = depth + moved
+        need = w + moved
+        # slack for the rounding of lo - w and of the coordinates (relative 1e-9 of the sizes)
+        scale = max(float(np.abs(a).max(initial=0.0)), float(np.abs(b).max(initial=0.0)),
+                    float(np.abs(x_prev).max(initial=0.0)), float(np.abs(x).max(initial=0.0)))
+        need_safe = need * (1.0 + 1e-9) + 1e-9 * scale
+        for n, (f, ka, kb, kx, W, cached) in enumerate(self.entries):
+            if (f is finder and W >= need_safe and kx.shape == x_prev.shape and np.array_equal(kx, x_prev)
+                    and np.array_equal(ka, a) and np.array_equal(kb, b)):
+                self.entries.insert(0, self.entries.pop(n))
+                lo, hi = _boxes(a, b, w)
+                return cached[_inside(x, cached[:, 0], cached[:, 1], lo, hi)]
+        W = 2.0 * need_safe
+        cached = finder(x_prev, a, b, W)
+        self.entries = [(finder, a.copy(), b.copy(), np.array(x_prev, float), W, cached)] + [
+            e for e in self.entries if not (e[0] is finder and e[3].shape == x_prev.shape
+                                            and np.array_equal(e[3], x_prev))][: self.size - 1]
+        lo, hi = _boxes(a, b, w)
+        return cached[_inside(x, cached[:, 0], cached[:, 1], lo, hi)]

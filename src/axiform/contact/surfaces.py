@@ -18,6 +18,13 @@ import numpy as np
 from ..fem.curves import PROPORTIONAL, Curve
 from . import search
 
+# `Polyline.local` tests every node against every piece's box at once up to this many pairs
+# (N M); beyond, the global search of `search` finds the candidates
+DENSE_PAIRS = 1 << 16
+# `Polyline._project` evaluates the arc formulas on every pair up to this many pairs (fewer
+# array operations), beyond on the arcs' pairs only (less arithmetic)
+ARC_SUBSET = 4096
+
 
 @dataclass
 class Projection:
@@ -40,6 +47,24 @@ class Projection:
         z = np.zeros(n)
         return cls(np.zeros(n, bool), z.copy(), np.zeros((n, 2)), np.zeros((n, 2)), z.copy(), z.copy(),
                    np.ones(n), np.zeros((n, 2)), z.copy(), np.zeros(n, np.int8))
+
+
+def _best_per_node(i: np.ndarray, score: np.ndarray, rank: np.ndarray) -> np.ndarray:
+    """For pairs sorted by node i: the index of the last pair of each node among those with
+    the node's largest score and, among them, its largest rank."""
+    new = np.empty(len(i), bool)
+    new[0] = True
+    np.not_equal(i[1:], i[:-1], out=new[1:])
+    start = np.flatnonzero(new)
+    group = np.cumsum(new) - 1
+    top = score == np.maximum.reduceat(score, start)[group]
+    rank = np.where(top, rank, -np.inf)
+    pick = np.flatnonzero(top & (rank == np.maximum.reduceat(rank, start)[group]))
+    gp = group[pick]
+    last = np.empty(len(pick), bool)
+    np.not_equal(gp[1:], gp[:-1], out=last[:-1])
+    last[-1] = True
+    return pick[last]
 
 
 @dataclass
@@ -153,6 +178,24 @@ class Polyline(RigidSurface):
         for k in np.flatnonzero(self.is_arc):
             pts = self._arc_points(k, 33)
             self.lo[k], self.hi[k] = pts.min(axis=0), pts.max(axis=0)
+        # the pieces as arrays for `_project` (a straight piece: center 0, radius 1, phi0 0,
+        # sweep 1, unused), and each vertex k (between pieces k - 1 and k) for cavity corners:
+        # whether the mould turns towards the body there, and the mean normal
+        arc = self.is_arc
+        self._any_arc = bool(arc.any())
+        self._par = np.column_stack([self.a, self.tan_a, self.L, np.where(arc[:, None], self.c, 0.0),
+                                     np.where(arc, self.R, 1.0), np.where(arc, self.phi0, 0.0),
+                                     np.where(arc & (self.sweep > 0), self.sweep, 1.0), self.dir,
+                                     -self.tan_a[:, 1], self.tan_a[:, 0]])
+        self._pair_cache = search.PairCache()  # `_candidates`: the pairs of a step reused
+        self._cavity = np.zeros(m, bool)
+        self._vertex_n = np.zeros((m, 2))
+        for k in range(1, m):
+            t1, t2 = self.tan_b[k - 1], self.tan_a[k]
+            self._cavity[k] = t1[0] * t2[1] - t1[1] * t2[0] > 0
+            nv = np.array([-t1[1], t1[0]]) + np.array([-t2[1], t2[0]])
+            norm = np.linalg.norm(nv)
+            self._vertex_n[k] = nv / norm if norm > 0 else nv
 
     @classmethod
     def from_profile(cls, profile, motion=(0.0, 0.0)) -> Polyline:
@@ -184,39 +227,89 @@ class Polyline(RigidSurface):
     def _piece_local(self, k: np.ndarray, x: np.ndarray):
         """For pairs (piece k, point x): xi (fraction along the piece, < 0 before its start,
         > 1 beyond its end), gap g, normal n, tangent t, curvature kappa, m, point."""
-        arc = self.is_arc[k]
-        a, tan = self.a[k], self.tan_a[k]
-        nor = np.column_stack([-tan[:, 1], tan[:, 0]])
-        xi = np.einsum("ij,ij->i", x - a, tan) / self.L[k]
-        g = np.einsum("ij,ij->i", x - a, nor)
-        t, n = tan.copy(), nor
-        kappa = np.zeros(len(k))
-        m = np.ones(len(k))
-        if arc.any():
-            ka, xa = k[arc], x[arc]
-            d = xa - self.c[ka]
-            rho = np.maximum(np.linalg.norm(d, axis=1), 1e-300)
-            phi = np.arctan2(d[:, 1], d[:, 0])
-            sweep, sgn = self.sweep[ka], self.dir[ka]
-            alpha = ((phi - self.phi0[ka]) * sgn) % (2 * np.pi)
+        xi, g, n, t, kappa, m, point = self._project(k, x, True)
+        return xi, g, n, t, kappa, m, point
+
+    def _project(self, k: np.ndarray, x: np.ndarray, full: bool = True, subset: bool = True):
+        """`_piece_local` on arrays, every pair at once: the pieces' data gathered by k and
+        both the straight and the circular formula evaluated for every pair (the arc's only
+        where the polyline has arcs), the right one picked by np.where.  full=False: xi and g
+        only (the last converged positions need no more)."""
+        P = self._par[k]  # (p, 13): one gather of every piece's constants
+        ar, az, tr, tz, L, cr, cz, R, phi0, sweep, sgn = P.T[:11]
+        xr, xz = x[:, 0], x[:, 1]
+        dx, dz = xr - ar, xz - az
+        xi = (dx * tr + dz * tz) / L
+        g = dx * -tz + dz * tr  # (x - a) . nor, nor = (-t_z, t_r)
+        if self._any_arc:
+            arc = self.is_arc[k]
+            if subset and len(k) > ARC_SUBSET:
+                return self._project_subset(k, x, full, arc, xi, g, P)
+            dr, dh = xr - cr, xz - cz
+            rho = np.maximum(np.sqrt(dr * dr + dh * dh), 1e-300)
+            phi = np.arctan2(dh, dr)
+            alpha = ((phi - phi0) * sgn) % (2 * np.pi)
             after = alpha - sweep
             before = 2 * np.pi - alpha
-            xa_frac = np.where(alpha <= sweep, alpha / np.where(sweep > 0, sweep, 1.0),
-                               np.where(after < before, 1.0 + after / sweep, -before / sweep))
-            ta = sgn[:, None] * np.column_stack([-np.sin(phi), np.cos(phi)])
-            na = np.column_stack([-ta[:, 1], ta[:, 0]])
-            xi[arc] = xa_frac
-            g[arc] = np.einsum("ij,ij->i", d - self.R[ka, None] * d / rho[:, None], na)
-            t[arc], n[arc] = ta, na
-            kappa[arc] = -sgn / rho  # ccw: the body inside the arc
-            m[arc] = self.R[ka] / rho
+            frac = np.where(alpha <= sweep, alpha / sweep, np.where(after < before, 1.0 + after / sweep, -before / sweep))
+            cos, sin = np.cos(phi), np.sin(phi)
+            nar, naz = -(sgn * cos), sgn * -sin  # the arc's normal: its tangent sgn (-sin, cos) turned
+            ga = (dr - R * dr / rho) * nar + (dh - R * dh / rho) * naz
+            xi = np.where(arc, frac, xi)
+            g = np.where(arc, ga, g)
+        if not full:
+            return xi, g
         xic = np.clip(xi, 0.0, 1.0)
-        point = np.where(arc[:, None], np.nan, a + (xic * self.L[k])[:, None] * tan)
-        if arc.any():
-            ka = k[arc]
-            phi = self.phi0[ka] + self.dir[ka] * xic[arc] * self.sweep[ka]
-            point[arc] = self.c[ka] + self.R[ka, None] * np.column_stack([np.cos(phi), np.sin(phi)])
+        t, n = P[:, 2:4], P[:, 11:13]  # the line's tangent and normal
+        point = P[:, 0:2] + (xic * L)[:, None] * t
+        if self._any_arc:
+            isarc = arc[:, None]
+            sc = np.empty((len(k), 2))
+            np.negative(sin, out=sc[:, 0])
+            sc[:, 1] = cos
+            ta = sgn[:, None] * sc  # sgn (-sin, cos)
+            t = np.where(isarc, ta, t)
+            n = np.where(isarc, ta[:, ::-1] * [-1.0, 1.0], n)
+            kappa = np.where(arc, -sgn / rho, 0.0)  # ccw: the body inside the arc
+            m = np.where(arc, R / rho, 1.0)
+            ph = phi0 + sgn * xic * sweep
+            sc[:, 0] = np.cos(ph)
+            sc[:, 1] = np.sin(ph)
+            point = np.where(isarc, P[:, 5:7] + R[:, None] * sc, point)
+        else:
+            kappa, m = np.zeros(len(k)), np.ones(len(k))
         return xi, g, n, t, kappa, m, point
+
+    def _project_subset(self, k, x, full, arc, xi, g, P):
+        """`_project` for many pairs: the arc formulas on the arcs' pairs only (the same
+        numbers: every formula works element by element)."""
+        ia = np.flatnonzero(arc)
+        sub = self._project(k[ia], x[ia], full, subset=False)
+        xi[ia], g[ia] = sub[0], sub[1]
+        if not full:
+            return xi, g
+        xic = np.clip(xi, 0.0, 1.0)
+        t, n = P[:, 2:4].copy(), P[:, 11:13].copy()
+        point = P[:, 0:2] + (xic * P[:, 4])[:, None] * t
+        kappa, m = np.zeros(len(k)), np.ones(len(k))
+        n[ia], t[ia], kappa[ia], m[ia], point[ia] = sub[2:]
+        return xi, g, n, t, kappa, m, point
+
+    def _candidates(self, x: np.ndarray, x_prev: np.ndarray, depth: float, moved: float, method: str):
+        """The (node, piece) pairs of the global search (boxes widened by depth + moved),
+        sorted by node then piece.  For a few pairs in all (N M <= DENSE_PAIRS) every node
+        is tested against every widened box at once: the very pairs every method of `search`
+        returns, without its set-up.  Else the search, its pairs of x_prev reused while the
+        nodes stay near x_prev (`search.PairCache`: the same pairs)."""
+        if len(x) * len(self.a) <= DENSE_PAIRS:
+            widen = depth + moved
+            lo, hi = self.lo - widen, self.hi + widen
+            xr, xz = x[:, 0, None], x[:, 1, None]
+            inside = (xr >= lo[:, 0]) & (xr <= hi[:, 0]) & (xz >= lo[:, 1]) & (xz <= hi[:, 1])
+            return np.nonzero(inside)
+        finder = {"buckets": search.buckets, "binary": search.binary_sort, "brute": search.brute_force}[method]
+        pairs = self._pair_cache.pairs(finder, x, x_prev, self.lo, self.hi, depth, moved)
+        return pairs[:, 0], pairs[:, 1]
 
     def local(self, x: np.ndarray, x_prev: np.ndarray, depth: float, method: str = "buckets") -> Projection:
         """Candidates from the global search (piece boxes widened by the depth and by how far
@@ -229,25 +322,28 @@ class Polyline(RigidSurface):
            away from the body faces two pieces (Figure 8): it leaves by the nearer face;
         3. else a corner where the mould turns towards the body (a cavity corner), the node
            behind both pieces and outside both projection ranges, facing none (Figure 8):
-           the vertex is its contact point, with the mean of the two normals."""
+           the vertex is its contact point, with the mean of the two normals.
+        Every pair of every node is evaluated at once (arrays over the pairs, no loop over
+        pieces or nodes)."""
+        if method not in ("buckets", "binary", "brute"):
+            raise KeyError(method)
         nn = len(x)
-        moved = float(np.linalg.norm(x - x_prev, axis=1).max()) if nn else 0.0
-        widen = depth + moved
-        finder = {"buckets": search.buckets, "binary": search.binary_sort, "brute": search.brute_force}[method]
-        pairs = finder(x, self.lo, self.hi, widen)
+        dxp = x - x_prev
+        moved = float(np.sqrt(dxp[:, 0] * dxp[:, 0] + dxp[:, 1] * dxp[:, 1]).max()) if nn else 0.0
+        i, k = self._candidates(x, x_prev, depth, moved, method)
         out = Projection.empty(nn)
-        if len(pairs) == 0:
+        if len(i) == 0:
             return out
-        i, k = pairs[:, 0], pairs[:, 1]
-        xi, g, n, t, kappa, m, point = self._piece_local(k, x[i])
-        xi0, g0, *_ = self._piece_local(k, x_prev[i])
+        xi, g, n, t, kappa, m, point = self._project(k, x[i])
+        xi0, g0 = self._project(k, x_prev[i], full=False)
         tol = 1e-9
-        with np.errstate(divide="ignore", invalid="ignore"):
-            tau = np.where(g0 - g > 0, g0 / (g0 - g), np.inf)  # where along the path it crosses
+        dg = g0 - g
+        tau = np.divide(g0, dg, out=np.full(len(g), np.inf), where=dg > 0)  # where along the path it crosses
         crossed = (g0 >= 0) & (g < 0) & np.isfinite(tau)
         if crossed.any():
-            xc = x_prev[i[crossed]] + np.minimum(tau[crossed], 1.0)[:, None] * (x[i[crossed]] - x_prev[i[crossed]])
-            xic = self._piece_local(k[crossed], xc)[0]
+            ic = i[crossed]
+            xc = x_prev[ic] + np.minimum(tau[crossed], 1.0)[:, None] * (x[ic] - x_prev[ic])
+            xic = self._project(k[crossed], xc, full=False)[0]
             crossed[crossed] = (xic >= -tol) & (xic <= 1 + tol)
         # in front of the piece or less than depth behind it; or behind it now and near it at the
         # last converged step (it went deeper during the increment: a Newton iterate may overshoot
@@ -257,9 +353,17 @@ class Polyline(RigidSurface):
         # rank the pairs of each node: crossings first (earliest), then in-range (largest gap)
         score = np.where(crossed, 2.0 + (1.0 - np.minimum(tau, 1.0)), np.where(inrange, 1.0, -np.inf))
         gap_rank = np.where(crossed | ~inrange, 0.0, g)
-        order = np.lexsort((gap_rank, score, i))  # ascending: the best pair of a node is its last
-        last = np.r_[i[order][1:] != i[order][:-1], True]
-        best = order[last]
+        # per node the largest score, then among those the largest gap_rank, then the last such
+        # pair: the last pair of each node in a stable sort by (node, score, gap_rank)
+        if len(i) <= ARC_SUBSET:
+            order = np.lexsort((gap_rank, score, i))
+            io = i[order]
+            last = np.empty(len(io), bool)
+            np.not_equal(io[1:], io[:-1], out=last[:-1])
+            last[-1] = True
+            best = order[last]
+        else:  # the same without the sort (the pairs come sorted by node): maxima per node
+            best = _best_per_node(i, score, gap_rank)
         best = best[np.isfinite(score[best])]
         bi, bk = i[best], k[best]
         out.active[bi] = True
@@ -269,25 +373,28 @@ class Polyline(RigidSurface):
         out.s_prev[bi] = self.s0[bk] + np.clip(xi0[best], 0.0, 1.0) * self.L[bk]
         out.kind[bi] = np.where(crossed[best], 3, 1)
         # cavity corners: a node behind piece k beyond its end and behind k+1 before its start
-        free = ~out.active
-        if free.any() and len(self.a) > 1:
-            beyond = (xi > 1 + tol) & (g < 0) & (g > -depth) & free[i]
-            before = (xi < -tol) & (g < 0) & (g > -depth) & free[i]
-            key_end = set(zip(i[beyond].tolist(), k[beyond].tolist()))
-            for node, seg in zip(i[before].tolist(), k[before].tolist()):
-                if seg >= 1 and (node, seg - 1) in key_end and not out.active[node]:
-                    prev = seg - 1
-                    t1, t2 = self.tan_b[prev], self.tan_a[seg]
-                    if t1[0] * t2[1] - t1[1] * t2[0] <= 0:  # the mould turns away from the body
-                        continue
-                    v = self.b[prev]
-                    nv = np.array([-t1[1], t1[0]]) + np.array([-t2[1], t2[0]])
-                    nv /= np.linalg.norm(nv)
-                    out.active[node] = True
-                    out.n[node] = nv
-                    out.t[node] = [nv[1], -nv[0]]
-                    out.g[node] = float(np.dot(x[node] - v, nv))
-                    out.s[node] = out.s_prev[node] = self.s0[seg]
-                    out.point[node] = v
-                    out.kind[node] = 2
+        if len(self.a) > 1 and len(bi) < nn:
+            free = ~out.active[i]
+            behind = (g < 0) & (g > -depth) & free
+            beyond = behind & (xi > 1 + tol)
+            before = behind & (xi < -tol) & (k >= 1)
+            if beyond.any() and before.any():
+                M = len(self.a)
+                nb, sb = i[before], k[before]
+                # the previous piece's pair is a candidate beyond its end, and the mould turns
+                # towards the body at the vertex (pairs sorted by node: the first such per node)
+                hit = np.isin(nb * M + sb - 1, i[beyond] * M + k[beyond]) & self._cavity[sb]
+                nb, sb = nb[hit], sb[hit]
+                if len(nb):
+                    nb, first = np.unique(nb, return_index=True)
+                    sb = sb[first]
+                    v, nv = self.b[sb - 1], self._vertex_n[sb]
+                    out.active[nb] = True
+                    out.n[nb] = nv
+                    out.t[nb] = np.column_stack([nv[:, 1], -nv[:, 0]])
+                    # np.dot node by node, as ever (BLAS may round a dot product otherwise): few nodes
+                    out.g[nb] = [float(np.dot(d, e)) for d, e in zip(x[nb] - v, nv)]
+                    out.s[nb] = out.s_prev[nb] = self.s0[sb]
+                    out.point[nb] = v
+                    out.kind[nb] = 2
         return out

@@ -8,6 +8,7 @@ then f_e = sum_q G_q^T P_q dV_q and K_e = sum_q G_q^T A_q G_q dV_q (eqs. 17-30 i
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,16 +18,27 @@ QUAD_EDGES = np.array([[0, 1], [1, 2], [2, 3], [3, 0]])
 Q8_EDGE_MIDS = np.array([4, 5, 6, 7])
 
 
+def _frozen(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
+    for a in arrays:
+        a.flags.writeable = False
+    return arrays
+
+
+@functools.lru_cache(maxsize=None)
 def gauss_1d(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss-Legendre points and weights on [-1, 1]."""
-    return np.polynomial.legendre.leggauss(n)
+    """Gauss-Legendre points and weights on [-1, 1].  Built once per n (numpy's leggauss
+    costs ~0.4 ms, and contact asks for the rule at every evaluation): the arrays are shared
+    and read-only; copy them to change them."""
+    return _frozen(*np.polynomial.legendre.leggauss(int(n)))
 
 
+@functools.lru_cache(maxsize=None)
 def gauss_quad(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """n x n Gauss rule on the square [-1, 1]^2: points (n*n, 2) and weights (n*n,)."""
+    """n x n Gauss rule on the square [-1, 1]^2: points (n*n, 2) and weights (n*n,).  Built
+    once per n, shared and read-only, as `gauss_1d`."""
     x, w = gauss_1d(n)
     xi, eta = np.meshgrid(x, x, indexing="xy")
-    return np.column_stack([xi.ravel(), eta.ravel()]), np.outer(w, w).ravel()
+    return _frozen(np.column_stack([xi.ravel(), eta.ravel()]), np.outer(w, w).ravel())
 
 
 def q4_shape(xi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -163,6 +175,15 @@ def edge_shape(n: int, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         N = np.column_stack([s * (s - 1) / 2, s * (s + 1) / 2, 1 - s**2])
         dN = np.column_stack([s - 0.5, s + 0.5, -2 * s])
     return N, dN
+
+
+@functools.lru_cache(maxsize=None)
+def edge_rule(edge_nodes: int, npoints: int = 3) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The npoints Gauss rule on an edge of edge_nodes nodes with its shape functions there:
+    points s (p,), weights w (p,), N (p, k) and dN/ds (p, k), exactly
+    `gauss_1d(npoints)` and `edge_shape(edge_nodes, s)`; built once, shared and read-only."""
+    s, w = gauss_1d(npoints)
+    return (s, w, *_frozen(*edge_shape(int(edge_nodes), s)))
 
 
 def edge_interpolation(kind: ElementKind, X: np.ndarray, npoints: int = 3):
