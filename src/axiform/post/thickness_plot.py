@@ -31,17 +31,37 @@ def _read_thickness(path: Path) -> tuple[dict[str, np.ndarray], int]:
     return table, step
 
 
-def z_runs(z: np.ndarray) -> list[slice]:
-    """The stretches of the wall along which the current z goes one way (a wall that turns back,
-    a flat bottom at one z, makes several): thickness against z is drawn one line each, so that
-    it does not loop back over itself."""
-    dz = np.sign(np.diff(z))
-    cuts = [0]
-    for k in range(1, len(dz)):
-        if dz[k] != 0 and dz[k] != dz[k - 1]:
-            cuts.append(k)
-    cuts.append(len(z) - 1)
-    return [slice(a, b + 1) for a, b in zip(cuts[:-1], cuts[1:])] if len(z) > 1 else [slice(0, len(z))]
+def z_runs(z: np.ndarray, tolerance: float = 0.03) -> list[slice]:
+    """The stretches of the wall along which the current z goes one way, cut where z turns back
+    by more than `tolerance` of its range (a wall wrapped round a tool, a bottle's shoulder
+    and base): thickness against z is drawn one line each, so that it does not loop back over
+    itself.  Consecutive stretches share their turning point."""
+    n = len(z)
+    tol = tolerance * float(np.ptp(z)) if n else 0.0
+    cuts, direction, extreme = [0], 0.0, 0
+    for k in range(1, n):
+        if direction == 0.0:
+            if abs(z[k] - z[0]) > tol:
+                direction, extreme = float(np.sign(z[k] - z[0])), k
+        elif (z[k] - z[extreme]) * direction >= 0:
+            extreme = k
+        elif (z[extreme] - z[k]) * direction > tol:
+            cuts.append(extreme)
+            direction, extreme = -direction, k
+    cuts.append(max(n - 1, 0))
+    return [slice(a, b + 1) for a, b in zip(cuts[:-1], cuts[1:])]
+
+
+def _against_z(ax, t: dict[str, np.ndarray], length: str | None) -> None:
+    """Thickness against z, a line per stretch where z goes one way (z_runs); several get a
+    colour each and a legend of the reference arc length they span."""
+    runs = z_runs(t["z"])
+    for k, run in enumerate(runs):
+        s = t["s"][run]
+        label = f"s {short(s[0])} to {short(s[-1])}" + (f" {length}" if length else "") if len(runs) > 1 else None
+        ax.plot(t["z"][run], t["thickness"][run], "o-", ms=2.5, color="C0" if k == 0 else f"C{k + 3}", label=label)
+    if len(runs) > 1:
+        ax.legend(fontsize=8, title="wall turning back in z", title_fontsize=8)
 
 
 def thickness_figure(thickness: Path, info: FolderInfo, history: dict[str, np.ndarray] | None = None):
@@ -68,8 +88,7 @@ def thickness_figure(thickness: Path, info: FolderInfo, history: dict[str, np.nd
         a_s.text(0.02, 0.04, f"initial thickness {span}" + (f" {length}" if length else ""),
                  transform=a_s.transAxes, fontsize=8)
     a_s.legend(fontsize=8)
-    for run in z_runs(t["z"]):  # one line per stretch along which z goes one way
-        a_z.plot(t["z"][run], t["thickness"][run], "o-", ms=2.5, color="C0")
+    _against_z(a_z, t, length)
     a_ratio.plot(t["s"], t["ratio"], "o-", ms=2.5, color="C2")
     one = t["ratio"].max() >= 0.33
     if one:
@@ -119,7 +138,8 @@ def _first_contact(ax, t: dict[str, np.ndarray], info: FolderInfo, arc: str, xli
     else:
         ax.plot(t["s"], t["first_contact"], "o", ms=3, color="C3")
     ax.set_xlabel(arc)
-    ax.set_ylabel(with_unit("time of first contact t", "time", info.units))
+    timed = info.process or bool(info.units.get("time"))  # else t is the load factor
+    ax.set_ylabel(with_unit("time of first contact t", "time", info.units) if timed else "load factor λ at first contact")
     ax.set_xlim(xlim)
     ax.grid(True, alpha=0.3)
 
