@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from .figures import new_figure, save
+from .figures import new_figure, save, wrapped
 
 if TYPE_CHECKING:
     from ..app.sweep import Sweep
@@ -81,7 +81,8 @@ def plot_sweep(path: Path, sweep: Sweep, rows: list[dict | None]) -> bool:
     finished = sum(1 for r in rows if r and r.get("status") == "finished")
     ax.set_xlabel(first)
     ax.set_ylabel(sweep.report)
-    ax.set_title(f"{sweep.report} against {first}: {finished} of {len(rows)} cases finished", fontsize=10)
+    ax.set_title(wrapped(f"{sweep.report} against {first}: {finished} of {len(rows)} cases finished", 6.0, 10),
+                 fontsize=10)
     ax.grid(True, alpha=0.3)
     if others and groups:
         ax.legend(fontsize=8)
