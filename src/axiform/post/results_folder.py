@@ -61,9 +61,10 @@ class FolderInfo:
         return self.contacts[k] if k < len(self.contacts) else f"contact[{k}]"
 
     def load_label(self) -> str:
-        """The load axis: the loaded quantity with its unit, or the load factor."""
+        """The load axis: the loaded quantity with its unit, else the time t (a case with a time
+        unit) or the load factor."""
         if self.load is None:
-            return "load factor λ"
+            return self.time_label()
         return with_unit(self.load.get("name", self.load["quantity"]), self.load["quantity"], self.units)
 
     def load_of(self, history: dict[str, np.ndarray]) -> np.ndarray:
