@@ -173,7 +173,7 @@ def test_thickness_every_and_units_in_summary_and_labels(tmp_path):
     assert x[0] == 0 and y[0] == 0 and np.allclose(y[1:], h["load_factor"]) and np.allclose(x[1:], h["w_center"])
     fig = thickness_figure(out / "thickness.csv", info, h)
     labels = {ax.get_xlabel() for ax in fig.axes} | {ax.get_ylabel() for ax in fig.axes}
-    assert {"current arc length s (in)", "current z (in)", "thickness (in)", "thickness ratio t / t0"} <= labels
+    assert {"reference arc length s (in)", "current z (in)", "thickness (in)", "thickness ratio t / t0"} <= labels
     assert f"step {n}, p = {short(h['load_factor'][-1])} psi" in fig.get_suptitle()
     vtu = written_steps(out)[-1]
     fig = deformed_figure(vtu, info, "von_mises", None, h)

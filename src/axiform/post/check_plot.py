@@ -122,37 +122,67 @@ def _value(v: float, quantity: str, units: dict[str, str]) -> str:
 
 
 def check_figure(built):
-    """The Figure of plot_check (see the module docstring)."""
-    from matplotlib.collections import LineCollection, PolyCollection
+    """The Figure of plot_check (see the module docstring): the drawing's frame, then each
+    part of the set-up by its own function, then the axes and the legend."""
     from matplotlib.figure import Figure
 
     case, model = built.case, built.model
-    mesh = model.mesh
-    X = mesh.points
     units = {k: v for k, v in case.units.model_dump().items() if v}
-    t_end = _end_time(built)
-    moulds = [pair.surface for pair in model.contacts]
-    outlines = [_mould_points(s) + s.offset(0.0) for s in moulds]
-    ends = [(_mould_points(s) + s.offset(t_end)) if np.any(s.offset(t_end) != s.offset(0.0)) else None
-            for s in moulds]
-    travels = [s.offset(t_end) - s.offset(0.0) for s in moulds]
-    lo, hi = _frame(X, [(p, d) for p, d in zip(outlines, travels)]
-                    + [(e, d) for e, d in zip(ends, travels) if e is not None])
+    moulds = _mould_positions(model, _end_time(built))
+    lo, hi = _frame(model.mesh.points, [(p, d) for p, _, d in moulds] + [(e, d) for _, e, d in moulds if e is not None])
     size = float((hi - lo).max())
     w, h = hi - lo
     scale = min(7.0 / w, 6.0 / h)
     fig = Figure(figsize=(max(w * scale, 2.2) + 3.6, max(h * scale, 1.4) + 1.1))
     ax = fig.add_subplot()
+    _draw_mesh(ax, model.mesh, size)
+    _draw_supports(ax, model)
+    _draw_pressures(ax, case, model, size, units)
+    _draw_point_loads(ax, case, model.mesh, size, units)
+    _draw_cavities(ax, case, model)
+    _draw_moulds(ax, model, moulds, size, _end_time(built))
+    _draw_monitors(ax, case, built)
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_aspect("equal")
+    ax.ticklabel_format(useOffset=False)
+    ax.set_xlabel(with_unit("r", "length", units))
+    ax.set_ylabel(with_unit("z", "length", units))
+    fig.suptitle(case.title or "case", fontsize=10, x=0.02, ha="left")
+    fig.set_layout_engine("constrained")
+    fig.legend(loc="outside right lower", fontsize=7, frameon=False)
+    return fig
 
-    # the mesh
+
+def _mould_positions(model, t_end: float) -> list[tuple[np.ndarray, np.ndarray | None, np.ndarray]]:
+    """Each mould's outline at t = 0, at the end of the run where it moves (else None), and its
+    travel over the run."""
+    out = []
+    for pair in model.contacts:
+        s = pair.surface
+        start, end = s.offset(0.0), s.offset(t_end)
+        moved = bool(np.any(end != start))
+        out.append((_mould_points(s) + start, (_mould_points(s) + end) if moved else None, end - start))
+    return out
+
+
+def _draw_mesh(ax, mesh, size: float) -> None:
+    """The undeformed cells (a thin wall's with wide dark edges, so that it shows)."""
+    from matplotlib.collections import PolyCollection
+
+    X = mesh.points
     thin = _is_thin(X, mesh.cells, size)
     ax.add_collection(PolyCollection(X[_outline(mesh)], facecolor="0.85" if thin else "0.93",
                                      edgecolor="0.4" if thin else COLOURS["mesh"], lw=1.2 if thin else 0.3,
                                      label=f"mesh: {mesh.n_cells} {mesh.element.name} cells, {mesh.n_nodes} nodes"))
 
-    # supports: which dofs each node holds; nodes prescribed to a non-zero value apart
-    held = np.zeros((mesh.n_nodes, 3), bool)
-    moved = np.zeros(mesh.n_nodes, bool)
+
+def _draw_supports(ax, model) -> None:
+    """A marker per held node by the dofs it holds; the nodes prescribed to a non-zero value
+    apart."""
+    X = model.mesh.points
+    held = np.zeros((model.mesh.n_nodes, 3), bool)
+    moved = np.zeros(model.mesh.n_nodes, bool)
     for d, v in model.fixed.items():
         node, k = divmod(d, model.dpn)
         held[node, k] = True
@@ -168,7 +198,13 @@ def check_figure(built):
         ax.plot(X[nodes, 0], X[nodes, 1], "D", ls="none", ms=4.5, mfc="none", mec=COLOURS["prescribed"],
                 label="displacement prescribed")
 
-    # pressures: the face, and arrows where they push (into the body for a positive value)
+
+def _draw_pressures(ax, case, model, size: float, units: dict[str, str]) -> None:
+    """Each loaded face, with arrows where its pressure pushes (into the body for a positive
+    value)."""
+    from matplotlib.collections import LineCollection
+
+    X = model.mesh.points
     arrow = ARROW * size
     for i, (spec, p) in enumerate(zip(case.pressure, model.pressures)):
         a, b = X[p.nodes[:, 0]], X[p.nodes[:, 1]]
@@ -183,10 +219,14 @@ def check_figure(built):
                   scale=1.0, color=COLOURS["pressure"], width=0.004, headwidth=4, headlength=5,
                   label=f"pressure[{i}] = {_value(spec.value, 'pressure', units)}{_times(spec.curve)}")
 
-    # point loads
-    for i, spec in enumerate(case.point_load):
-        from ..fem.selectors import select_nodes
 
+def _draw_point_loads(ax, case, mesh, size: float, units: dict[str, str]) -> None:
+    """An arrow at each node of a point load, along its dof and sign."""
+    from ..fem.selectors import select_nodes
+
+    X = mesh.points
+    arrow = ARROW * size
+    for i, spec in enumerate(case.point_load):
         nodes = select_nodes(mesh, spec.at.model_dump(), f"point_load[{i}].at")
         e = np.array([1.0, 0.0]) if spec.dof == "ur" else np.array([0.0, 1.0])
         d = np.sign(spec.value) * e * arrow
@@ -194,13 +234,23 @@ def check_figure(built):
                   angles="xy", scale_units="xy", scale=1.0, color=COLOURS["point"], width=0.005,
                   label=f"point_load[{i}] = {_value(spec.value, 'force', units)}{_times(spec.curve)} along {spec.dof}")
 
-    # gas cavities: their boundary
-    for i, (spec, cav) in enumerate(zip(case.cavity, model.cavities)):
+
+def _draw_cavities(ax, case, model) -> None:
+    """The boundary of each gas cavity."""
+    from matplotlib.collections import LineCollection
+
+    X = model.mesh.points
+    for spec, cav in zip(case.cavity, model.cavities):
         ax.add_collection(LineCollection(_face(X, cav.nodes), colors=COLOURS["cavity"], lw=3.5, alpha=0.8,
                                          label=f'cavity "{spec.name}" ({spec.control} control)'))
 
-    # moulds: outline, normal ticks on the body's side, the end of a moving mould's travel
-    for i, (pair, pts, end) in enumerate(zip(model.contacts, outlines, ends)):
+
+def _draw_moulds(ax, model, moulds, size: float, t_end: float) -> None:
+    """Each mould's outline, normal ticks on its body's side, and where a moving mould ends the
+    run (dotted)."""
+    from matplotlib.collections import LineCollection
+
+    for i, (pair, (pts, end, _)) in enumerate(zip(model.contacts, moulds)):
         colour = MOULD_COLOURS[i % len(MOULD_COLOURS)]
         name = f"contact[{i}]" + (f" {pair.name}" if pair.name else "")
         ax.plot(pts[:, 0], pts[:, 1], "-", color=colour, lw=1.8, label=f"{name}, ticks towards its body")
@@ -210,7 +260,11 @@ def check_figure(built):
         if end is not None:
             ax.plot(end[:, 0], end[:, 1], ":", color=colour, lw=1.2, label=f"{name} at t = {t_end:g}")
 
-    # monitored points (one node) and monitored reactions (their nodes)
+
+def _draw_monitors(ax, case, built) -> None:
+    """The monitored points (one node, named) and the nodes of monitored reactions."""
+    model = built.model
+    X = model.mesh.points
     for m in case.monitor:
         if m.at is None and m.reaction is None:
             continue
@@ -223,17 +277,6 @@ def check_figure(built):
         if m.at is not None:
             ax.annotate(m.name, X[nodes[0]], xytext=(5, 5), textcoords="offset points", fontsize=7,
                         color=COLOURS["monitor"])
-
-    ax.set_xlim(lo[0], hi[0])
-    ax.set_ylim(lo[1], hi[1])
-    ax.set_aspect("equal")
-    ax.ticklabel_format(useOffset=False)
-    ax.set_xlabel(with_unit("r", "length", units))
-    ax.set_ylabel(with_unit("z", "length", units))
-    fig.suptitle(case.title or "case", fontsize=10, x=0.02, ha="left")
-    fig.set_layout_engine("constrained")
-    fig.legend(loc="outside right lower", fontsize=7, frameon=False)
-    return fig
 
 
 def plot_check(built, path: str | Path) -> Path:

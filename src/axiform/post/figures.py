@@ -36,3 +36,25 @@ def save(fig, path: str | Path, dpi: float = DPI, **savefig: Any) -> Path | None
         savefig.setdefault("pil_kwargs", {"compress_level": 1})
     fig.savefig(path, dpi=dpi, **savefig)
     return Path(path)
+
+
+def wrapped(text: str, width_in: float, fontsize: float = 12.0) -> str:
+    """`text` with each line broken at spaces to fit `width_in` inches at `fontsize` points
+    (about 0.55 em a character): a long title over a narrow figure is not cut at its edges."""
+    import textwrap
+
+    chars = max(12, int(width_in * 72.0 / (0.55 * fontsize)) - 2)
+
+    def balanced(line: str) -> str:  # as many lines as needed, of about equal length
+        lines = textwrap.wrap(line, chars)
+        width = -(-len(line) // max(1, len(lines)))
+        while len(textwrap.wrap(line, width)) > len(lines):
+            width += 1
+        return "\n".join(textwrap.wrap(line, width)) or line
+
+    return "\n".join(balanced(line) for line in text.split("\n"))
+
+
+def title(fig, text: str, fontsize: float = 12.0, **kwargs: Any):
+    """fig.suptitle(text), wrapped to the figure's width (see `wrapped`)."""
+    return fig.suptitle(wrapped(text, float(fig.get_size_inches()[0]), fontsize), fontsize=fontsize, **kwargs)

@@ -7,6 +7,12 @@ labels every axis from the folder alone.
 "displacement", "value": v, "name": label, "curve": [[t, f], ...]} (the loaded quantity is
 v f(lambda), f(lambda) = lambda without a curve), or {"quantity": "pressure", "monitor":
 column} when a cavity pressure monitor of history.csv carries it.
+
+`applied` lists every applied quantity of the case the same way (each pressure, point load,
+prescribed displacement, mould motion and cavity target: a cavity under volume control as
+{"quantity": "volume", "cavity": name, "value": V, ...}, its volume V0 + f(t) (V - V0));
+`process` is true for a multi-stage process (a curve with more than two knots, or loads on
+different curves): its load curve panels are drawn against the process time t.
 """
 
 from __future__ import annotations
@@ -21,9 +27,11 @@ QUANTITY_UNIT = {"pressure": "pressure", "stress": "pressure", "force": "force",
 
 def case_labels(case: Any) -> dict[str, Any]:
     """units, load and monitor_quantities of a validated case (axiform.case.schema.Case)."""
+    applied = applied_quantities(case)
     return {"units": {k: v for k, v in case.units.model_dump().items() if v},
             "load": loaded_quantity(case),
-            "monitor_quantities": {m.name: monitor_quantity(m) for m in case.monitor}}
+            "monitor_quantities": {m.name: monitor_quantity(m) for m in case.monitor},
+            "applied": applied, "process": is_process(applied, getattr(case, "cavity", []))}
 
 
 def monitor_quantity(m: Any) -> str:
@@ -74,19 +82,63 @@ def loaded_quantity(case: Any) -> dict[str, Any] | None:
         ur, uz = c.motion.ur, c.motion.uz
         if ur or uz:
             dof = "uz" if abs(uz) >= abs(ur) else "ur"
-            piece = c.name or (c.surface.layer.lower() if c.surface.layer else f"mould {i}")
+            piece = _piece(c, i)
             return _scaled("displacement", uz if dof == "uz" else ur, f"{piece} displacement {dof}", _curve(c.motion))
     return None
 
 
-def load_values(load: dict[str, Any], lam: np.ndarray) -> np.ndarray:
-    """The loaded quantity v f(lambda) at the load factors lam (a value-scaled load)."""
+def _piece(contact: Any, i: int) -> str:
+    layer = getattr(contact.surface, "layer", None)
+    return contact.name or (layer.lower() if layer else f"mould {i}")
+
+
+def applied_quantities(case: Any) -> list[dict[str, Any]]:
+    """Every quantity the case applies, as loaded_quantity says one (the same pressures or
+    point loads on the same curve once): cavities under pressure or volume control, pressures,
+    point loads, prescribed displacements and mould motions (a gas cavity's pressure is its
+    monitor's)."""
+    out: list[dict[str, Any]] = []
+    for c in getattr(case, "cavity", []):
+        if c.control == "pressure" and c.pressure:
+            out.append(_scaled("pressure", c.pressure, f"{c.name} pressure", _curve(c)))
+        elif c.control == "volume":
+            out.append({**_scaled("volume", c.volume, f"{c.name} volume", _curve(c)), "cavity": c.name})
+    for kind, specs in (("pressure", case.pressure), ("force", case.point_load)):
+        seen = []
+        for k, p in enumerate(specs):
+            if p.value and (p.value, _curve(p)) not in seen:
+                seen.append((p.value, _curve(p)))
+                name = kind if len({(q.value, str(_curve(q))) for q in specs}) == 1 else f"{kind}[{k}]"
+                out.append(_scaled(kind, p.value, name, _curve(p)))
+    for i, f in enumerate(case.fix):
+        if f.value:
+            out.append(_scaled("displacement", f.value, f"fix[{i}] {', '.join(f.dofs)}", _curve(f)))
+    for i, c in enumerate(case.contact):
+        for dof in ("ur", "uz"):
+            value = getattr(c.motion, dof)
+            if value:
+                out.append(_scaled("displacement", value, f"{_piece(c, i)} displacement {dof}", _curve(c.motion)))
+    return out
+
+
+def is_process(applied: list[dict[str, Any]], cavities: Any = ()) -> bool:
+    """A multi-stage process: a curve with more than two knots, or loads on different curves
+    (a gas cavity's curve counts too)."""
+    curves = [a.get("curve") for a in applied] + [_curve(c) for c in cavities if c.control == "gas"]
+    return len({str(c) for c in curves}) > 1 or any(len(c or ()) > 2 for c in curves)
+
+
+def load_values(load: dict[str, Any], lam: np.ndarray, start: float = 0.0) -> np.ndarray:
+    """The loaded quantity v f(lambda) at the load factors lam (a value-scaled load); with
+    `start` (a cavity's initial volume V0), start + f(lambda) (v - start)."""
     lam = np.asarray(lam, float)
     curve = load.get("curve")
     if curve is None:
-        return load["value"] * lam
-    t, f = np.asarray(curve, float).T
-    return load["value"] * np.interp(lam, t, f)
+        f = lam
+    else:
+        t, fk = np.asarray(curve, float).T
+        f = np.interp(lam, t, fk)
+    return start + f * (load["value"] - start)
 
 
 def unit_of(quantity: str, units: dict[str, str]) -> str:

@@ -25,15 +25,16 @@ def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResul
     the target (the stations outside the target's range shaded), and the objective and the max
     deviation of each iteration against the forward solves spent."""
     units = design.built.case.units
-    length = f" [{units.length}]" if units.length else ""
+    length = f" ({units.length})" if units.length else ""
     runs = ((design.initial, result.initial, GREY, "initial"), (result.best.design, result.best, BLUE, "optimized"))
-    fig = new_figure((11, 8.5), layout=None)
-    axes = fig.subplots(2, 2)
-    _section(axes[0, 0], design, result, runs, length)
-    _wall(axes[0, 1], design, runs, length)
-    _final_thickness(axes[1, 0], design, result, runs, target, length)
-    _convergence(axes[1, 1], result)
-    fig.tight_layout()
+    # the section, a tall part drawn to scale, takes the left column's full height; the three
+    # graphs stack on the right
+    fig = new_figure((13, 11))
+    grid = fig.add_gridspec(3, 2, width_ratios=[1.0, 1.45])
+    _section(fig.add_subplot(grid[:, 0]), design, result, runs, length)
+    _wall(fig.add_subplot(grid[0, 1]), design, runs, length)
+    _final_thickness(fig.add_subplot(grid[1, 1]), design, result, runs, target, length)
+    _convergence(fig.add_subplot(grid[2, 1]), result)
     save(fig, path)
 
 
@@ -60,7 +61,7 @@ def _section(ax, design, result, runs, length: str) -> None:
     ax.set_xlabel("r" + length)
     ax.set_ylabel("z" + length)
     ax.set_title("section: parison and final wall (mid-surface)")
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)  # beside the tall part
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.07), ncols=2)  # under the tall part
 
 
 def _wall(ax, design, runs, length: str) -> None:

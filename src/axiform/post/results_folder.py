@@ -30,6 +30,9 @@ class FolderInfo:
     load: dict[str, Any] | None = None
     monitor_quantities: dict[str, str] = dc_field(default_factory=dict)
     contacts: list[str] = dc_field(default_factory=list)  # the mould pieces' names, pair by pair
+    applied: list[dict[str, Any]] = dc_field(default_factory=list)  # every applied quantity (labels)
+    process: bool = False  # a multi-stage process: load curves against the time t
+    cavities: dict[str, dict[str, float]] = dc_field(default_factory=dict)  # summary.json's cavities
 
     @classmethod
     def read(cls, folder: Path) -> "FolderInfo":
@@ -39,16 +42,29 @@ class FolderInfo:
         s = json.loads(path.read_text())
         contacts = [c.get("name", f"contact[{k}]") for k, c in enumerate(s.get("contact") or [])]
         return cls(s.get("title", ""), s.get("units") or {}, s.get("load"), s.get("monitor_quantities") or {},
-                   contacts)
+                   contacts, s.get("applied") or [], bool(s.get("process")), s.get("cavities") or {})
+
+    def time_label(self) -> str:
+        """The process time t with its unit, or the load factor λ of a case without a time unit
+        that is no multi-stage process."""
+        if self.process or self.units.get("time"):
+            return with_unit("time t", "time", self.units)
+        return "load factor λ"
+
+    def applied_values(self, applied: dict[str, Any], lam: np.ndarray) -> np.ndarray:
+        """An applied quantity (an entry of `applied`) at the load factors lam."""
+        cavity = self.cavities.get(applied.get("cavity", ""), {})
+        return load_values(applied, lam, float(cavity.get("initial_volume", 0.0)) if "cavity" in applied else 0.0)
 
     def contact_name(self, k: int) -> str:
         """The name of mould piece k (pair k of contact.csv)."""
         return self.contacts[k] if k < len(self.contacts) else f"contact[{k}]"
 
     def load_label(self) -> str:
-        """The load axis: the loaded quantity with its unit, or the load factor."""
+        """The load axis: the loaded quantity with its unit, else the time t (a case with a time
+        unit) or the load factor."""
         if self.load is None:
-            return "load factor λ"
+            return self.time_label()
         return with_unit(self.load.get("name", self.load["quantity"]), self.load["quantity"], self.units)
 
     def load_of(self, history: dict[str, np.ndarray]) -> np.ndarray:
@@ -65,12 +81,16 @@ class FolderInfo:
         if len(rows) == 0:
             return f"step {step}"
         value = self.load_of(history)[rows[0]]
+        time = ""
+        if self.process or self.units.get("time"):
+            unit = unit_of("time", self.units)
+            time = f", t = {short(history['load_factor'][rows[0]])}" + (f" {unit}" if unit else "")
         if self.load is None:
-            return f"step {step}, λ = {short(value)}"
+            return f"step {step}" + (time or f", λ = {short(value)}")
         symbol = {"pressure": "p", "force": "F"}.get(self.load["quantity"], "")
         name = symbol if self.load.get("name") in ("pressure", "force") else self.load.get("name", symbol)
         unit = unit_of(self.load["quantity"], self.units)
-        return f"step {step}, {name} = {short(value)}" + (f" {unit}" if unit else "")
+        return f"step {step}{time}, {name} = {short(value)}" + (f" {unit}" if unit else "")
 
 
 def read_history(path: Path) -> dict[str, np.ndarray]:

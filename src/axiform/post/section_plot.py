@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .figures import colormap, new_figure, save
+from .figures import colormap, new_figure, save, title, wrapped
 from .labels import with_unit
 from .results_folder import FieldError, FolderInfo, read_history, surfaces_of, written_steps
 
@@ -15,7 +15,11 @@ FIELD_NAMES = {"von_mises": ("von Mises stress", "stress"), "J": ("J = det F", "
                "cauchy_stress": ("Cauchy stress", "stress"), "principal_stretches": ("principal stretch", ""),
                "displacement": ("displacement", "length"), "thickness": ("thickness", "length"),
                "contact_pressure": ("contact pressure", "pressure"), "fibre_rotation": ("fibre rotation", "rotation"),
-               "first_contact": ("time of first contact", "time")}
+               "first_contact": ("time of first contact", "time"),
+               "pressure": ("hydrostatic pressure −tr σ / 3", "stress"),
+               "hydrostatic_pressure": ("hydrostatic pressure −tr σ / 3", "stress")}
+# the same field under an older or a newer name: either is accepted for the other
+ALIASES = {"pressure": "hydrostatic_pressure", "hydrostatic_pressure": "pressure"}
 COMPONENTS = {"displacement": ("ur", "uz"), "cauchy_stress": ("rr", "zz", "tt", "rz"),
               "principal_stretches": ("major", "minor", "hoop")}
 
@@ -25,6 +29,8 @@ def field_values(point_data: dict[str, np.ndarray], spec: str, units: dict[str, 
     or tensor without a component gives its magnitude (the Cauchy stress: the Frobenius norm
     of the tensor, the shear counted twice), and the label says so."""
     name, _, comp = spec.partition(":")
+    if name not in point_data and ALIASES.get(name) in point_data:
+        name = ALIASES[name]
     if name not in point_data:
         raise FieldError(f"no field '{name}' in the results (fields: {', '.join(sorted(point_data))})")
     values = np.asarray(point_data[name], float)
@@ -172,7 +178,7 @@ def deformed_figure(vtu: Path, info: FolderInfo, field: str = "von_mises", surfa
     state = info.state(step, history or {})
     # a line holds about 11 characters per inch at 11 pt: a tall part's narrow figure takes the note below
     gap = "  " if len(state) + len(note) + 4 < 11 * size[0] else "\n"
-    fig.suptitle((info.title + "\n" if info.title else "") + f"{state}{gap}({note})", fontsize=11)
+    title(fig, (info.title + "\n" if info.title else "") + f"{state}{gap}({note})", fontsize=11)
     return fig
 
 
@@ -213,6 +219,6 @@ def animate(folder: Path, out: Path, info: FolderInfo | None = None, fps: float 
             ax.clear()
             _draw(ax, X, x, outline, v[cells].mean(axis=1), norm, cmap, mould, thin)
             _finish_axes(ax, lo, hi, info.units)
-            ax.set_title(info.state(int(f.stem.split("_")[-1]), history), fontsize=10)
+            ax.set_title(wrapped(info.state(int(f.stem.split("_")[-1]), history), 0.8 * size[0], 10), fontsize=10)
             writer.grab_frame()
     return out
