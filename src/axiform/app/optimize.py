@@ -1,4 +1,4 @@
-"""Parison and preform programming (DESIGN 10.10): the initial wall thickness table of a
+"""Parison and preform programming: the initial wall thickness table of a
 layered case that gives a wanted final wall.
 
 Design: the thicknesses t_k of the case's `mesh.thickness` table [[s_k, t_k], ...], bounded

@@ -1,4 +1,4 @@
-"""The [[cavity]] tables of the case file: the gas cavities (DESIGN 10.5) and their control;
+"""The [[cavity]] tables of the case file: the gas cavities and their control;
 and the model's cavities they make."""
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from ..fem.selectors import select_edges
 
 
 class CavitySpec(CurveMixin):
-    """A gas cavity (DESIGN 10.5): the wall edges that bound the gas, and its control."""
+    """A gas cavity: the wall edges that bound the gas, and its control."""
 
     name: Annotated[str, Field(min_length=1)]
     boundary: Selector

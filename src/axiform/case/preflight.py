@@ -1,4 +1,4 @@
-"""Pre-run warnings of a built case (DESIGN § 13): what is valid but probably not what was
+"""Pre-run warnings of a built case: what is valid but probably not what was
 meant, found without solving.  Each warning is one line that begins with the table and key at
 fault.
 

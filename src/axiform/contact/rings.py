@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..fem.elements import edge_shape, gauss_1d
+from ..fem.elements import edge_rule
 from ..fem.mesh import Mesh
 
 
@@ -29,8 +29,7 @@ def ring_areas(x: np.ndarray, edges: np.ndarray, derivative: bool = False):
     Returns per edge and edge node the part a (m, k) and, if asked, its derivative
     da[m, i, j, :] = d a_i / d x_j (m, k, k, 2) with respect to the positions of the edge's
     nodes; a node's area is the sum of its parts over its edges."""
-    s, wq = gauss_1d(3)
-    N, dN = edge_shape(edges.shape[1], s)  # (p, k)
+    _, wq, N, dN = edge_rule(edges.shape[1], 3)  # (p,), (p, k): built once
     X = x[edges]  # (m, k, 2)
     t = np.einsum("pk,mkd->mpd", dN, X)  # dx/ds (m, p, 2)
     L = np.linalg.norm(t, axis=2)  # (m, p)
@@ -56,8 +55,7 @@ def pole_rows(x: np.ndarray, edges: np.ndarray, corner: np.ndarray, derivative: 
     M_00 = -M_01 = 2 pi r_1 L / 60 on a straight edge.
 
     Returns M (q, k) and, if asked, dM[q, j, l, :] = d M_ij / d x_l (q, k, k, 2)."""
-    s, wq = gauss_1d(3)  # the rule of `ring_areas`, so that the row sums to its area exactly
-    N, dN = edge_shape(edges.shape[1], s)  # (p, k)
+    _, wq, N, dN = edge_rule(edges.shape[1], 3)  # the rule of `ring_areas`: the row sums to its area exactly
     X = x[edges]  # (q, k, 2)
     t = np.einsum("pk,qkd->qpd", dN, X)
     L = np.linalg.norm(t, axis=2)  # (q, p)

@@ -133,7 +133,7 @@ def default_wall(points: np.ndarray, loaded_edges: Sequence[np.ndarray]) -> str:
 
 
 def write_thickness_csv(path: str | Path, table: dict[str, np.ndarray]) -> None:
-    """thickness.csv: the header row first (DESIGN 10.12), one row per station, the COLUMNS
+    """thickness.csv: the header row first, one row per station, the COLUMNS
     then any per-piece first_contact_K; the step and load factor are in summary.json; the
     contact times are left empty where never."""
     names = list(COLUMNS) + [n for n in table if n not in COLUMNS]

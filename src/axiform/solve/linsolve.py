@@ -13,8 +13,8 @@ The solver is chosen by the size n of K (benchmarks/README.md § 3.2 measured ea
   solver object, driven phase by phase, was measured slower (benchmarks/README.md § 3.9:
   its import and constructor look for MKL through site-packages, 0.24 to 0.40 s a process,
   and each call converts the indices to one-based and builds its pointers, +0.1 ms = +9 to
-  13 % for a factorization and solve at 1e3 unknowns), so this module keeps its own binding
-  (DESIGN § 12);
+  13 % for a factorization and solve at 1e3 unknowns), so this module keeps its own binding,
+  typed and guarded (benchmarks/README.md § 3.9);
 - without MKL (not x86-64): SciPy's SuperLU with the column ordering minimum degree on
   K^T K (MMD_ATA), computed once per pattern and then given as the natural order of the
   permuted K.  A column ordering bounds the fill whatever rows partial pivoting picks;
