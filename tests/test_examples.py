@@ -83,3 +83,14 @@ def test_contact_and_law_examples_finish(tmp_path, name, key, value):
         assert s["monitors"][key] == pytest.approx(value, rel=5e-3)
     else:
         assert s["monitors"][key] < 0  # the plug pushes the sheet down
+
+
+def test_rubber_ring_between_plates_has_the_homogeneous_force(tmp_path):
+    """Held by contact alone and pressed from a gap: the plate force within 0.5 % of
+    pi (b^2 - a^2) mu (l^-2 - l) at the ring's stretch l (measured: 0.03 %; each face sinks into
+    its plate by the penalty's give, about 0.01 mm)."""
+    summary = run("rubber_ring_plates", tmp_path)
+    stretch = (4.0 + summary["monitors"]["top_uz"] - summary["monitors"]["bottom_uz"]) / 4.0
+    exact = np.pi * (22.0**2 - 18.0**2) * (stretch**-2 - stretch)
+    assert 0.70 < stretch < 0.71
+    assert -summary["monitors"]["plate_force"] == pytest.approx(exact, rel=5e-3)
