@@ -221,11 +221,6 @@ def test_check_like_names_the_first_item_that_differs(finished):
         check_like(other, state)
 
 
-@pytest.mark.xfail(strict=True, reason="app/run.py run (cli._run before h2): a checkpoint that is whole (its checksum matches, or a file "
-                   "of before the checksum) but fits no model fails in the solve with exit 3; in _run, after build(): "
-                   "check_like(state, {'path': {'u_f': np.zeros(model.n_free)}, 'model': "
-                   "model.initial_state().to_dict(), 'size': 0.0, 'step': 0, 'newton_iterations': 0}) "
-                   "(io/checkpoint.py) after build(), a ValueError -> CaseError(f'--resume: {resume}/restart/checkpoint.npz: {exc}')")
 @pytest.mark.parametrize("damage", ["u_f", "path", "contacts"])
 def test_a_checkpoint_that_fits_no_model_is_refused_naming_the_file(finished, damage):
     path, run = finished
@@ -270,19 +265,11 @@ def test_a_folder_named_as_a_mesh_or_mould_file_is_refused_as_such(tmp_path, nam
 # ---- families whose fix is the lead's (strict xfail: they fail now, pass once fixed) -----------
 
 
-@pytest.mark.xfail(strict=True, reason="app/run.py prepare_folder (cli._prepare before h2): Path.exists() raises OSError ENAMETOOLONG for a name "
-                   "longer than the file system allows; wrap its loop over (folder, *folder.parents) in the same "
-                   "try/except OSError as the mkdir, returning f'cannot create or write {folder} "
-                   "({exc.strerror or exc})' (and results_folder's folder.exists() likewise)")
 def test_an_output_path_longer_than_the_file_system_allows_is_refused(tmp_path):
     path = write_case(tmp_path, BASE)
     refused(["run", path, "--out", tmp_path / ("x" * 300), "-q"], "--out:", "File name too long")
 
 
-@pytest.mark.xfail(strict=True, reason="app/run.py resume_state, app/plot.py plot (cli.py before h2): Path.is_dir() / is_file() raise OSError ENAMETOOLONG for a name longer "
-                   "than the file system allows: in resume_state (--resume: exit 3) and plot (a traceback); wrap "
-                   "`folder.is_dir()` in resume_state and `(path / 'history.csv').is_file()` in plot in try/except "
-                   "OSError -> exit 2 with f'--resume: {folder}: {exc.strerror}' / f'axiform: {folder}: {exc.strerror}'")
 @pytest.mark.parametrize("command", ["resume", "plot"])
 def test_a_results_folder_name_too_long_is_refused(tmp_path, command):
     path = write_case(tmp_path, BASE)
