@@ -277,10 +277,6 @@ def test_a_results_folder_name_too_long_is_refused(tmp_path, command):
     refused(argv, "File name too long")
 
 
-@pytest.mark.xfail(strict=True, reason="post/results_folder.py read_history (post/plots.py before h1; or app/plot.py plot): a ragged row of history.csv gives "
-                   "float(None) / float(list) TypeError, a traceback; read it with csv.reader, and for each row n "
-                   "raise ValueError(f'{path} line {n}: {len(row)} values for {len(header)} columns') when the "
-                   "lengths differ and ValueError(f'{path} line {n}: {cell!r} is not a number') for text")
 @pytest.mark.parametrize("row", ["3,1\n", "3,1,1,1,1,1\n", "abc,1,2,3\n"])
 def test_a_ragged_history_is_refused_by_plot_naming_the_file_and_line(tmp_path, row):
     path = write_case(tmp_path, BASE)
