@@ -291,27 +291,18 @@ def test_a_ragged_history_is_refused_by_plot_naming_the_file_and_line(tmp_path, 
     refused(["plot", out], f"{history} line")
 
 
-@pytest.mark.xfail(strict=True, reason="app/fit.py read_data: refuse stretches outside [1e-3, 1e3] and stresses "
-                   "beyond 1e30 (or nonzero below 1e-30) in magnitude, naming f'{where}'; stretch 1e-300 now ends "
-                   "in numpy LinAlgError (a traceback) in the fit")
 def test_fit_data_of_absurd_magnitude_is_refused_naming_the_line(tmp_path):
     csv = tmp_path / "d.csv"
     csv.write_text("mode,stretch,stress\nuniaxial,1e-300,0.3\nuniaxial,2.0,0.55\n")
     refused(["fit", csv, "--model", "neo-hooke", "--out", tmp_path / "fit"], f"{csv} line 2")
 
 
-@pytest.mark.xfail(strict=True, reason="app/fit.py read_data: path.read_text() raises UnicodeDecodeError (a "
-                   "traceback) for data that is not UTF-8; catch (OSError, UnicodeDecodeError) and raise "
-                   "FitDataError(f'{path}: not UTF-8 text (byte {exc.start})')")
 def test_fit_data_that_is_not_utf8_is_refused_naming_the_file(tmp_path):
     csv = tmp_path / "d.csv"
     csv.write_bytes(b"mode,stretch,stress\nuniaxial,1.5,0.3\xe9\n")
     refused(["fit", csv, "--model", "neo-hooke", "--out", tmp_path / "fit"], str(csv))
 
 
-@pytest.mark.xfail(strict=True, reason="app/fit.py run: folder.mkdir() raises FileExistsError (a traceback) when "
-                   "--out lies below a file; check it before the fit with app/run.prepare_folder(folder) and exit 2 with "
-                   "'axiform: invalid output folder:\\n--out: {problem}'")
 def test_fit_out_below_a_file_is_refused(tmp_path):
     csv = tmp_path / "d.csv"
     csv.write_text("mode,stretch,stress\nuniaxial,1.5,0.3\nuniaxial,2.0,0.55\n")
