@@ -1,7 +1,7 @@
 """Bad inputs refused cleanly (DESIGN § 13): exit 2 with a message naming the key, or the file
 and line, before any work; no traceback, no hang.  One test per family the fuzzing found or
-the issue named; the strict xfail tests are the families whose fix lies in files of other
-owners (cli.py, app/*, post/plots.py): their reason says the fix."""
+the issue named.  A family whose fix lies in files of other owners (cli.py, app/*, post/*)
+comes as a strict xfail test whose reason says the fix, its marker lifted with the fix."""
 
 from __future__ import annotations
 
@@ -262,7 +262,7 @@ def test_a_folder_named_as_a_mesh_or_mould_file_is_refused_as_such(tmp_path, nam
     refused(["check", write_case(tmp_path, case)], "is a folder, not a gmsh file")
 
 
-# ---- families whose fix is the lead's (strict xfail: they fail now, pass once fixed) -----------
+# ---- families fixed in app/* and post/* (strict xfail tests until h11) --------------------------
 
 
 def test_an_output_path_longer_than_the_file_system_allows_is_refused(tmp_path):
@@ -335,9 +335,6 @@ def test_a_mould_file_of_huge_coordinates_is_refused_naming_the_row(tmp_path):
             "at most 1e+30")
 
 
-@pytest.mark.xfail(strict=True, reason="app/design.py read_target (app/optimize.py before h2): a thickness of 1e-300 (or s, thickness beyond 1e30) "
-                   "is accepted and the run reports a deviation of 6.5e+301 %; refuse magnitudes as the case's numbers "
-                   "are (case/schema.py MAX_MAGNITUDE, MIN_MAGNITUDE): TargetError(f'{path}: line {n}: ... magnitude')")
 def test_a_target_of_absurd_magnitude_is_refused_naming_the_line(tmp_path):
     from test_fuzz_files import LAYERED
 
