@@ -1,7 +1,7 @@
 """Bad inputs refused cleanly (DESIGN § 13): exit 2 with a message naming the key, or the file
 and line, before any work; no traceback, no hang.  One test per family the fuzzing found or
-the issue named; the strict xfail tests are the families whose fix lies in files of other
-owners (cli.py, app/*, post/plots.py): their reason says the fix."""
+the issue named.  A family whose fix lies in files of other owners (cli.py, app/*, post/*)
+comes as a strict xfail test whose reason says the fix, its marker lifted with the fix."""
 
 from __future__ import annotations
 
@@ -221,11 +221,6 @@ def test_check_like_names_the_first_item_that_differs(finished):
         check_like(other, state)
 
 
-@pytest.mark.xfail(strict=True, reason="app/run.py run (cli._run before h2): a checkpoint that is whole (its checksum matches, or a file "
-                   "of before the checksum) but fits no model fails in the solve with exit 3; in _run, after build(): "
-                   "check_like(state, {'path': {'u_f': np.zeros(model.n_free)}, 'model': "
-                   "model.initial_state().to_dict(), 'size': 0.0, 'step': 0, 'newton_iterations': 0}) "
-                   "(io/checkpoint.py) after build(), a ValueError -> CaseError(f'--resume: {resume}/restart/checkpoint.npz: {exc}')")
 @pytest.mark.parametrize("damage", ["u_f", "path", "contacts"])
 def test_a_checkpoint_that_fits_no_model_is_refused_naming_the_file(finished, damage):
     path, run = finished
@@ -267,22 +262,14 @@ def test_a_folder_named_as_a_mesh_or_mould_file_is_refused_as_such(tmp_path, nam
     refused(["check", write_case(tmp_path, case)], "is a folder, not a gmsh file")
 
 
-# ---- families whose fix is the lead's (strict xfail: they fail now, pass once fixed) -----------
+# ---- families fixed in app/* and post/* (strict xfail tests until h11) --------------------------
 
 
-@pytest.mark.xfail(strict=True, reason="app/run.py prepare_folder (cli._prepare before h2): Path.exists() raises OSError ENAMETOOLONG for a name "
-                   "longer than the file system allows; wrap its loop over (folder, *folder.parents) in the same "
-                   "try/except OSError as the mkdir, returning f'cannot create or write {folder} "
-                   "({exc.strerror or exc})' (and results_folder's folder.exists() likewise)")
 def test_an_output_path_longer_than_the_file_system_allows_is_refused(tmp_path):
     path = write_case(tmp_path, BASE)
     refused(["run", path, "--out", tmp_path / ("x" * 300), "-q"], "--out:", "File name too long")
 
 
-@pytest.mark.xfail(strict=True, reason="app/run.py resume_state, app/plot.py plot (cli.py before h2): Path.is_dir() / is_file() raise OSError ENAMETOOLONG for a name longer "
-                   "than the file system allows: in resume_state (--resume: exit 3) and plot (a traceback); wrap "
-                   "`folder.is_dir()` in resume_state and `(path / 'history.csv').is_file()` in plot in try/except "
-                   "OSError -> exit 2 with f'--resume: {folder}: {exc.strerror}' / f'axiform: {folder}: {exc.strerror}'")
 @pytest.mark.parametrize("command", ["resume", "plot"])
 def test_a_results_folder_name_too_long_is_refused(tmp_path, command):
     path = write_case(tmp_path, BASE)
@@ -290,10 +277,6 @@ def test_a_results_folder_name_too_long_is_refused(tmp_path, command):
     refused(argv, "File name too long")
 
 
-@pytest.mark.xfail(strict=True, reason="post/results_folder.py read_history (post/plots.py before h1; or app/plot.py plot): a ragged row of history.csv gives "
-                   "float(None) / float(list) TypeError, a traceback; read it with csv.reader, and for each row n "
-                   "raise ValueError(f'{path} line {n}: {len(row)} values for {len(header)} columns') when the "
-                   "lengths differ and ValueError(f'{path} line {n}: {cell!r} is not a number') for text")
 @pytest.mark.parametrize("row", ["3,1\n", "3,1,1,1,1,1\n", "abc,1,2,3\n"])
 def test_a_ragged_history_is_refused_by_plot_naming_the_file_and_line(tmp_path, row):
     path = write_case(tmp_path, BASE)
@@ -308,27 +291,18 @@ def test_a_ragged_history_is_refused_by_plot_naming_the_file_and_line(tmp_path, 
     refused(["plot", out], f"{history} line")
 
 
-@pytest.mark.xfail(strict=True, reason="app/fit.py read_data: refuse stretches outside [1e-3, 1e3] and stresses "
-                   "beyond 1e30 (or nonzero below 1e-30) in magnitude, naming f'{where}'; stretch 1e-300 now ends "
-                   "in numpy LinAlgError (a traceback) in the fit")
 def test_fit_data_of_absurd_magnitude_is_refused_naming_the_line(tmp_path):
     csv = tmp_path / "d.csv"
     csv.write_text("mode,stretch,stress\nuniaxial,1e-300,0.3\nuniaxial,2.0,0.55\n")
     refused(["fit", csv, "--model", "neo-hooke", "--out", tmp_path / "fit"], f"{csv} line 2")
 
 
-@pytest.mark.xfail(strict=True, reason="app/fit.py read_data: path.read_text() raises UnicodeDecodeError (a "
-                   "traceback) for data that is not UTF-8; catch (OSError, UnicodeDecodeError) and raise "
-                   "FitDataError(f'{path}: not UTF-8 text (byte {exc.start})')")
 def test_fit_data_that_is_not_utf8_is_refused_naming_the_file(tmp_path):
     csv = tmp_path / "d.csv"
     csv.write_bytes(b"mode,stretch,stress\nuniaxial,1.5,0.3\xe9\n")
     refused(["fit", csv, "--model", "neo-hooke", "--out", tmp_path / "fit"], str(csv))
 
 
-@pytest.mark.xfail(strict=True, reason="app/fit.py run: folder.mkdir() raises FileExistsError (a traceback) when "
-                   "--out lies below a file; check it before the fit with app/run.prepare_folder(folder) and exit 2 with "
-                   "'axiform: invalid output folder:\\n--out: {problem}'")
 def test_fit_out_below_a_file_is_refused(tmp_path):
     csv = tmp_path / "d.csv"
     csv.write_text("mode,stretch,stress\nuniaxial,1.5,0.3\nuniaxial,2.0,0.55\n")
@@ -336,10 +310,6 @@ def test_fit_out_below_a_file_is_refused(tmp_path):
     refused(["fit", csv, "--model", "neo-hooke", "--out", tmp_path / "blocker" / "fit"], "--out:")
 
 
-@pytest.mark.xfail(strict=True, reason="app/sweep.py load_sweep: itertools.product of [vary] is parsed case by case "
-                   "(10^8 cases: a hang); count math.prod(len(v) for v in vary.values()) first and refuse more than "
-                   "a bound (say 10,000) with CaseError(f'vary: {n:,} cases (the product of the list lengths); at "
-                   "most 10,000')")
 def test_a_sweep_of_too_many_cases_is_refused_at_once(tmp_path):
     write_case(tmp_path, BASE)
     values = "[" + ", ".join(str(80.0 + k) for k in range(10)) + "]"
@@ -350,9 +320,6 @@ def test_a_sweep_of_too_many_cases_is_refused_at_once(tmp_path):
     refused(["sweep", sweep, "--out", tmp_path / "out"], "vary:", bound=1.0)
 
 
-@pytest.mark.xfail(strict=True, reason="app/sweep.py toml_value raises TypeError (a traceback) for a TOML date or "
-                   "time among the values; load_sweep should refuse it: CaseError(f'vary.{key}: a date or time is "
-                   "not a case value') (or [[cases]] likewise)")
 def test_a_sweep_value_that_is_a_date_is_refused(tmp_path):
     write_case(tmp_path, BASE)
     sweep = tmp_path / "sweep.toml"
@@ -368,9 +335,6 @@ def test_a_mould_file_of_huge_coordinates_is_refused_naming_the_row(tmp_path):
             "at most 1e+30")
 
 
-@pytest.mark.xfail(strict=True, reason="app/design.py read_target (app/optimize.py before h2): a thickness of 1e-300 (or s, thickness beyond 1e30) "
-                   "is accepted and the run reports a deviation of 6.5e+301 %; refuse magnitudes as the case's numbers "
-                   "are (case/schema.py MAX_MAGNITUDE, MIN_MAGNITUDE): TargetError(f'{path}: line {n}: ... magnitude')")
 def test_a_target_of_absurd_magnitude_is_refused_naming_the_line(tmp_path):
     from test_fuzz_files import LAYERED
 

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from ..case.schema import Built, CaseError, build, parse, read
+from ..case.schema import MAX_MAGNITUDE, MIN_MAGNITUDE, Built, CaseError, build, parse, read
 from ..model.model import Model
 from ..solve.solver import LoadControl
 
@@ -49,6 +49,10 @@ def read_target(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
             raise TargetError(f"{path}: line {n}: expected two numbers s,thickness, got {line.strip()!r}") from None
         if not (np.isfinite(a) and np.isfinite(b)) or b <= 0:
             raise TargetError(f"{path}: line {n}: s must be finite and the thickness finite and > 0")
+        for name, value in (("s", a), ("thickness", b)):
+            if abs(value) > MAX_MAGNITUDE or 0 < abs(value) < MIN_MAGNITUDE:
+                raise TargetError(f"{path}: line {n}: {name} {value:g} is beyond the magnitude of a case's numbers "
+                                  f"(at most {MAX_MAGNITUDE:g}, and nonzero at least {MIN_MAGNITUDE:g})")
         if s and a <= s[-1]:
             raise TargetError(f"{path}: line {n}: s must increase")
         s.append(a)

@@ -39,11 +39,15 @@ import numpy as np
 from scipy.optimize import least_squares, lsq_linear
 
 from ..case.material import KEYS, MAX_OGDEN_TERMS, MaterialSpec
+from ..case.schema import MAX_MAGNITUDE, MIN_MAGNITUDE
 from ..materials import ArrudaBoyce, Gent, Hyperelastic, MooneyRivlin, Ogden, Yeoh
 from ..post.fit_plots import plot_fit as plot
+from .run import prepare_folder
 
 MODES = ("uniaxial", "equibiaxial", "planar")
 STABILITY_STRETCHES = 10.0 ** np.linspace(-1.0, 1.0, 401)  # 0.1 to 10, 1 in the middle
+# the stretches and stresses a data file may hold: beyond them the fit's powers overflow
+STRETCH_RANGE = (1e-3, 1e3)
 ALPHA_BOUND = 25.0  # |alpha_i| of the Ogden fit, so that lambda^alpha stays finite
 OGDEN_ALPHA_STARTS = ((2.0, -2.0, 4.0, -1.0, 6.0, 1.0), (1.3, 5.0, -2.0, 3.0, -4.0, 8.0),
                       (1.0, 3.0, 6.0, -2.0, -4.0, 9.0), (3.0, -1.0, 8.0, 1.5, -3.0, 5.0),
@@ -81,6 +85,8 @@ def read_data(paths: list[str | Path]) -> Data:
     for path in map(Path, paths):
         try:
             text = path.read_text()
+        except UnicodeDecodeError as exc:
+            raise FitDataError(f"{path}: not UTF-8 text (byte {exc.start})") from None
         except OSError as exc:
             raise FitDataError(f"{path}: cannot read ({exc.strerror or exc})") from None
         header, rows = None, len(modes)
@@ -111,6 +117,12 @@ def read_data(paths: list[str | Path]) -> Data:
             lam, stress = numbers["stretch"], numbers["stress"]
             if lam <= 0:
                 raise FitDataError(f"{where}: stretch must be > 0, got {value['stretch']}")
+            if not STRETCH_RANGE[0] <= lam <= STRETCH_RANGE[1]:
+                raise FitDataError(f"{where}: stretch {value['stretch']} is beyond the magnitude of a test "
+                                   f"({STRETCH_RANGE[0]:g} to {STRETCH_RANGE[1]:g})")
+            if abs(stress) > MAX_MAGNITUDE or 0 < abs(stress) < MIN_MAGNITUDE:
+                raise FitDataError(f"{where}: stress {value['stress']} is beyond the magnitude of a number of "
+                                   f"axiform (nonzero, {MIN_MAGNITUDE:g} to {MAX_MAGNITUDE:g})")
             if lam == 1.0:
                 notes.append(f"{where}: stretch 1 skipped (every law gives stress 0 there)")
                 continue
@@ -352,12 +364,15 @@ def run(paths: list[str], model: str, terms: int | None, out: str | None, kappa:
         return 2
     for note in data.notes:
         print(f"axiform fit: {note}", file=sys.stderr)
+    folder = Path(out) if out else Path("results") / f"fit-{model}"
+    problem = prepare_folder(folder)
+    if problem:
+        print(f"axiform: invalid output folder:\n--out: {problem}", file=sys.stderr)
+        return 2
     result = fit(data, model, terms, kappa)
     if result is None:
         print(f"axiform fit: no admissible {model} constants found for these data", file=sys.stderr)
         return 1
-    folder = Path(out) if out else Path("results") / f"fit-{model}"
-    folder.mkdir(parents=True, exist_ok=True)
     counts = ", ".join(f"{m} {c}" for m, c in result.points.items())
     table = material_table(result)
     (folder / "material.toml").write_text(

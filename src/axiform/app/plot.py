@@ -25,7 +25,12 @@ def plot(folder: str, field: str, animate: bool = False) -> int:
     from ..post.plots import FieldError, plot_folder, read_history
 
     path = Path(folder)
-    if not (path / "history.csv").is_file():
+    try:
+        there = (path / "history.csv").is_file()
+    except OSError as exc:  # a name longer than the file system allows
+        say(f"axiform: {folder}: {exc.strerror or exc}")
+        return 2
+    if not there:
         say(f"axiform: {folder} is not a results folder (no history.csv)")
         return 2
     try:

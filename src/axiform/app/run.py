@@ -90,7 +90,11 @@ def results_folder(case_file: Path, digest: str, root: Path = Path("results")) -
     name = case_file.stem
     for n in range(1, 10**6):
         folder = root / (name if n == 1 else f"{name}-{n}")
-        if not folder.exists():
+        try:
+            there = folder.exists()
+        except OSError:  # a name longer than the file system allows: prepare_folder says why
+            break
+        if not there:
             break
         try:
             held = json.loads((folder / "summary.json").read_text())["case"]["sha256"]
@@ -104,12 +108,12 @@ def results_folder(case_file: Path, digest: str, root: Path = Path("results")) -
 
 def prepare_folder(folder: Path) -> str | None:
     """Create an output folder; the reason it cannot be, or None."""
-    for up in (folder, *folder.parents):
-        if up.exists() and not up.is_dir():
-            return f"{up} is a file, not a folder"
-        if up.exists():
-            break
     try:
+        for up in (folder, *folder.parents):
+            if up.exists() and not up.is_dir():
+                return f"{up} is a file, not a folder"
+            if up.exists():
+                break
         folder.mkdir(parents=True, exist_ok=True)
         probe = folder / ".axiform-write-test"
         probe.write_text("")
@@ -125,7 +129,11 @@ def resume_state(folder: Path, data: dict) -> dict:
     from ..case.schema import CaseError, fingerprint
     from ..io.checkpoint import load as load_checkpoint
 
-    if not folder.is_dir():
+    try:
+        there = folder.is_dir()
+    except OSError as exc:  # a name longer than the file system allows
+        raise CaseError(f"--resume: {folder}: {exc.strerror or exc}") from None
+    if not there:
         raise CaseError(f"--resume: {folder} is not a results folder")
     try:
         state, meta = load_checkpoint(folder / "restart")
@@ -135,6 +143,23 @@ def resume_state(folder: Path, data: dict) -> dict:
         if meta.get(key) != fingerprint(data.get(key, {})):
             raise CaseError(f"{key}: differs from the run being resumed ([{key}] cannot change on --resume)")
     return state
+
+
+def check_fit(state: dict, model, folder: Path) -> None:
+    """CaseError (exit 2) naming the checkpoint file and its first item that does not fit the
+    model at hand (another number of unknowns, of contact pairs, a number where a table
+    belongs), before the solve would fail on it."""
+    import numpy as np
+
+    from ..case.schema import CaseError
+    from ..io.checkpoint import FILE, check_like
+
+    template = {"path": {"u_f": np.zeros(model.n_free)}, "model": model.initial_state().to_dict(),
+                "size": 0.0, "step": 0, "newton_iterations": 0}
+    try:
+        check_like(state, template)
+    except ValueError as exc:
+        raise CaseError(f"--resume: {folder / 'restart' / FILE}: {exc}") from None
 
 
 @dataclass
@@ -172,7 +197,10 @@ class Job:
                 raise CaseError("--out: a resumed run writes in the folder it resumes (--resume)")
             out = resume
             state = resume_state(Path(resume), data)
-        return cls(case_file, overrides, data, case, build(case, case_file.parent), state, out)
+        built = build(case, case_file.parent)
+        if state is not None:
+            check_fit(state, built.model, Path(resume))
+        return cls(case_file, overrides, data, case, built, state, out)
 
     def folder(self) -> tuple[Path, str]:
         """The results folder (--out, or the default) and a note when it is not the first choice."""

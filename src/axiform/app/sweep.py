@@ -9,6 +9,7 @@ of one case on a Dask cluster (DESIGN § 10.8).
     [report]
     monitor = "w_center"                # plotted against the varied keys (default: the first monitor)
 
+At most 10,000 cases (MAX_CASES); a date or time is no case value.
 Case k (k = 1, 2, ...; the last key of [vary] varies fastest) runs in DIR/cases/NNNN/
 (NNNN = k, four digits) through the same code as `axiform run CASE --set KEY=VALUE ... --out
 DIR/cases/NNNN`: a normal results folder.  DIR/sweep.csv has one row per case (case, the
@@ -27,9 +28,11 @@ folders, by a shared file system).  Exit 0 when every case finished, 1 when some
 from __future__ import annotations
 
 import csv
+import datetime
 import io
 import itertools
 import json
+import math
 import os
 import sys
 import time
@@ -46,6 +49,9 @@ from ..post.sweep_plots import plot_sweep
 from .console import ProgressLine
 
 SWEEP_KEYS = ("case", "vary", "cases", "report")
+# the most cases a sweep may have: a [vary] of many long lists is refused at once, not
+# parsed case by case for hours
+MAX_CASES = 10_000
 FIXED_COLUMNS = ("status", "exit_code", "steps", "wall_time_s", "message")
 # one math library thread per worker: the workers already fill the cores
 WORKER_ENV = {v: "1" for v in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")}
@@ -120,6 +126,17 @@ class Sweep:
         return [f"{key}={toml_value(v)}" for key, v in self.cases[k].items()]
 
 
+def _has_date(value: Any) -> bool:
+    """Whether a TOML value is, or holds, a date or time (no case key takes one)."""
+    if isinstance(value, (datetime.date, datetime.time)):  # a datetime is a date
+        return True
+    if isinstance(value, dict):
+        return any(_has_date(v) for v in value.values())
+    if isinstance(value, list):
+        return any(_has_date(v) for v in value)
+    return False
+
+
 def load_sweep(path: str | Path) -> Sweep:
     """Read and check a sweep file; CaseError names the key and the reason.  Every case is
     read and validated (not built) here, before any work."""
@@ -140,9 +157,21 @@ def load_sweep(path: str | Path) -> Sweep:
     if not case_file.is_file():
         raise CaseError(f"case: no such file {case_file}")
     if spec.vary is not None:
+        for key, values in spec.vary.items():
+            if any(_has_date(v) for v in values):
+                raise CaseError(f"vary.{key}: a date or time is not a case value")
+        n = math.prod(len(v) for v in spec.vary.values())
+        if n > MAX_CASES:
+            raise CaseError(f"vary: {n:,} cases (the product of the list lengths); at most {MAX_CASES:,}")
         keys = list(spec.vary)
         cases = [dict(zip(keys, combo)) for combo in itertools.product(*spec.vary.values())]
     else:
+        for i, case in enumerate(spec.cases):
+            for key, value in case.items():
+                if _has_date(value):
+                    raise CaseError(f"cases[{i}].{key}: a date or time is not a case value")
+        if len(spec.cases) > MAX_CASES:
+            raise CaseError(f"cases: {len(spec.cases):,} cases; at most {MAX_CASES:,}")
         cases = [dict(c) for c in spec.cases]
         keys = list(dict.fromkeys(k for c in cases for k in c))
     monitor = spec.report.monitor

@@ -94,12 +94,29 @@ class FolderInfo:
 
 
 def read_history(path: Path) -> dict[str, np.ndarray]:
-    """history.csv as columns (step, load_factor, iterations, monitors...)."""
-    with open(path) as fh:
-        rows = list(csv.DictReader(fh))
+    """history.csv as columns (step, load_factor, iterations, monitors...); ValueError naming
+    the file and line of a row with another number of values than the header has columns, or
+    a value that is not a number."""
+    with open(path, newline="") as fh:
+        reader = csv.reader(fh)
+        header = next(reader, None)
+        rows = []
+        for row in reader:
+            if not row:  # a blank line
+                continue
+            n = reader.line_num
+            if len(row) != len(header):
+                raise ValueError(f"{path} line {n}: {len(row)} values for {len(header)} columns")
+            values = []
+            for cell in row:
+                try:
+                    values.append(float(cell))
+                except ValueError:
+                    raise ValueError(f"{path} line {n}: {cell!r} is not a number") from None
+            rows.append(values)
     if not rows:
         return {}
-    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
+    return {k: np.array([r[i] for r in rows]) for i, k in enumerate(header)}
 
 
 def written_steps(folder: Path) -> list[Path]:
