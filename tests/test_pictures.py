@@ -176,6 +176,11 @@ def test_sweep_legend_names_what_varies(tmp_path):
     cases = with_defaults(sweep)
     assert [c["solver.steps"] for c in cases] == [10, 40] and cases[1]["contact[0].friction"] == 0.3
     assert [legend_label(c, ["solver.steps"]) for c in cases] == ["solver.steps = 10", "solver.steps = 40"]
+    from axiform.app.sweep import toml_value
+    from axiform.post.sweep_plots import value_text
+
+    for value in (0.3, "q8", [1, 2.5], {"a": [1, "x"]}, True, "a\nb"):
+        assert value_text(value) == toml_value(value)
 
 
 def test_picture_functions_are_short():
@@ -184,3 +189,34 @@ def test_picture_functions_are_short():
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.FunctionDef):
                 assert node.end_lineno - node.lineno < 80, f"{path.name}: {node.name}"
+
+
+def test_sweep_plots_the_peak_of_a_monitor_that_ends_at_zero(tmp_path):
+    """A friction sweep whose plug force is back at 0 at the end of every case: sweep.png
+    plots the peak over the run (the largest magnitude, signed), and the end value dashed."""
+    from axiform.app.sweep import Sweep
+    from axiform.post.sweep_plots import plot_sweep, sweep_figure
+
+    case = tmp_path / "c.toml"
+    case.write_text("[[contact]]\nfriction = 0.3\n")
+    frictions = [0.1, 0.2, 0.4]
+    sweep = Sweep(case, ["contact[0].friction"], [{"contact[0].friction": f} for f in frictions], "plug_force")
+    rows = [{"status": "finished", "monitors": {"plug_force": 0.0},
+             "extremes": {"plug_force": (-100.0 * (1 + f), 5.0)}} for f in frictions]
+    rows.append({"status": "failed"})
+    sweep.cases.append({"contact[0].friction": 0.8})
+    (ax,) = sweep_figure(sweep, rows).axes
+    peak, end = ax.lines
+    assert np.allclose(peak.get_xdata(), frictions) and np.allclose(peak.get_ydata(), [-110.0, -120.0, -140.0])
+    assert np.allclose(end.get_ydata(), 0.0) and end.get_linestyle() == "--"
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["peak (largest |value|) over the run",
+                                                                   "at the end of the run"]
+    assert ax.get_ylabel() == "plug_force: peak over the run and at the end"
+    assert "3 of 4 cases finished" in ax.get_title()
+
+    for row in rows[:3]:  # the end is the peak: one line
+        row["extremes"]["plug_force"] = (0.0, 0.0)
+    (ax,) = sweep_figure(sweep, rows).axes
+    assert len(ax.lines) == 1 and ax.get_ylabel() == "plug_force: peak over the run"
+    assert plot_sweep(tmp_path / "sweep.png", sweep, rows) and (tmp_path / "sweep.png").stat().st_size > 0
+    assert not list(tmp_path.glob(".*.tmp"))
