@@ -163,6 +163,16 @@ def test_the_hydrostatic_pressure_under_either_name():
     assert np.array_equal(field_values({"pressure": np.ones(2)}, "hydrostatic_pressure", {})[0], np.ones(2))
 
 
+@pytest.mark.parametrize("name", ["hydrostatic_pressure", "cauchy_stress_rr", "cauchy_stress_zz", "cauchy_stress_tt",
+                                  "cauchy_stress_rz"])
+def test_the_scalar_stress_fields_have_names_and_units(name):
+    """The scalars a VTU file holds (fields.with_components): a name and a unit on the colour bar."""
+    label = field_values({name: np.array([1.0, 2.0])}, name, {"pressure": "MPa"})[1]
+    assert label.endswith(" (MPa)") and name not in label
+    if name.startswith("cauchy"):
+        assert label == f"Cauchy stress {name.rsplit('_', 1)[1]} (MPa)"
+
+
 def test_sweep_legend_names_what_varies(tmp_path):
     """A [[cases]] table that leaves a key to the case file: its line says the case file's
     value, not '(case)'."""
