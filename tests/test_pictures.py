@@ -230,3 +230,29 @@ def test_sweep_plots_the_peak_of_a_monitor_that_ends_at_zero(tmp_path):
     assert len(ax.lines) == 1 and ax.get_ylabel() == "plug_force: peak over the run"
     assert plot_sweep(tmp_path / "sweep.png", sweep, rows) and (tmp_path / "sweep.png").stat().st_size > 0
     assert not list(tmp_path.glob(".*.tmp"))
+
+
+def test_post_imports_nothing_above_it():
+    """Data flows one way: post/ imports neither app/, io/ nor solve/ at run time (in a
+    function either); `if TYPE_CHECKING:` imports for annotations are fine."""
+    above = ("app", "io", "solve")
+
+    def names(node) -> list[str]:
+        if isinstance(node, ast.ImportFrom):
+            module = node.module or ""
+            if node.level == 2:
+                return [module] + ([f"{a.name}" for a in node.names] if not module else [])
+            if node.level == 0 and module.startswith("axiform."):
+                return [module.removeprefix("axiform.")]
+        if isinstance(node, ast.Import):
+            return [a.name.removeprefix("axiform.") for a in node.names if a.name.startswith("axiform.")]
+        return []
+
+    for path in POST.glob("*.py"):
+        tree = ast.parse(path.read_text())
+        typing_only = {id(n) for block in ast.walk(tree) if isinstance(block, ast.If)
+                       and "TYPE_CHECKING" in ast.unparse(block.test) for n in ast.walk(block)}
+        for node in ast.walk(tree):
+            if id(node) not in typing_only:
+                for name in names(node):
+                    assert name.split(".")[0] not in above, f"{path.name}:{node.lineno} imports {name}"
