@@ -143,3 +143,27 @@ def test_the_command_from_a_shell(tmp_path):
                           "--out", str(tmp_path / "bad"), "-q", "--set", "solver.steps=-1"],
                          env=env, capture_output=True, text=True, timeout=120)
     assert bad.returncode == 2 and "solver.steps" in bad.stderr
+
+
+def test_a_run_says_why_a_picture_is_missing(tmp_path, capsys, monkeypatch):
+    """Each picture not drawn is a `note:` line on stderr and in summary.json's `notes`; a mesh
+    without through-thickness fibres (a gmsh mesh) has no thickness.png by design: no note."""
+    out = tmp_path / "b"
+    assert main(["run", str(EXAMPLES / "balloon.toml"), "--out", str(out), "-q", "--set", "output.vtu=false"]) == 0
+    notes = json.loads((out / "summary.json").read_text())["notes"]
+    assert notes == ["no deformed.png: no field output (output.vtu = false)"]
+    assert "note: no deformed.png: no field output" in capsys.readouterr().err
+
+    out = tmp_path / "d"
+    assert main(["run", str(EXAMPLES / "balloon.toml"), "--out", str(out), "-q"]) == 0
+    assert "notes" not in json.loads((out / "summary.json").read_text())
+    assert "note:" not in capsys.readouterr().err
+
+    import axiform.fem.mesh
+
+    monkeypatch.setattr(axiform.fem.mesh, "_set_fibres", lambda *args: None)  # as a gmsh mesh
+    out = tmp_path / "c"
+    assert main(["run", str(EXAMPLES / "balloon.toml"), "--out", str(out), "-q", "--set", "output.vtu=false"]) == 0
+    assert not (out / "thickness.png").exists() and (out / "load_curve.png").exists()
+    assert json.loads((out / "summary.json").read_text())["notes"] == notes
+    assert "thickness.png" not in capsys.readouterr().err

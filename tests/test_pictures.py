@@ -163,6 +163,16 @@ def test_the_hydrostatic_pressure_under_either_name():
     assert np.array_equal(field_values({"pressure": np.ones(2)}, "hydrostatic_pressure", {})[0], np.ones(2))
 
 
+@pytest.mark.parametrize("name", ["hydrostatic_pressure", "cauchy_stress_rr", "cauchy_stress_zz", "cauchy_stress_tt",
+                                  "cauchy_stress_rz"])
+def test_the_scalar_stress_fields_have_names_and_units(name):
+    """The scalars a VTU file holds (fields.with_components): a name and a unit on the colour bar."""
+    label = field_values({name: np.array([1.0, 2.0])}, name, {"pressure": "MPa"})[1]
+    assert label.endswith(" (MPa)") and name not in label
+    if name.startswith("cauchy"):
+        assert label == f"Cauchy stress {name.rsplit('_', 1)[1]} (MPa)"
+
+
 def test_sweep_legend_names_what_varies(tmp_path):
     """A [[cases]] table that leaves a key to the case file: its line says the case file's
     value, not '(case)'."""
@@ -176,6 +186,11 @@ def test_sweep_legend_names_what_varies(tmp_path):
     cases = with_defaults(sweep)
     assert [c["solver.steps"] for c in cases] == [10, 40] and cases[1]["contact[0].friction"] == 0.3
     assert [legend_label(c, ["solver.steps"]) for c in cases] == ["solver.steps = 10", "solver.steps = 40"]
+    from axiform.app.sweep import toml_value
+    from axiform.post.sweep_plots import value_text
+
+    for value in (0.3, "q8", [1, 2.5], {"a": [1, "x"]}, True, "a\nb"):
+        assert value_text(value) == toml_value(value)
 
 
 def test_picture_functions_are_short():
@@ -184,3 +199,60 @@ def test_picture_functions_are_short():
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.FunctionDef):
                 assert node.end_lineno - node.lineno < 80, f"{path.name}: {node.name}"
+
+
+def test_sweep_plots_the_peak_of_a_monitor_that_ends_at_zero(tmp_path):
+    """A friction sweep whose plug force is back at 0 at the end of every case: sweep.png
+    plots the peak over the run (the largest magnitude, signed), and the end value dashed."""
+    from axiform.app.sweep import Sweep
+    from axiform.post.sweep_plots import plot_sweep, sweep_figure
+
+    case = tmp_path / "c.toml"
+    case.write_text("[[contact]]\nfriction = 0.3\n")
+    frictions = [0.1, 0.2, 0.4]
+    sweep = Sweep(case, ["contact[0].friction"], [{"contact[0].friction": f} for f in frictions], "plug_force")
+    rows = [{"status": "finished", "monitors": {"plug_force": 0.0},
+             "extremes": {"plug_force": (-100.0 * (1 + f), 5.0)}} for f in frictions]
+    rows.append({"status": "failed"})
+    sweep.cases.append({"contact[0].friction": 0.8})
+    (ax,) = sweep_figure(sweep, rows).axes
+    peak, end = ax.lines
+    assert np.allclose(peak.get_xdata(), frictions) and np.allclose(peak.get_ydata(), [-110.0, -120.0, -140.0])
+    assert np.allclose(end.get_ydata(), 0.0) and end.get_linestyle() == "--"
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["peak (largest |value|) over the run",
+                                                                   "at the end of the run"]
+    assert ax.get_ylabel() == "plug_force: peak over the run and at the end"
+    assert "3 of 4 cases finished" in ax.get_title()
+
+    for row in rows[:3]:  # the end is the peak: one line
+        row["extremes"]["plug_force"] = (0.0, 0.0)
+    (ax,) = sweep_figure(sweep, rows).axes
+    assert len(ax.lines) == 1 and ax.get_ylabel() == "plug_force: peak over the run"
+    assert plot_sweep(tmp_path / "sweep.png", sweep, rows) and (tmp_path / "sweep.png").stat().st_size > 0
+    assert not list(tmp_path.glob(".*.tmp"))
+
+
+def test_post_imports_nothing_above_it():
+    """Data flows one way: post/ imports neither app/, io/ nor solve/ at run time (in a
+    function either); `if TYPE_CHECKING:` imports for annotations are fine."""
+    above = ("app", "io", "solve")
+
+    def names(node) -> list[str]:
+        if isinstance(node, ast.ImportFrom):
+            module = node.module or ""
+            if node.level == 2:
+                return [module] + ([f"{a.name}" for a in node.names] if not module else [])
+            if node.level == 0 and module.startswith("axiform."):
+                return [module.removeprefix("axiform.")]
+        if isinstance(node, ast.Import):
+            return [a.name.removeprefix("axiform.") for a in node.names if a.name.startswith("axiform.")]
+        return []
+
+    for path in POST.glob("*.py"):
+        tree = ast.parse(path.read_text())
+        typing_only = {id(n) for block in ast.walk(tree) if isinstance(block, ast.If)
+                       and "TYPE_CHECKING" in ast.unparse(block.test) for n in ast.walk(block)}
+        for node in ast.walk(tree):
+            if id(node) not in typing_only:
+                for name in names(node):
+                    assert name.split(".")[0] not in above, f"{path.name}:{node.lineno} imports {name}"

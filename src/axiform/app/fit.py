@@ -393,7 +393,7 @@ def run(paths: list[str], model: str, terms: int | None, out: str | None, kappa:
     }
     (folder / "fit.json").write_text(json.dumps(summary, indent=2) + "\n")
     for mode in result.points:
-        plot(result, data, mode, folder / f"fit_{mode}.png")
+        plot(result, data, mode, folder / f"fit_{mode}.png", MODES, nominal_stress)
     print(f"{_name(result)} fitted to {counts} points; initial shear modulus {result.law.shear_modulus:.6g}\n")
     print(table)
     print(f"{'mode':<12} {'points':>6}  RMS relative error")

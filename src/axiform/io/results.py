@@ -409,11 +409,27 @@ class ResultsWriter:
             self._vtu_writer.shutdown()
             self._vtu_writer = None
         if self.plots and self.steps:
-            from ..post.plots import plot_folder
-
-            plot_folder(self.out)
+            self._plot()
         if failure is not None:
             raise failure
+
+    def _plot(self) -> None:
+        """Draw the plots; each picture not drawn is said on stderr (`note: no X.png: why`)
+        and listed in summary.json's `notes`.  A mesh without through-thickness fibres (a
+        gmsh mesh, say) has no thickness.csv by design: its missing thickness.png is no news."""
+        from ..post.plots import plot_folder
+
+        made = plot_folder(self.out)
+        missing = dict(made.missing)
+        if self.model.mesh.fibres is None:
+            missing.pop("thickness.png", None)
+        notes = [f"no {name}: {why}" for name, why in missing.items()]
+        if not notes:
+            return
+        for line in notes:
+            print(f"note: {line}", file=sys.stderr)
+        self.summary["notes"] = notes
+        self._write_summary()
 
     def _end_of_run(self, step) -> None:
         """The run's checks on its last step (run_report.RunRecord): the stabilization's work

@@ -43,10 +43,11 @@ def _is_thin(x: np.ndarray, cells: np.ndarray, extent: float) -> bool:
 
 
 def _end_time(built) -> float:
-    from ..solve.solver import DisplacementControl
-
+    """The load factor at the end of the run: its target, but 1 under a displacement control
+    (its target is the driven dof's displacement; known by its `dof`, so that post/ needs no
+    solve/ import)."""
     control = built.control
-    return 1.0 if isinstance(control, DisplacementControl) else float(control.target)
+    return 1.0 if getattr(control, "dof", None) is not None else float(control.target)
 
 
 def _mould_points(surface) -> np.ndarray:

@@ -17,7 +17,9 @@ FIELD_NAMES = {"von_mises": ("von Mises stress", "stress"), "J": ("J = det F", "
                "contact_pressure": ("contact pressure", "pressure"), "fibre_rotation": ("fibre rotation", "rotation"),
                "first_contact": ("time of first contact", "time"),
                "pressure": ("hydrostatic pressure −tr σ / 3", "stress"),
-               "hydrostatic_pressure": ("hydrostatic pressure −tr σ / 3", "stress")}
+               "hydrostatic_pressure": ("hydrostatic pressure −tr σ / 3", "stress"),
+               # the components the VTU files hold besides as scalars (fields.with_components)
+               **{f"cauchy_stress_{c}": (f"Cauchy stress {c}", "stress") for c in ("rr", "zz", "tt", "rz")}}
 # the same field under an older or a newer name: either is accepted for the other
 ALIASES = {"pressure": "hydrostatic_pressure", "hydrostatic_pressure": "pressure"}
 COMPONENTS = {"displacement": ("ur", "uz"), "cauchy_stress": ("rr", "zz", "tt", "rz"),

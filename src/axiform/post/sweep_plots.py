@@ -1,9 +1,15 @@
-"""sweep.png of `axiform sweep` (axiform.app.sweep): the report monitor against a varied key."""
+"""sweep.png of `axiform sweep` (axiform.app.sweep): the report monitor against a varied key:
+its peak over each case's run (the value of largest magnitude, from the rows' `extremes`, the
+sweep.csv columns M_min / M_max) and, where it differs, its value at the end.  A monitor that
+goes back to 0 at the end of a run (a plug force after the plug withdraws) would otherwise plot
+as a flat line."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from .figures import new_figure, save, wrapped
 
@@ -11,11 +17,19 @@ if TYPE_CHECKING:
     from ..app.sweep import Sweep
 
 
+def value_text(value: Any) -> str:
+    """A value (as tomllib reads it) as one line of TOML: tomli-w's text of it, its arrays
+    joined on one line (the same text as axiform.app.sweep.toml_value, which the overrides use)."""
+    import tomli_w
+
+    text = tomli_w.dumps({"v": [value]}, indent=0)  # in an array: a table is written inline
+    text = text.removeprefix("v = [\n").removesuffix(",\n]\n")
+    return text.replace("[\n", "[").replace(",\n]", "]").replace(",\n", ", ")
+
+
 def _text(value: Any) -> str:
     """A varied value in a label ("default" where neither the sweep nor the case file sets it)."""
-    from ..app.sweep import toml_value
-
-    return "default" if value is None else toml_value(value)
+    return "default" if value is None else value_text(value)
 
 
 def case_file_value(case_file: Path, key: str) -> Any:
@@ -52,12 +66,20 @@ def legend_label(case: dict[str, Any], keys: list[str]) -> str:
     return ", ".join(f"{k} = {_text(case.get(k))}" for k in keys)
 
 
-def plot_sweep(path: Path, sweep: Sweep, rows: list[dict | None]) -> bool:
-    """sweep.png: the report monitor against the first key that takes several values, one
-    line for each combination of the other such keys; cases that did not finish are left out
-    (and counted)."""
-    if sweep.report is None or not sweep.keys:
-        return False
+def peak_and_end(row: dict, monitor: str) -> tuple[float, float] | None:
+    """A finished case's (peak, end) of `monitor`: the peak is the value of largest magnitude
+    over the run (its `extremes`; the end value where the row has none); None for a case that
+    did not finish or has no such monitor."""
+    if not row or row.get("status") != "finished" or monitor not in row.get("monitors", {}):
+        return None
+    end = float(row["monitors"][monitor])
+    low, high = (row.get("extremes") or {}).get(monitor, (end, end))
+    return (float(high) if abs(high) >= abs(low) else float(low)), end
+
+
+def sweep_points(sweep: Sweep, rows: list[dict | None]) -> tuple[str, list[str], bool, dict[str, list]]:
+    """The first key that takes several values, its values as text, whether they are numbers,
+    and the points (x, peak, end) of each line ('key = value' of the other varied keys)."""
     cases = with_defaults(sweep)
     # keys that take one value in every case say nothing on the picture
     varied = [k for k in sweep.keys if len({_text(c.get(k)) for c in cases}) > 1] or sweep.keys[:1]
@@ -65,29 +87,47 @@ def plot_sweep(path: Path, sweep: Sweep, rows: list[dict | None]) -> bool:
     xs = list(dict.fromkeys(_text(case.get(first)) for case in cases))  # values as text: lists too
     values = {_text(case.get(first)): case.get(first) for case in cases}
     numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values.values())
-    groups: dict[str, list[tuple[float, float]]] = {}
+    groups: dict[str, list[tuple[float, float, float]]] = {}
     for case, row in zip(cases, rows):
-        if row and row.get("status") == "finished" and sweep.report in row.get("monitors", {}):
-            label = legend_label(case, others)
+        found = peak_and_end(row, sweep.report)
+        if found is not None:
             x = _text(case.get(first))
-            groups.setdefault(label, []).append((values[x] if numeric else xs.index(x), row["monitors"][sweep.report]))
+            groups.setdefault(legend_label(case, others), []).append((values[x] if numeric else xs.index(x), *found))
+    return first, xs, numeric, groups
+
+
+def plot_sweep(path: Path, sweep: Sweep, rows: list[dict | None]) -> bool:
+    """sweep.png (sweep_figure); False where the sweep reports no monitor or varies no key."""
+    if sweep.report is None or not sweep.keys:
+        return False
+    save(sweep_figure(sweep, rows), path, dpi=120, format="png")
+    return True
+
+
+def sweep_figure(sweep: Sweep, rows: list[dict | None]):
+    """The report monitor's peak over the run (largest magnitude) against the first key that
+    takes several values, one line for each combination of the other such keys, with its end
+    value dashed where that differs; cases that did not finish are left out (and counted)."""
+    first, xs, numeric, groups = sweep_points(sweep, rows)
+    ends = any(not np.isclose(p[1], p[2], rtol=1e-9, atol=0.0) for points in groups.values() for p in points)
     fig = new_figure((6.4, 4.4))
     ax = fig.add_subplot()
     for label, points in groups.items():
         points.sort()
-        ax.plot([p[0] for p in points], [p[1] for p in points], marker="o", label=label or None)
+        x = [p[0] for p in points]
+        prefix = f"{label}: " if label else ""
+        (line,) = ax.plot(x, [p[1] for p in points], marker="o", label=f"{prefix}peak (largest |value|) over the run")
+        if ends:
+            ax.plot(x, [p[2] for p in points], marker="s", linestyle="--", color=line.get_color(), alpha=0.7,
+                    label=f"{prefix}at the end of the run")
     if not numeric:
         ax.set_xticks(range(len(xs)), xs)
     finished = sum(1 for r in rows if r and r.get("status") == "finished")
     ax.set_xlabel(first)
-    ax.set_ylabel(sweep.report)
+    ax.set_ylabel(f"{sweep.report}: peak over the run" + (" and at the end" if ends else ""))
     ax.set_title(wrapped(f"{sweep.report} against {first}: {finished} of {len(rows)} cases finished", 6.0, 10),
                  fontsize=10)
     ax.grid(True, alpha=0.3)
-    if others and groups:
+    if groups:
         ax.legend(fontsize=8)
-    from ..io.results import atomic
-
-    with atomic(path) as tmp:
-        save(fig, tmp, dpi=120, format="png")
-    return True
+    return fig
