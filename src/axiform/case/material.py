@@ -15,6 +15,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, ValidationInfo, field_validator, model_validator
 
 from ..materials import ArrudaBoyce, Gent, Hyperelastic, MooneyRivlin, Ogden, Yeoh
+from ..materials.viscoelastic import Prony, Viscoelastic
 
 Model = Literal["neo-hooke", "mooney-rivlin", "yeoh", "ogden", "gent", "arruda-boyce"]
 
@@ -64,6 +65,22 @@ def _numbers(value: Any, what: str) -> list[float]:
     return out
 
 
+class ViscoelasticSpec(BaseModel):
+    """`viscoelastic = { g = [...], tau = [...] }`: a Prony series on the law's isochoric
+    stress (materials.viscoelastic), 1 to 8 terms, 0 < g_i, sum g < 1, tau_i > 0 in the case's
+    time unit."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+    g: list[float]
+    tau: list[float]
+
+    @model_validator(mode="after")
+    def _series(self):
+        Prony(tuple(self.g), tuple(self.tau))  # its checks name what is wrong
+        return self
+
+
 class MaterialSpec(BaseModel):
     """The [material] table (see the module docstring)."""
 
@@ -82,6 +99,7 @@ class MaterialSpec(BaseModel):
     kappa: float | None = None
     E: float | None = None
     nu: float | None = None
+    viscoelastic: ViscoelasticSpec | None = None
 
     @field_validator(*_RANGE, mode="before")
     @classmethod
@@ -141,7 +159,14 @@ class MaterialSpec(BaseModel):
             raise ValueError(f"missing material constant: {', '.join(missing)}")
         return self
 
-    def build(self) -> Hyperelastic:
+    def build(self) -> Hyperelastic | Viscoelastic:
+        """The law (with its Prony series where `viscoelastic` is given)."""
+        law = self.elastic_law()
+        if self.viscoelastic is None:
+            return law
+        return Viscoelastic(law, Prony(tuple(self.viscoelastic.g), tuple(self.viscoelastic.tau)))
+
+    def elastic_law(self) -> Hyperelastic:
         """The law, with kappa given or from E and nu, and the shear constant from E and nu
         where it was left out."""
         kappa = self.kappa if self.kappa is not None else self.E / (3.0 * (1.0 - 2.0 * self.nu))

@@ -61,7 +61,12 @@ class SolverSpec(Strict):
 
 def build_control(model: Model, mesh: Mesh, spec: SolverSpec) -> LoadControl | DisplacementControl | ArcLengthControl:
     """The path-following control of the [solver] table, on the model with its [[fix]] tables
-    prescribed (a driven or stop dof that is also fixed is refused)."""
+    prescribed (a driven or stop dof that is also fixed is refused).  A law with memory makes
+    the load factor the process time: only load control advances it."""
+    if spec.control != "load" and getattr(model.material, "prony", None) is not None:
+        raise CaseError(f"solver.control: \"{spec.control}\" does not work with a viscoelastic material: the load "
+                        "factor is the process time there, and time must advance; use control = \"load\" with a "
+                        "cavity under volume or gas control, or a prescribed motion with its curve")
     if spec.control == "displacement":
         if spec.dof.dof == "rot":
             raise CaseError("solver.dof.dof: drive a displacement (ur or uz), not a fibre rotation")

@@ -10,6 +10,7 @@ import numpy as np
 
 from .elements import gradient_operator
 from ..materials import InvertedElementError, deformation_gradient
+from ..materials.viscoelastic import Memory
 from .mesh import Mesh
 
 
@@ -72,9 +73,12 @@ class SolidAssembly:
         e, _, _, nd = self.G.shape
         return np.empty((e, nd)), np.empty((e, nd, nd)) if tangent else None
 
-    def evaluate(self, u_full: np.ndarray, tangent: bool = True, out: tuple | None = None):
+    def evaluate(self, u_full: np.ndarray, tangent: bool = True, out: tuple | None = None,
+                 memory: Memory | None = None):
         """Element internal forces fe (e, nd) and, if asked, element tangents Ke (e, nd, nd),
-        written into out = (fe, Ke) when given (from `buffers`) and returned."""
+        written into out = (fe, Ke) when given (from `buffers`) and returned.  memory: the
+        step of a law with a history per quadrature point (materials.viscoelastic.Memory),
+        whose trial arrays are filled here."""
         e, q, _, nd = self.G.shape
         fe, Ke = out if out is not None else self.buffers(tangent)
         for sl, x in self.chunks(u_full):
@@ -82,9 +86,15 @@ class SolidAssembly:
             GdV_T = self._GdV[sl].transpose(0, 2, 1)
             if tangent:
                 P, A = self.material.stress_tangent(x)
+            else:
+                P, A = self.material.stress(x), None
+            if memory is not None:
+                P_iso, A_iso = self.material.iso_stress_tangent(x) if tangent else (self.material.iso_stress(x), None)
+                dP, dA = memory.add(sl, x, P_iso, A_iso)
+                P = P + dP
+                A = None if A is None else A + dA
+            if tangent:
                 AG = np.matmul(A, self.G[sl]).reshape(m, q * 5, nd)
                 np.matmul(GdV_T, AG, out=Ke[sl])
-            else:
-                P = self.material.stress(x)
             np.matmul(GdV_T, P.reshape(m, q * 5, 1), out=fe[sl, :, None])
         return fe, Ke

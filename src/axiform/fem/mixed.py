@@ -112,9 +112,11 @@ class MixedAssembly(SolidAssembly):
         P += p * dJ
         return from_rows(P, None, shape)[0]
 
-    def evaluate(self, u_full: np.ndarray, tangent: bool = True, out: tuple | None = None):
+    def evaluate(self, u_full: np.ndarray, tangent: bool = True, out: tuple | None = None,
+                 memory=None):
         """Element internal forces fe (e, nd) and, if asked, element tangents Ke (e, nd, nd),
-        written into out = (fe, Ke) when given (from `buffers`) and returned.  The law's
+        written into out = (fe, Ke) when given (from `buffers`) and returned (memory: as for
+        SolidAssembly.evaluate).  The law's
         isochoric part (`stress_rows` with kappa = 0) and the pressure terms are computed on the
         contiguous component rows (5, n), then brought to (m, q, 5, 5) once."""
         e, q, _, nd = self.G.shape
@@ -125,6 +127,12 @@ class MixedAssembly(SolidAssembly):
             xt, shape = to_rows(x)
             p, dJ = self._pressure(xt, sl)
             P, A = self.material.stress_rows(xt, 0.0, tangent)
+            if memory is not None:  # the Prony series on the isochoric part (rows viewed as points)
+                dP, dA = memory.add(sl, xt.T.reshape(shape + (5,)), P.T.reshape(shape + (5,)),
+                                    None if A is None else A.transpose(2, 0, 1).reshape(shape + (5, 5)))
+                P += dP.reshape(-1, 5).T
+                if A is not None:
+                    A += dA.reshape(-1, 5, 5).transpose(1, 2, 0)
             P += p * dJ
             if tangent:
                 add_pressure_hessian(A, xt, p)

@@ -24,6 +24,7 @@ from ..contact.state import ContactState
 from ..fem.cavity import Cavity
 from ..fem.curves import Curve
 from ..fem.loads import FollowerPressure
+from ..materials.viscoelastic import Memory
 from .state import CavityState
 
 
@@ -63,16 +64,27 @@ class SolidTerm:
         self._scratch: dict[bool, tuple] = {}
 
     def initial_state(self) -> dict:
-        """The history per quadrature point before the first step: none for elastic laws."""
-        return {}
+        """The history per quadrature point before the first step: none for elastic laws; for
+        a law with a Prony series (materials.viscoelastic) its arrays (e, q, ...) and the
+        time t of the state."""
+        prony = getattr(self.assembly.material, "prony", None)
+        if prony is None:
+            return {}
+        return prony.initial(self.assembly.dV.shape) | {"t": np.zeros(())}
 
     def evaluate(self, u: np.ndarray, t: float, state: dict | None = None, tangent: bool = True) -> Contribution:
         if tangent not in self._scratch:
             self._scratch[tangent] = self.assembly.buffers(tangent)
-        fe, Ke = self.assembly.evaluate(u, tangent, self._scratch[tangent])
+        memory = None
+        if state:  # a law with memory: the step from the committed state's time to t
+            history = {k: v for k, v in state.items() if k != "t"}
+            dt = max(float(t) - float(state["t"]), 0.0)
+            memory = Memory(history, self.assembly.material.prony.factors(dt))
+        fe, Ke = self.assembly.evaluate(u, tangent, self._scratch[tangent], memory)
         dofs = self.assembly.dofs
+        trial = {} if memory is None else memory.trial | {"t": np.asarray(float(t))}
         return Contribution(assemble(dofs, fe, self.n_full), K=(Ke,) if tangent else (),
-                            magnitude=assemble(dofs, np.abs(fe), self.n_full), trial={})
+                            magnitude=assemble(dofs, np.abs(fe), self.n_full), trial=trial)
 
 
 class PressureTerm:

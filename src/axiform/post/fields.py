@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..materials import cauchy_stress
+from ..materials.viscoelastic import f_times
 from .thickness import contact_times, nodal_thickness, pieces, thickness_table
 
 
@@ -31,6 +32,9 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
     solid = model.solid
     x = solid.gradient(u_full)
     P = solid.stress(x)  # the formulation's stress (mixed: with the element pressure)
+    history = (state.solid if state is not None else {}).get("h")
+    if history is not None:  # a law with memory: S = S_law - sum h_i, P = F S
+        P = P - f_times(x, history.sum(axis=-2))
     J = x[..., 4] * (x[..., 0] * x[..., 3] - x[..., 1] * x[..., 2])
     sig = cauchy_stress(x, P)  # (e, q, 4): rr, zz, tt, rz
     s_rr, s_zz, s_tt, s_rz = (sig[..., i] for i in range(4))

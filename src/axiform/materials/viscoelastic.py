@@ -1,0 +1,138 @@
+"""Quasi-linear finite-strain viscoelasticity: a Prony series on the isochoric stress of any
+law (Simo 1987; Abaqus' convention for g_i).
+
+With S_iso the isochoric second Piola-Kirchhoff stress of the law (the instantaneous
+response), S = S_vol + S_iso - sum_i h_i, dh_i/dt = (g_i S_iso - h_i) / tau_i, h_i(0) = 0: a
+step of strain gives the law's stress at once and relaxes as g(t) = 1 - sum g_i (1 -
+exp(-t / tau_i)); the long-term response is (1 - sum g_i) times the law's isochoric part.
+The volumetric part stays elastic.
+
+Over a step of length dt, with S_iso linear in time (exact then):
+    h_i' = e_i h_i + g_i (gamma_i - e_i) S_n + g_i (1 - gamma_i) S',
+    e_i = exp(-dt / tau_i), gamma_i = (1 - e_i) tau_i / dt,
+so that P = F S = P_law(F) - c P_iso(F) - F H0 with H0 = sum_i (e_i h_i + g_i (gamma_i - e_i)
+S_n) and c = sum_i g_i (1 - gamma_i), and the consistent tangent A = A_law - c A_iso - d(F H0)/dF.
+
+Components: F and P as everywhere, x = (F_rR, F_rZ, F_zR, F_zZ, F_tT); the symmetric S and
+h_i as (S_RR, S_RZ, S_ZZ, S_TT).  History per quadrature point: h (..., m, 4) for m terms and
+the committed S_iso (..., 4).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+MAX_TERMS = 8
+
+
+@dataclass(frozen=True)
+class Prony:
+    """g_i (relative moduli, 0 < g_i, sum < 1) and tau_i (relaxation times > 0), m terms."""
+
+    g: tuple[float, ...]
+    tau: tuple[float, ...]
+
+    def __post_init__(self):
+        g, tau = np.asarray(self.g, float), np.asarray(self.tau, float)
+        if not 1 <= g.size <= MAX_TERMS or g.shape != tau.shape:
+            raise ValueError(f"give 1 to {MAX_TERMS} terms, as many g as tau")
+        if not ((g > 0).all() and g.sum() < 1):
+            raise ValueError("g: every g_i > 0 and their sum < 1")
+        if not (tau > 0).all():
+            raise ValueError("tau: every tau_i > 0")
+
+    def relaxation(self, t: np.ndarray) -> np.ndarray:
+        """g(t) = 1 - sum g_i (1 - exp(-t / tau_i)), the relaxation of a step of strain."""
+        t = np.asarray(t, float)[..., None]
+        return 1.0 - (np.asarray(self.g) * (1.0 - np.exp(-t / np.asarray(self.tau)))).sum(-1)
+
+    def factors(self, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per term over a step dt >= 0: e_i, a_i = g_i (gamma_i - e_i), b_i = g_i (1 - gamma_i)."""
+        g, tau = np.asarray(self.g, float), np.asarray(self.tau, float)
+        e = np.exp(-dt / tau)
+        gamma = (1.0 - e) * tau / dt if dt > 0 else np.ones_like(tau)
+        return e, g * (gamma - e), g * (1.0 - gamma)
+
+    def initial(self, points: tuple[int, ...]) -> dict[str, np.ndarray]:
+        """The history before the first step at quadrature points of shape `points`: no h, no S."""
+        return {"h": np.zeros(points + (len(self.g), 4)), "S": np.zeros(points + (4,))}
+
+
+def second_piola(x: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """S = F^-1 P (..., 4) of a symmetric S from F and P (..., 5)."""
+    a, b, c, d, f = (x[..., k] for k in range(5))
+    det = a * d - b * c
+    # inverse of the meridian block [[a, b], [c, d]] (rows r, z; columns R, Z)
+    S_RR = (d * P[..., 0] - b * P[..., 2]) / det
+    S_RZ = (d * P[..., 1] - b * P[..., 3]) / det
+    S_ZR = (-c * P[..., 0] + a * P[..., 2]) / det
+    S_ZZ = (-c * P[..., 1] + a * P[..., 3]) / det
+    return np.stack([S_RR, 0.5 * (S_RZ + S_ZR), S_ZZ, P[..., 4] / f], axis=-1)
+
+
+def f_times(x: np.ndarray, H: np.ndarray) -> np.ndarray:
+    """F H (..., 5) for a symmetric H (..., 4)."""
+    RR, RZ, ZZ, TT = (H[..., k] for k in range(4))
+    return np.stack([x[..., 0] * RR + x[..., 1] * RZ, x[..., 0] * RZ + x[..., 1] * ZZ,
+                     x[..., 2] * RR + x[..., 3] * RZ, x[..., 2] * RZ + x[..., 3] * ZZ, x[..., 4] * TT], axis=-1)
+
+
+def d_f_times(H: np.ndarray) -> np.ndarray:
+    """d(F H)/dF (..., 5, 5) for a constant symmetric H (..., 4)."""
+    D = np.zeros(H.shape[:-1] + (5, 5))
+    RR, RZ, ZZ, TT = (H[..., k] for k in range(4))
+    for row, col in ((0, 0), (2, 2)):  # (F H)_iR = F_iR H_RR + F_iZ H_ZR
+        D[..., row, col], D[..., row, col + 1] = RR, RZ
+    for row, col in ((1, 0), (3, 2)):  # (F H)_iZ = F_iR H_RZ + F_iZ H_ZZ
+        D[..., row, col], D[..., row, col + 1] = RZ, ZZ
+    D[..., 4, 4] = TT
+    return D
+
+
+def viscous_part(x: np.ndarray, P_iso: np.ndarray, A_iso: np.ndarray | None, history: dict[str, np.ndarray],
+                 factors: tuple[np.ndarray, np.ndarray, np.ndarray]):
+    """What the Prony series adds to the law's P (..., 5) and A (..., 5, 5) at F = x over a
+    step (its `factors`, Prony.factors) from the committed history (h (..., m, 4), S (...,
+    4)), and the trial history at its end."""
+    e, a, b = factors
+    h, S_n = history["h"], history["S"]
+    S = second_piola(x, P_iso)
+    H0 = np.einsum("m,...mk->...k", e, h) + a.sum() * S_n
+    c = float(b.sum())
+    dP = -(f_times(x, H0) + c * P_iso)
+    dA = None if A_iso is None else -(d_f_times(H0) + c * A_iso)
+    trial = {"h": e[:, None] * h + a[:, None] * S_n[..., None, :] + b[:, None] * S[..., None, :], "S": S}
+    return dP, dA, trial
+
+
+class Viscoelastic:
+    """A law (materials.Hyperelastic) as the instantaneous response, with a Prony series on its
+    isochoric part (`prony`).  Everything else (energy, moduli, kappa) is the law's."""
+
+    def __init__(self, law, prony: Prony):
+        self.law = law
+        self.prony = prony
+
+    def __getattr__(self, name: str):
+        return getattr(self.law, name)
+
+
+class Memory:
+    """One evaluation's use of the history of a law with memory: the committed history
+    (arrays (e, q, ...)), the step's factors (Prony.factors), and the trial history filled
+    chunk by chunk of elements (`add`)."""
+
+    def __init__(self, committed: dict[str, np.ndarray], factors: tuple[np.ndarray, np.ndarray, np.ndarray]):
+        self.committed = committed
+        self.factors = factors
+        self.trial = {k: np.empty_like(v) for k, v in committed.items()}
+
+    def add(self, sl: slice, x: np.ndarray, P_iso: np.ndarray, A_iso: np.ndarray | None):
+        """What the memory adds to P and A at the points x (m, q, 5) of the elements sl."""
+        history = {k: v[sl] for k, v in self.committed.items()}
+        dP, dA, trial = viscous_part(x, P_iso, A_iso, history, self.factors)
+        for k, v in trial.items():
+            self.trial[k][sl] = v
+        return dP, dA
