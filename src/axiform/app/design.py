@@ -1,4 +1,4 @@
-"""The problem of parison and preform programming (DESIGN 10.10; the methods are in
+"""The problem of parison and preform programming (the methods are in
 optimize.py): the design, the thickness table of a layered case (`ThicknessDesign`), the
 target final wall (`read_target`) and the least-squares misfit to it (`Objective`).
 

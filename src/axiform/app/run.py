@@ -32,7 +32,7 @@ EXIT = {"finished": 0, "stopped": 1, "failed": 3}
 # history.csv, summary.json, thickness.csv and fields.pvd are rewritten at most every half
 # second (and whenever the run ends): four atomic rewrites a step (benchmarks/README.md § 3.1)
 FLUSH_EVERY_S = 0.5
-# the case tables a resumed run may not change (DESIGN 10.9): the model must be the same
+# the case tables a resumed run may not change: the model must be the same
 FROZEN_ON_RESUME = ("mesh", "material")
 
 

@@ -1,5 +1,5 @@
 """`axiform sweep SWEEP.toml --out DIR [--scheduler ADDRESS] [--workers N]`: many variants
-of one case on a Dask cluster (DESIGN § 10.8).
+of one case on a Dask cluster.
 
     case = "plate.toml"                 # relative to SWEEP.toml
     [vary]                              # full factorial over the listed values of case keys

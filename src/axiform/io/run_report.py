@@ -1,4 +1,4 @@
-"""What summary.json says about a whole run besides the last step (DESIGN § 13): per contact
+"""What summary.json says about a whole run besides the last step: per contact
 pair the largest force and the largest penetration against the local wall over the run,
 whether it ever touched; the thinnest wall of the last thickness table; the work of the
 contact stabilization against the strain energy; and the warnings drawn from them at the
