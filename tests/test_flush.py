@@ -78,14 +78,14 @@ def test_a_vtu_file_that_cannot_be_written_fails_the_run_keeping_the_steps_befor
     from axiform.io import results
     from axiform.cli import main
 
-    write_vtu = results._write_vtu
+    write_vtu = results.write_vtu
 
     def full_disk(path, mesh, data):
         if path.name == f"step_{bad:04d}.vtu":
             raise OSError(28, "No space left on device")
         write_vtu(path, mesh, data)
 
-    monkeypatch.setattr(results, "_write_vtu", full_disk)
+    monkeypatch.setattr(results, "write_vtu", full_disk)
     out = tmp_path / "out"
     assert main(["run", str(PLATE), "--out", str(out), "-q", "--set", "output.plots=false",
                  "--set", "solver.steps=6", "--set", "solver.target=1.5"]) == 3

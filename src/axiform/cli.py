@@ -35,6 +35,14 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
                                             "go to stdout, warnings and errors to stderr.")
     parser.add_argument("--version", action="version", version=f"axiform {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
+    _run_and_check(sub)
+    p_fit = _plot_and_fit(sub)
+    _optimize_and_sweep(sub)
+    return parser, p_fit
+
+
+def _run_and_check(sub) -> None:
+    """The `run` and `check` sub-parsers."""
     p_run = sub.add_parser("run", help="run a case file and write its results folder",
                            description="Run a case file and write its results folder as the steps converge.")
     p_run.add_argument("case", help="the case file (TOML)")
@@ -56,6 +64,10 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
         p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                        help="override a key, VALUE in TOML syntax: --set mesh.element='\"q8\"' "
                             "--set mesh.divisions=[40,4] --set contact[1].friction=0.0 (repeatable)")
+
+
+def _plot_and_fit(sub) -> argparse.ArgumentParser:
+    """The `plot` and `fit` sub-parsers; returns `fit`'s."""
     p_plot = sub.add_parser("plot", help="write the PNG plots of a results folder",
                             description="(Re)write the PNG plots of a results folder: load_curve.png, "
                                         "thickness.png, deformed.png.")
@@ -80,6 +92,11 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
     p_fit.add_argument("--terms", type=int, help="Ogden: number of terms, 1 to 6 (default 3)")
     p_fit.add_argument("--out", help="output folder (default: results/fit-<model>)")
     p_fit.add_argument("--kappa", type=float, help="bulk modulus written (default: 1000 x the initial shear modulus)")
+    return p_fit
+
+
+def _optimize_and_sweep(sub) -> None:
+    """The `optimize` and `sweep` sub-parsers."""
     p_opt = sub.add_parser("optimize", help="program a parison / preform: the thickness table that gives a target "
                                             "final wall",
                            description="Find the mesh.thickness table of a layered case whose final wall meets "
@@ -108,7 +125,6 @@ def build_parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
     p_sweep.add_argument("--out", required=True, help="the sweep folder: cases/NNNN/, sweep.csv, sweep.png")
     p_sweep.add_argument("--scheduler", help="address of a running Dask scheduler (default: a LocalCluster)")
     p_sweep.add_argument("--workers", type=int, help="worker processes of the LocalCluster (default: the cores)")
-    return parser, p_fit
 
 
 def dispatch(args: argparse.Namespace) -> int:

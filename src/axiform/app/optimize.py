@@ -260,7 +260,7 @@ def write_outputs(out: Path, design: ThicknessDesign, result: OptimizeResult,
     """optimized.toml, optimize.csv, optimize.json and optimize.png in `out`."""
     import csv
 
-    from ..io.results import write_atomic
+    from ..io.files import write_atomic
 
     write_atomic(out / "optimized.toml", case_text(design, result.best.design))
     table = io.StringIO()
@@ -293,7 +293,7 @@ def _invalid_option(max_iter: int, tolerance: float, smoothness: float) -> str |
 def run_final(out_dir: Path, design: ThicknessDesign, result: OptimizeResult, quiet: bool) -> Path | None:
     """optimized.toml and its run in out_dir/final/ (as `axiform run`); the folder, None
     when no design finished.  A final run that does not finish makes the result "stopped"."""
-    from ..io.results import write_atomic
+    from ..io.files import write_atomic
     from .run import run as run_case
 
     if not result.best.finished:

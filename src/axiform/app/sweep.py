@@ -270,7 +270,7 @@ class SweepProgress:
 
 def write_table(path: Path, sweep: Sweep, rows: list[dict | None]) -> None:
     """sweep.csv: one row per case (status "pending" for those not done yet), atomically."""
-    from ..io.results import write_atomic
+    from ..io.files import write_atomic
 
     text = io.StringIO()
     w = csv.writer(text, lineterminator="\n")

@@ -372,29 +372,38 @@ class Polyline(RigidSurface):
         out.s[bi] = self.s0[bk] + np.clip(xi[best], 0.0, 1.0) * self.L[bk]
         out.s_prev[bi] = self.s0[bk] + np.clip(xi0[best], 0.0, 1.0) * self.L[bk]
         out.kind[bi] = np.where(crossed[best], 3, 1)
-        # cavity corners: a node behind piece k beyond its end and behind k+1 before its start
         if len(self.a) > 1 and len(bi) < nn:
-            free = ~out.active[i]
-            behind = (g < 0) & (g > -depth) & free
-            beyond = behind & (xi > 1 + tol)
-            before = behind & (xi < -tol) & (k >= 1)
-            if beyond.any() and before.any():
-                M = len(self.a)
-                nb, sb = i[before], k[before]
-                # the previous piece's pair is a candidate beyond its end, and the mould turns
-                # towards the body at the vertex (pairs sorted by node: the first such per node)
-                hit = np.isin(nb * M + sb - 1, i[beyond] * M + k[beyond]) & self._cavity[sb]
-                nb, sb = nb[hit], sb[hit]
-                if len(nb):
-                    nb, first = np.unique(nb, return_index=True)
-                    sb = sb[first]
-                    v, nv = self.b[sb - 1], self._vertex_n[sb]
-                    out.active[nb] = True
-                    out.n[nb] = nv
-                    out.t[nb] = np.column_stack([nv[:, 1], -nv[:, 0]])
-                    # np.dot node by node, as ever (BLAS may round a dot product otherwise): few nodes
-                    out.g[nb] = [float(np.dot(d, e)) for d, e in zip(x[nb] - v, nv)]
-                    out.s[nb] = out.s_prev[nb] = self.s0[sb]
-                    out.point[nb] = v
-                    out.kind[nb] = 2
+            self._cavity_corners(out, x, i, k, g, xi, depth, tol)
         return out
+
+    def _cavity_corners(self, out: Projection, x: np.ndarray, i: np.ndarray, k: np.ndarray, g: np.ndarray,
+                        xi: np.ndarray, depth: float, tol: float) -> None:
+        """Step 3 of `local`, in place on `out`: a node still without a contact point, behind
+        piece k beyond its end and behind piece k+1 before its start, where the mould turns
+        towards the body, touches the vertex, with the mean of the two normals.  Over the
+        candidate pairs (i node, k piece) and their projections (g, xi)."""
+        free = ~out.active[i]
+        behind = (g < 0) & (g > -depth) & free
+        beyond = behind & (xi > 1 + tol)
+        before = behind & (xi < -tol) & (k >= 1)
+        if not (beyond.any() and before.any()):
+            return
+        M = len(self.a)
+        nb, sb = i[before], k[before]
+        # the previous piece's pair is a candidate beyond its end, and the mould turns
+        # towards the body at the vertex (pairs sorted by node: the first such per node)
+        hit = np.isin(nb * M + sb - 1, i[beyond] * M + k[beyond]) & self._cavity[sb]
+        nb, sb = nb[hit], sb[hit]
+        if not len(nb):
+            return
+        nb, first = np.unique(nb, return_index=True)
+        sb = sb[first]
+        v, nv = self.b[sb - 1], self._vertex_n[sb]
+        out.active[nb] = True
+        out.n[nb] = nv
+        out.t[nb] = np.column_stack([nv[:, 1], -nv[:, 0]])
+        # np.dot node by node, as ever (BLAS may round a dot product otherwise): few nodes
+        out.g[nb] = [float(np.dot(d, e)) for d, e in zip(x[nb] - v, nv)]
+        out.s[nb] = out.s_prev[nb] = self.s0[sb]
+        out.point[nb] = v
+        out.kind[nb] = 2

@@ -15,13 +15,11 @@ from __future__ import annotations
 import csv
 import io
 import json
-import os
 import shutil
 import sys
 import time
 from collections.abc import Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
-from contextlib import contextmanager
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
@@ -30,38 +28,8 @@ import numpy as np
 from . import gid
 from ..post.fields import point_fields, with_components
 from ..post.thickness import thickness_table, write_thickness_csv
+from .files import atomic, mould_outlines, write_atomic, write_vtu
 from .run_report import RunRecord, column_units, thickness_summary
-
-
-@contextmanager
-def atomic(path: str | Path):
-    """Yield a temporary path beside `path` to write; on success it replaces `path` in one
-    rename, so a reader (or a run killed at any moment) sees the old file or the new one,
-    never a part."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp")
-    try:
-        yield tmp
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-
-
-def write_atomic(path: str | Path, text: str) -> None:
-    with atomic(path) as tmp:
-        tmp.write_text(text)
-
-
-def _write_vtu(path: Path, mesh, data: dict[str, np.ndarray]) -> None:
-    """One VTU file of the mesh (r, z, 0) with the point data `data`, atomically.  Run by
-    ResultsWriter's writer thread: meshio's XML and zlib (which lets go of the GIL) then
-    overlap the solve of the next step (about 2 ms of a step's 5 on the plate Q8 4 x 40)."""
-    import meshio  # here: 0.1 s to import, for VTU files only
-
-    cell_type = "quad8" if mesh.element.nodes == 8 else "quad"
-    pts = np.column_stack([mesh.points, np.zeros(mesh.n_nodes)])
-    with atomic(path) as tmp:
-        meshio.write(tmp, meshio.Mesh(pts, [(cell_type, mesh.cells)], point_data=data), file_format="vtu")
 
 
 class NonFiniteResult(ArithmeticError):
@@ -166,7 +134,7 @@ class ResultsWriter:
         self.steps = 0
         self.newton_iterations = 0
         self._pvd: list[tuple[float, str]] = []
-        self._vtu_writer: ThreadPoolExecutor | None = None  # writes the VTU files (_write_vtu)
+        self._vtu_writer: ThreadPoolExecutor | None = None  # writes the VTU files (write_vtu)
         self._vtu_pending: list[tuple[float, str, Future]] = []  # submitted, not yet in _pvd
         self._last_written = 0
         self._unsaid: list[str] = []  # warnings to print to stderr at the end (not the pre-run ones)
@@ -346,7 +314,7 @@ class ResultsWriter:
         name = f"step_{step.number:04d}.vtu"
         if self._vtu_writer is None:
             self._vtu_writer = ThreadPoolExecutor(max_workers=1, thread_name_prefix="axiform-vtu")
-        job = self._vtu_writer.submit(_write_vtu, self.out / "fields" / name, mesh, with_components(data))
+        job = self._vtu_writer.submit(write_vtu, self.out / "fields" / name, mesh, with_components(data))
         self._vtu_pending.append((float(step.number), f"fields/{name}", job))
 
     def _wait_for_vtu(self, wait: bool = True) -> None:
@@ -452,14 +420,3 @@ class ResultsWriter:
             from .checkpoint import save
 
             save(self.out / "restart", self._checkpoint, {**self.restart_meta, "step": self._checkpoint["step"]})
-
-
-def mould_outlines(pairs, lam: float) -> str:
-    """The rigid surfaces at load factor lam as CSV text: pair, r, z per outline point."""
-    text = io.StringIO()
-    table = csv.writer(text, lineterminator="\n")
-    table.writerow(["pair", "r", "z"])
-    for k, pair in enumerate(pairs):
-        pts = pair.surface.polyline() + pair.surface.offset(lam)
-        table.writerows([k, f"{r:.10g}", f"{z:.10g}"] for r, z in pts)
-    return text.getvalue()
