@@ -264,12 +264,8 @@ def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], st
 
 def time_name(model) -> str:
     """What the progress calls the load factor: `t` where it is the process time (load curves
-    or moving tools follow it), else `lambda`."""
-    import numpy as np
-
-    timed = bool(model.knots().size) or any(np.any(np.asarray(c.surface.motion, float) != 0)
-                                            for c in model.contacts)
-    return "t" if timed else "lambda"
+    or moving tools follow it, or a law with memory), else `lambda`."""
+    return "t" if model.timed() else "lambda"
 
 
 def fitted(head: str, tail: list[str], width: int) -> str:

@@ -264,6 +264,12 @@ class Model:
                   + [c.curve for c in self.cavities] + [getattr(c.surface, "curve", PROPORTIONAL) for c in self.contacts])
         return np.unique(np.concatenate([np.empty(0)] + [c.knots() for c in curves]))
 
+    def timed(self) -> bool:
+        """Whether the load factor is the process time: load curves with knots, moving tools,
+        or a law with memory follow it."""
+        return (bool(self.knots().size) or getattr(self.material, "prony", None) is not None
+                or any(np.any(np.asarray(c.surface.motion, float) != 0) for c in self.contacts))
+
     def prescribed(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         """Values of the prescribed equations at time t and their rates (np,)."""
         f = np.array([c(t) for c in self._presc_curves])

@@ -43,8 +43,7 @@ class ArcLengthPath(PathFollowing):
                 raise ValueError("the stop dof is prescribed")
         # with moving tools or load curves lambda is the process time: it may not decrease
         # (a limit point of such a process is a snap, not a path to follow back)
-        self.timed = bool(model.knots().size) or any(
-            np.any(np.asarray(c.surface.motion, float) != 0) for c in model.contacts)
+        self.timed = model.timed()
         self.load_step = abs(control.target / control.steps)
         if control.arc_length is not None:
             self.nominal = control.arc_length
