@@ -140,3 +140,20 @@ def test_the_written_stress_relaxes(tmp_path):
     steps = sorted((out / "fields").glob("step_*.vtu"))
     first, last = (meshio.read(f).point_data["von_mises"].mean() for f in (steps[0], steps[-1]))
     assert last / first == pytest.approx(PRONY.relaxation(1.0) / PRONY.relaxation(0.001), rel=2e-2)
+
+
+def test_max_dt_caps_every_step(tmp_path):
+    """[solver] max_dt: no step of the process longer than it (the steps would grow to 0.1)."""
+    from axiform.case.schema import build, parse
+    import tomllib
+
+    data = tomllib.loads(CASE)
+    data["solver"]["max_dt"] = 0.03
+    built = build(parse(data))
+    res = solve(built.model, built.control, built.options)
+    assert res.status == "finished"
+    times = np.array([0.0] + [s.lam for s in res.steps])
+    assert np.diff(times).max() <= 0.03 * (1 + 1e-12) and res.n_steps >= 1 / 0.03
+    data["solver"]["control"] = "arc-length"
+    with pytest.raises(Exception, match="max_dt"):
+        parse(data)

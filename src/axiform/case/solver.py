@@ -42,6 +42,7 @@ class SolverSpec(Strict):
     tolerance: Annotated[float, Field(gt=0, lt=1)] = 1e-8
     min_step: Annotated[float, Field(gt=0, le=1)] = 1e-4
     growth: Annotated[float, Field(ge=1)] = 1.5
+    max_dt: PositiveFloat | None = None  # load control: no step longer than this (process time)
 
     @model_validator(mode="after")
     def _control(self):
@@ -54,6 +55,8 @@ class SolverSpec(Strict):
             for key in ("arc_length", "stop"):
                 if getattr(self, key) is not None:
                     raise ValueError(f"'{key}' belongs to control = \"arc-length\"")
+        if self.max_dt is not None and self.control != "load":
+            raise ValueError("'max_dt' belongs to control = \"load\"")
         if self.target is not None and self.target == 0:
             raise ValueError("target must not be 0")
         return self
@@ -84,4 +87,4 @@ def build_control(model: Model, mesh: Mesh, spec: SolverSpec) -> LoadControl | D
             stop_value = spec.stop.value
         return ArcLengthControl(1.0 if spec.target is None else spec.target, spec.steps, spec.arc_length,
                                 stop_dof, stop_value, spec.max_steps)
-    return LoadControl(1.0 if spec.target is None else spec.target, spec.steps)
+    return LoadControl(1.0 if spec.target is None else spec.target, spec.steps, spec.max_dt)

@@ -16,10 +16,12 @@ from ..model.state import ModelState
 
 @dataclass
 class LoadControl:
-    """lambda from 0 to target in `steps` equal steps (cut back or grown as needed)."""
+    """lambda from 0 to target in `steps` equal steps (cut back or grown as needed), none
+    longer than max_dt where given (lambda is then the process time t: a law with memory)."""
 
     target: float = 1.0
     steps: int = 10
+    max_dt: float | None = None
 
 
 @dataclass

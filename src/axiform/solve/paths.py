@@ -118,6 +118,8 @@ class LoadPath(PathFollowing):
         super().__init__(model, opts)
         self.target = control.target
         self.nominal = control.target / control.steps
+        if control.max_dt is not None:  # the steps grow up to the nominal one: no longer than max_dt
+            self.nominal = float(np.copysign(min(abs(self.nominal), control.max_dt), self.nominal))
         k = model.knots()
         lo, hi = sorted((0.0, self.target))
         self.stops = np.append(k[(k > lo) & (k < hi)][:: 1 if self.target > 0 else -1], self.target)
