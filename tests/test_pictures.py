@@ -256,3 +256,15 @@ def test_post_imports_nothing_above_it():
             if id(node) not in typing_only:
                 for name in names(node):
                     assert name.split(".")[0] not in above, f"{path.name}:{node.lineno} imports {name}"
+
+
+def test_check_frame_holds_a_long_plate_near_the_body():
+    """A plate much longer than the body (its vertices far from it) 1 mm above the ring is in
+    the frame of check.png, not cut off with its normals."""
+    from axiform.case.schema import build, load
+    from axiform.post.check_plot import check_figure
+
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    fig = check_figure(build(load(examples / "rubber_ring_plates.toml"), examples))
+    low, high = fig.axes[0].get_ylim()
+    assert low < 0.0 and high > 5.0

@@ -92,11 +92,18 @@ def _frame(body: np.ndarray, moulds: list[tuple[np.ndarray, np.ndarray]]) -> tup
             near = pts
         else:
             slo, shi = np.minimum(blo, blo + travel) - pad, np.maximum(bhi, bhi + travel) + pad
-            near = pts[((pts > slo) & (pts < shi)).all(axis=1)]
+            dense = _along(pts)  # a long straight piece has no vertex near the body
+            near = dense[((dense > slo) & (dense < shi)).all(axis=1)]
         if len(near):
             lo, hi = np.minimum(lo, near.min(axis=0)), np.maximum(hi, near.max(axis=0))
     margin = 0.08 * float((hi - lo).max())
     return lo - margin, hi + margin
+
+
+def _along(points: np.ndarray, per_piece: int = 64) -> np.ndarray:
+    """Points along an outline (k, 2): per_piece of them on every piece between its vertices."""
+    s = np.linspace(0.0, 1.0, per_piece)[:, None, None]
+    return (points[:-1] + s * (points[1:] - points[:-1])).reshape(-1, 2) if len(points) > 1 else points
 
 
 def _spaced(points: np.ndarray, gap: float) -> np.ndarray:
