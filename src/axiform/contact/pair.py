@@ -216,7 +216,8 @@ class ContactPair:
         K = w[:, None, None] * dt
         e = self.edges
         m, k = e.shape
-        C = np.einsum("mi,mid,mije->midje", dw[e], t[e], dparts)  # d f_i / d x_j through a_i
+        # d f_i / d x_j through a_i: dw_i t_i (x) da_i/dx_j (m, k, 2, k, 2)
+        C = (dw[e][:, :, None] * t[e])[:, :, :, None, None] * dparts[:, :, None]
         pole_rate = self._poles(xa, t, dt, f, C) if self.pole_edge.size else None
         if guard_force is None:
             guard_force = np.zeros((len(e) if self.guarded else 1, 2))
@@ -235,8 +236,8 @@ class ContactPair:
         ds = np.where(free, 6.0 * xi * (1.0 - xi) / d, 0.0)  # ds/dg
         step = x - state.x_prev  # the motion relative to the surface since the last converged step
         nv, tv = proj.n, proj.t
-        delta = np.einsum("ij,ij->i", step, nv)
-        along = np.einsum("ij,ij->i", step, tv)
+        delta = step[:, 0] * nv[:, 0] + step[:, 1] * nv[:, 1]
+        along = step[:, 0] * tv[:, 0] + step[:, 1] * tv[:, 1]
         fs = -c * s * delta
         # d(fs n)/dx = n (dfs/dx)^T + fs dn/dx, dn/dx = kappa t t^T, d delta/dx = n + kappa (step . t) t
         K = -(c * ds * delta)[:, None, None] * outer(nv, nv)
@@ -254,12 +255,12 @@ class ContactPair:
         i = self.pole_corner
         M, dM = pole_rows(x, e, i, derivative=True)
         dT = t[e] - t[e[q, i]][:, None]  # (q, k, 2)
-        np.add.at(f, e[q, i], np.einsum("qj,qjd->qd", M, dT))
+        np.add.at(f, e[q, i], (M[:, :, None] * dT).sum(axis=1))
         # d/dx_l: dM_il (t_l - t_0) + M_il dt_l - delta_il a_0 dt_0, a_0 = sum_j M_0j
         D = M[:, :, None, None] * dt[e]  # (q, k, 2, 2): d f_0 / d x_l through t_l
         D[q, i] -= M.sum(axis=1)[:, None, None] * dt[e[q, i]]
         Cp = C[self.pole_edge]
-        Cp[q, i] += np.einsum("qjle,qjd->qdle", dM, dT) + D.transpose(0, 2, 1, 3)
+        Cp[q, i] += (dM[:, :, None] * dT[:, :, :, None, None]).sum(axis=1) + D.transpose(0, 2, 1, 3)
         C[self.pole_edge] = Cp
         return D
 
