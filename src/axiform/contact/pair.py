@@ -296,8 +296,8 @@ class ContactPair:
         force = (w * fn)[:, None] * proj.n  # on the mid-point (m, 2)
         Kx = ((w * dfn)[:, None, None] * outer(proj.n, proj.n)
               + (w * fn * proj.kappa)[:, None, None] * outer(proj.t, proj.t))
-        return (np.einsum("mdi,md->mi", P, force), np.einsum("mdi,mde,mej->mij", P, Kx, P),
-                np.einsum("mdi,mde,e->mi", P, Kx, velocity), force)
+        PT = P.transpose(0, 2, 1)  # (m, 2 dpn, 2): stacked matrix products, not einsums on tiny operands
+        return (PT @ force[..., None])[..., 0], PT @ (Kx @ P), (PT @ (Kx @ velocity)[..., None])[..., 0], force
 
     def rate(self, trial: ContactTrial, velocity: np.ndarray) -> np.ndarray:
         """d f / d lambda at fixed u of the evaluation `trial` divided by -1, per slave node
