@@ -282,9 +282,10 @@ class ContactPair:
         e = self.edges
         dpn = u.shape[1]
         un = u[self.nodes]
-        mid = self.X[e].mean(axis=1) + un[e, :2].mean(axis=1) - self.surface.offset(lam)
+        xa = self.X + un[:, :2]
+        mid = 0.5 * (xa[e[:, 0]] + xa[e[:, 1]]) - self.surface.offset(lam)
         P = np.zeros((len(e), 2, 2, dpn))  # d x_m / d (node, dof)
-        P[:, :, 0, :2] = P[:, :, 1, :2] = 0.5 * np.eye(2)
+        P[:, 0, :, 0] = P[:, 1, :, 1] = 0.5
         if dpn == 3:
             mid += (un[e[:, 0], 2] - un[e[:, 1], 2])[:, None] * self.guard_arm
             P[:, :, 0, 2], P[:, :, 1, 2] = self.guard_arm, -self.guard_arm
@@ -294,8 +295,8 @@ class ContactPair:
         fn, dfn = _normal_law(proj.g + self.guard_allowance, proj.active, self.guard_kn, self.smoothing)
         w = self.guard_weight
         force = (w * fn)[:, None] * proj.n  # on the mid-point (m, 2)
-        Kx = ((w * dfn)[:, None, None] * outer(proj.n, proj.n)
-              + (w * fn * proj.kappa)[:, None, None] * outer(proj.t, proj.t))
+        Kx = (w * dfn)[:, None, None] * outer(proj.n, proj.n)
+        Kx += (w * fn * proj.kappa)[:, None, None] * outer(proj.t, proj.t)
         PT = P.transpose(0, 2, 1)  # (m, 2 dpn, 2): stacked matrix products, not einsums on tiny operands
         return (PT @ force[..., None])[..., 0], PT @ (Kx @ P), (PT @ (Kx @ velocity)[..., None])[..., 0], force
 
@@ -328,13 +329,14 @@ class ContactPair:
         # touching the surface (g = 0) feels no force and the force has a continuous slope
         fn, dfn = _normal_law(g, contact, kn, d)
         nv, tv = proj.n, proj.t
+        nn, tt = outer(nv, nv), outer(tv, tv)
         if predicting and self.mu == 0 and not self.sticky:
             # nodes resting on the surface (0 <= g < d) get the penalty in the tangent only
             resting = proj.active & (g >= 0.0) & (g < d) & ~stuck
-            K -= (resting * kn)[:, None, None] * outer(nv, nv)
+            K -= (resting * kn)[:, None, None] * nn
         f += fn[:, None] * nv
-        K += dfn[:, None, None] * outer(nv, nv)
-        K += (fn * proj.kappa)[:, None, None] * outer(tv, tv)  # fn dn/dx
+        K += dfn[:, None, None] * nn
+        K += (fn * proj.kappa)[:, None, None] * tt  # fn dn/dx
         status[contact] = 1
         slip_state = None
         if self.mu > 0 and not self.sticky:
@@ -355,7 +357,7 @@ class ContactPair:
             sech2 = 1.0 - th * th
             ft = np.where(rub, -limit * th, 0.0)
             f += ft[:, None] * tv
-            K -= (rub * kt * sech2 * proj.m)[:, None, None] * outer(tv, tv)  # dft/ds
+            K -= (rub * kt * sech2 * proj.m)[:, None, None] * tt  # dft/ds
             K -= (rub * self.mu * (th - z * sech2) * dfn)[:, None, None] * outer(tv, nv)  # dft/dfn
             K -= (ft * proj.kappa)[:, None, None] * outer(nv, tv)  # ft dt/dx
             sliding = rub & (np.abs(z) > 1.0)
