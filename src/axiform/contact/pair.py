@@ -284,12 +284,8 @@ class ContactPair:
         un = u[self.nodes]
         xa = self.X + un[:, :2]
         mid = 0.5 * (xa[e[:, 0]] + xa[e[:, 1]]) - self.surface.offset(lam)
-        P = np.zeros((len(e), 2, 2, dpn))  # d x_m / d (node, dof)
-        P[:, 0, :, 0] = P[:, 1, :, 1] = 0.5
         if dpn == 3:
             mid += (un[e[:, 0], 2] - un[e[:, 1], 2])[:, None] * self.guard_arm
-            P[:, :, 0, 2], P[:, :, 1, 2] = self.guard_arm, -self.guard_arm
-        P = P.reshape(len(e), 2, 2 * dpn)
         mid_prev = 0.5 * (state.x_prev[e[:, 0]] + state.x_prev[e[:, 1]])
         proj = self.surface.local(mid, mid_prev, self.depth + self.guard_allowance.max(), self.search)
         fn, dfn = _normal_law(proj.g + self.guard_allowance, proj.active, self.guard_kn, self.smoothing)
@@ -297,8 +293,15 @@ class ContactPair:
         force = (w * fn)[:, None] * proj.n  # on the mid-point (m, 2)
         Kx = (w * dfn)[:, None, None] * outer(proj.n, proj.n)
         Kx += (w * fn * proj.kappa)[:, None, None] * outer(proj.t, proj.t)
+        Kv = Kx @ velocity
+        if dpn == 2:  # P = [I I] / 2: the products are copies of force, Kx and Kx v
+            return np.tile(0.5 * force, 2), np.tile(0.25 * Kx, (1, 2, 2)), np.tile(0.5 * Kv, 2), force
+        P = np.zeros((len(e), 2, 2, dpn))  # d x_m / d (node, dof)
+        P[:, 0, :, 0] = P[:, 1, :, 1] = 0.5
+        P[:, :, 0, 2], P[:, :, 1, 2] = self.guard_arm, -self.guard_arm
+        P = P.reshape(len(e), 2, 2 * dpn)
         PT = P.transpose(0, 2, 1)  # (m, 2 dpn, 2): stacked matrix products, not einsums on tiny operands
-        return (PT @ force[..., None])[..., 0], PT @ (Kx @ P), (PT @ (Kx @ velocity)[..., None])[..., 0], force
+        return (PT @ force[..., None])[..., 0], PT @ (Kx @ P), (PT @ Kv[..., None])[..., 0], force
 
     def rate(self, trial: ContactTrial, velocity: np.ndarray) -> np.ndarray:
         """d f / d lambda at fixed u of the evaluation `trial` divided by -1, per slave node
