@@ -72,20 +72,21 @@ def pole_rows(x: np.ndarray, edges: np.ndarray, corner: np.ndarray, derivative: 
     M_00 = -M_01 = 2 pi r_1 L / 60 on a straight edge.
 
     Returns M (q, k) and, if asked, dM[q, j, l, :] = d M_ij / d x_l (q, k, k, 2)."""
-    _, wq, N, dN = edge_rule(edges.shape[1], 3)  # the rule of `ring_areas`: the row sums to its area exactly
+    q, k = edges.shape
+    _, _, N, dN = edge_rule(k, 3)  # the rule of `ring_areas`: the row sums to its area exactly
+    wN, wNN, wNdN = _ring_weights(k)
     X = x[edges]  # (q, k, 2)
-    t = np.einsum("pk,qkd->qpd", dN, X)
-    L = np.linalg.norm(t, axis=2)  # (q, p)
-    r = np.einsum("pk,qk->qp", N, X[..., 0])
+    t = dN @ X  # (q, p, 2)
+    L = np.sqrt(t[..., 0] ** 2 + t[..., 1] ** 2)  # (q, p)
+    r = X[..., 0] @ N.T  # (q, p)
     Ni = N[:, corner].T  # (q, p)
-    M = 2 * np.pi * np.einsum("p,qp,pj,qp->qj", wq, Ni, N, r * L)
+    M = (Ni * r * L) @ wN
     if not derivative:
         return M
-    # d(r L) / dx_l = N_l L e_r + r dN_l t / L, as in `ring_areas`
-    dM = np.zeros(M.shape + M.shape[1:] + (2,))
-    dM[..., 0] = np.einsum("p,qp,pj,pl,qp->qjl", wq, Ni, N, N, L)
-    dM += np.einsum("p,qp,pj,pl,qpd->qjld", wq, Ni, N, dN, (r / L)[..., None] * t)
-    return M, 2 * np.pi * dM
+    # d(r L) / dx_l = N_l L e_r + r dN_l t / L, as in `ring_areas`: (q, 2, k k), then (q, k, k, 2)
+    dM = np.swapaxes((Ni * r / L)[..., None] * t, 1, 2) @ wNdN
+    dM[:, 0] += (Ni * L) @ wNN
+    return M, dM.reshape(q, 2, k, k).transpose(0, 2, 3, 1)
 
 
 def edge_heights(mesh: Mesh, edges: np.ndarray) -> np.ndarray:
