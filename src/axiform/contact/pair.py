@@ -311,7 +311,7 @@ class ContactPair:
         if trial.pole_rate is not None:
             q = np.arange(self.pole_edge.size)
             np.add.at(out, self.edges[self.pole_edge][q, self.pole_corner],
-                      np.einsum("qlde,e->qd", trial.pole_rate, velocity))
+                      (trial.pole_rate @ velocity).sum(axis=1))
         return out
 
     def _traction(self, x: np.ndarray, state: ContactState, predicting: bool):
