@@ -216,7 +216,8 @@ class ContactPair:
         K = w[:, None, None] * dt
         e = self.edges
         m, k = e.shape
-        C = np.einsum("mi,mid,mije->midje", dw[e], t[e], dparts)  # d f_i / d x_j through a_i
+        # d f_i / d x_j through a_i: dw_i t_i (x) da_i/dx_j (m, k, 2, k, 2)
+        C = (dw[e][:, :, None] * t[e])[:, :, :, None, None] * dparts[:, :, None]
         pole_rate = self._poles(xa, t, dt, f, C) if self.pole_edge.size else None
         if guard_force is None:
             guard_force = np.zeros((len(e) if self.guarded else 1, 2))
@@ -235,8 +236,8 @@ class ContactPair:
         ds = np.where(free, 6.0 * xi * (1.0 - xi) / d, 0.0)  # ds/dg
         step = x - state.x_prev  # the motion relative to the surface since the last converged step
         nv, tv = proj.n, proj.t
-        delta = np.einsum("ij,ij->i", step, nv)
-        along = np.einsum("ij,ij->i", step, tv)
+        delta = step[:, 0] * nv[:, 0] + step[:, 1] * nv[:, 1]
+        along = step[:, 0] * tv[:, 0] + step[:, 1] * tv[:, 1]
         fs = -c * s * delta
         # d(fs n)/dx = n (dfs/dx)^T + fs dn/dx, dn/dx = kappa t t^T, d delta/dx = n + kappa (step . t) t
         K = -(c * ds * delta)[:, None, None] * outer(nv, nv)
@@ -254,12 +255,12 @@ class ContactPair:
         i = self.pole_corner
         M, dM = pole_rows(x, e, i, derivative=True)
         dT = t[e] - t[e[q, i]][:, None]  # (q, k, 2)
-        np.add.at(f, e[q, i], np.einsum("qj,qjd->qd", M, dT))
+        np.add.at(f, e[q, i], (M[:, :, None] * dT).sum(axis=1))
         # d/dx_l: dM_il (t_l - t_0) + M_il dt_l - delta_il a_0 dt_0, a_0 = sum_j M_0j
         D = M[:, :, None, None] * dt[e]  # (q, k, 2, 2): d f_0 / d x_l through t_l
         D[q, i] -= M.sum(axis=1)[:, None, None] * dt[e[q, i]]
         Cp = C[self.pole_edge]
-        Cp[q, i] += np.einsum("qjle,qjd->qdle", dM, dT) + D.transpose(0, 2, 1, 3)
+        Cp[q, i] += (dM[:, :, None] * dT[:, :, :, None, None]).sum(axis=1) + D.transpose(0, 2, 1, 3)
         C[self.pole_edge] = Cp
         return D
 
@@ -281,22 +282,26 @@ class ContactPair:
         e = self.edges
         dpn = u.shape[1]
         un = u[self.nodes]
-        mid = self.X[e].mean(axis=1) + un[e, :2].mean(axis=1) - self.surface.offset(lam)
-        P = np.zeros((len(e), 2, 2, dpn))  # d x_m / d (node, dof)
-        P[:, :, 0, :2] = P[:, :, 1, :2] = 0.5 * np.eye(2)
+        xa = self.X + un[:, :2]
+        mid = 0.5 * (xa[e[:, 0]] + xa[e[:, 1]]) - self.surface.offset(lam)
         if dpn == 3:
             mid += (un[e[:, 0], 2] - un[e[:, 1], 2])[:, None] * self.guard_arm
-            P[:, :, 0, 2], P[:, :, 1, 2] = self.guard_arm, -self.guard_arm
-        P = P.reshape(len(e), 2, 2 * dpn)
         mid_prev = 0.5 * (state.x_prev[e[:, 0]] + state.x_prev[e[:, 1]])
         proj = self.surface.local(mid, mid_prev, self.depth + self.guard_allowance.max(), self.search)
         fn, dfn = _normal_law(proj.g + self.guard_allowance, proj.active, self.guard_kn, self.smoothing)
         w = self.guard_weight
         force = (w * fn)[:, None] * proj.n  # on the mid-point (m, 2)
-        Kx = ((w * dfn)[:, None, None] * outer(proj.n, proj.n)
-              + (w * fn * proj.kappa)[:, None, None] * outer(proj.t, proj.t))
-        return (np.einsum("mdi,md->mi", P, force), np.einsum("mdi,mde,mej->mij", P, Kx, P),
-                np.einsum("mdi,mde,e->mi", P, Kx, velocity), force)
+        Kx = (w * dfn)[:, None, None] * outer(proj.n, proj.n)
+        Kx += (w * fn * proj.kappa)[:, None, None] * outer(proj.t, proj.t)
+        Kv = Kx @ velocity
+        if dpn == 2:  # P = [I I] / 2: the products are copies of force, Kx and Kx v
+            return np.tile(0.5 * force, 2), np.tile(0.25 * Kx, (1, 2, 2)), np.tile(0.5 * Kv, 2), force
+        P = np.zeros((len(e), 2, 2, dpn))  # d x_m / d (node, dof)
+        P[:, 0, :, 0] = P[:, 1, :, 1] = 0.5
+        P[:, :, 0, 2], P[:, :, 1, 2] = self.guard_arm, -self.guard_arm
+        P = P.reshape(len(e), 2, 2 * dpn)
+        PT = P.transpose(0, 2, 1)  # (m, 2 dpn, 2): stacked matrix products, not einsums on tiny operands
+        return (PT @ force[..., None])[..., 0], PT @ (Kx @ P), (PT @ Kv[..., None])[..., 0], force
 
     def rate(self, trial: ContactTrial, velocity: np.ndarray) -> np.ndarray:
         """d f / d lambda at fixed u of the evaluation `trial` divided by -1, per slave node
@@ -306,7 +311,7 @@ class ContactPair:
         if trial.pole_rate is not None:
             q = np.arange(self.pole_edge.size)
             np.add.at(out, self.edges[self.pole_edge][q, self.pole_corner],
-                      np.einsum("qlde,e->qd", trial.pole_rate, velocity))
+                      (trial.pole_rate @ velocity).sum(axis=1))
         return out
 
     def _traction(self, x: np.ndarray, state: ContactState, predicting: bool):
@@ -327,13 +332,14 @@ class ContactPair:
         # touching the surface (g = 0) feels no force and the force has a continuous slope
         fn, dfn = _normal_law(g, contact, kn, d)
         nv, tv = proj.n, proj.t
+        nn, tt = outer(nv, nv), outer(tv, tv)
         if predicting and self.mu == 0 and not self.sticky:
             # nodes resting on the surface (0 <= g < d) get the penalty in the tangent only
             resting = proj.active & (g >= 0.0) & (g < d) & ~stuck
-            K -= (resting * kn)[:, None, None] * outer(nv, nv)
+            K -= (resting * kn)[:, None, None] * nn
         f += fn[:, None] * nv
-        K += dfn[:, None, None] * outer(nv, nv)
-        K += (fn * proj.kappa)[:, None, None] * outer(tv, tv)  # fn dn/dx
+        K += dfn[:, None, None] * nn
+        K += (fn * proj.kappa)[:, None, None] * tt  # fn dn/dx
         status[contact] = 1
         slip_state = None
         if self.mu > 0 and not self.sticky:
@@ -354,7 +360,7 @@ class ContactPair:
             sech2 = 1.0 - th * th
             ft = np.where(rub, -limit * th, 0.0)
             f += ft[:, None] * tv
-            K -= (rub * kt * sech2 * proj.m)[:, None, None] * outer(tv, tv)  # dft/ds
+            K -= (rub * kt * sech2 * proj.m)[:, None, None] * tt  # dft/ds
             K -= (rub * self.mu * (th - z * sech2) * dfn)[:, None, None] * outer(tv, nv)  # dft/dfn
             K -= (ft * proj.kappa)[:, None, None] * outer(nv, tv)  # ft dt/dx
             sliding = rub & (np.abs(z) > 1.0)

@@ -5,6 +5,8 @@ Arrays over the edges of a slave face, vectorized."""
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from ..fem.elements import edge_rule
@@ -20,6 +22,21 @@ def slave_edges(mesh: Mesh, nodes: np.ndarray) -> np.ndarray:
     return e[is_slave[e].all(axis=1)]
 
 
+@functools.lru_cache(maxsize=None)
+def _ring_weights(edge_nodes: int):
+    """The constant matrices of `ring_areas` for edges of edge_nodes nodes k, from
+    `edge_rule`: 2 pi w_p N_pi (p, k), 2 pi w_p N_pi N_pj (p, k k) and 2 pi w_p N_pi dN_pj
+    (p, k k); built once, shared and read-only."""
+    _, wq, N, dN = edge_rule(edge_nodes, 3)
+    k = N.shape[1]
+    wN = 2 * np.pi * wq[:, None] * N
+    out = (wN, (wN[:, :, None] * N[:, None, :]).reshape(-1, k * k),
+           (wN[:, :, None] * dN[:, None, :]).reshape(-1, k * k))
+    for arr in out:
+        arr.flags.writeable = False
+    return out
+
+
 def ring_areas(x: np.ndarray, edges: np.ndarray, derivative: bool = False):
     """The consistent ring areas of the edge nodes, a_i = int 2 pi r N_i ds over each edge
     with the edge's own shape functions N_i (linear, or quadratic for Q8: Simpson's corner
@@ -29,20 +46,20 @@ def ring_areas(x: np.ndarray, edges: np.ndarray, derivative: bool = False):
     Returns per edge and edge node the part a (m, k) and, if asked, its derivative
     da[m, i, j, :] = d a_i / d x_j (m, k, k, 2) with respect to the positions of the edge's
     nodes; a node's area is the sum of its parts over its edges."""
-    _, wq, N, dN = edge_rule(edges.shape[1], 3)  # (p,), (p, k): built once
+    m, k = edges.shape
+    _, _, N, dN = edge_rule(k, 3)  # (p, k): built once
+    wN, wNN, wNdN = _ring_weights(k)
     X = x[edges]  # (m, k, 2)
-    t = np.einsum("pk,mkd->mpd", dN, X)  # dx/ds (m, p, 2)
-    L = np.linalg.norm(t, axis=2)  # (m, p)
-    r = np.einsum("pk,mk->mp", N, X[..., 0])
-    a = 2 * np.pi * np.einsum("p,pi,mp->mi", wq, N, r * L)
+    t = dN @ X  # dx/ds (m, p, 2)
+    L = np.sqrt(t[..., 0] ** 2 + t[..., 1] ** 2)  # (m, p)
+    r = X[..., 0] @ N.T  # (m, p)
+    a = (r * L) @ wN
     if not derivative:
         return a
-    m, k = edges.shape
-    da = np.zeros((m, k, k, 2))
-    # d(r L) / dx_j = N_j L e_r + r dN_j t / L
-    da[..., 0] = np.einsum("p,pi,pj,mp->mij", wq, N, N, L)
-    da += np.einsum("p,pi,pj,mpd->mijd", wq, N, dN, (r / L)[..., None] * t)
-    return a, 2 * np.pi * da
+    # d(r L) / dx_j = N_j L e_r + r dN_j t / L: (m, 2, k k), then (m, k, k, 2)
+    da = np.swapaxes((r / L)[..., None] * t, 1, 2) @ wNdN
+    da[:, 0] += L @ wNN
+    return a, da.reshape(m, 2, k, k).transpose(0, 2, 3, 1)
 
 
 def pole_rows(x: np.ndarray, edges: np.ndarray, corner: np.ndarray, derivative: bool = False):
@@ -55,20 +72,21 @@ def pole_rows(x: np.ndarray, edges: np.ndarray, corner: np.ndarray, derivative: 
     M_00 = -M_01 = 2 pi r_1 L / 60 on a straight edge.
 
     Returns M (q, k) and, if asked, dM[q, j, l, :] = d M_ij / d x_l (q, k, k, 2)."""
-    _, wq, N, dN = edge_rule(edges.shape[1], 3)  # the rule of `ring_areas`: the row sums to its area exactly
+    q, k = edges.shape
+    _, _, N, dN = edge_rule(k, 3)  # the rule of `ring_areas`: the row sums to its area exactly
+    wN, wNN, wNdN = _ring_weights(k)
     X = x[edges]  # (q, k, 2)
-    t = np.einsum("pk,qkd->qpd", dN, X)
-    L = np.linalg.norm(t, axis=2)  # (q, p)
-    r = np.einsum("pk,qk->qp", N, X[..., 0])
+    t = dN @ X  # (q, p, 2)
+    L = np.sqrt(t[..., 0] ** 2 + t[..., 1] ** 2)  # (q, p)
+    r = X[..., 0] @ N.T  # (q, p)
     Ni = N[:, corner].T  # (q, p)
-    M = 2 * np.pi * np.einsum("p,qp,pj,qp->qj", wq, Ni, N, r * L)
+    M = (Ni * r * L) @ wN
     if not derivative:
         return M
-    # d(r L) / dx_l = N_l L e_r + r dN_l t / L, as in `ring_areas`
-    dM = np.zeros(M.shape + M.shape[1:] + (2,))
-    dM[..., 0] = np.einsum("p,qp,pj,pl,qp->qjl", wq, Ni, N, N, L)
-    dM += np.einsum("p,qp,pj,pl,qpd->qjld", wq, Ni, N, dN, (r / L)[..., None] * t)
-    return M, 2 * np.pi * dM
+    # d(r L) / dx_l = N_l L e_r + r dN_l t / L, as in `ring_areas`: (q, 2, k k), then (q, k, k, 2)
+    dM = np.swapaxes((Ni * r / L)[..., None] * t, 1, 2) @ wNdN
+    dM[:, 0] += (Ni * L) @ wNN
+    return M, dM.reshape(q, 2, k, k).transpose(0, 2, 3, 1)
 
 
 def edge_heights(mesh: Mesh, edges: np.ndarray) -> np.ndarray:

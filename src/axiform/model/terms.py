@@ -146,19 +146,23 @@ class ContactTerm:
         velocity = pair.surface.velocity(t)
         moving = bool(velocity.any())
         u_nodes = u.reshape(-1, self.dpn)
-        r = np.zeros(self.n_full)
-        dr = np.zeros(self.n_full) if moving else None
+        n = self.n_full
+        dr = None
         guard_force, guard_K = None, ()
         if pair.guarded:  # the mid-points of straight edges (ContactPair.guard)
             fg, Kg, rate, guard_force = pair.guard(u_nodes, t, velocity, state)
-            np.add.at(r, self.guard_dofs.ravel(), -fg.ravel())
-            if moving:
-                np.add.at(dr, self.guard_dofs.ravel(), rate.ravel())
             guard_K = (-Kg,)
         trial = pair.evaluate(u_nodes[:, :2], t, state, predicting, guard_force)
-        np.add.at(r, self.node_dofs.ravel(), -trial.f.ravel())
+        # the slave nodes' dofs are distinct: their forces are placed, not summed
+        r = np.zeros(n)
+        r[self.node_dofs.ravel()] = -trial.f.ravel()
         if moving:
-            np.add.at(dr, self.node_dofs.ravel(), pair.rate(trial, velocity).ravel())
+            dr = np.zeros(n)
+            dr[self.node_dofs.ravel()] = pair.rate(trial, velocity).ravel()
+        if pair.guarded:  # edges share nodes: summed (np.bincount, not the slower np.add.at)
+            r -= np.bincount(self.guard_dofs.ravel(), fg.ravel(), n)
+            if moving:
+                dr += np.bincount(self.guard_dofs.ravel(), rate.ravel(), n)
         K = (-trial.K, -trial.coupling) + guard_K if tangent else ()
         return Contribution(r, dr, K, trial=trial.state)
 
