@@ -39,21 +39,10 @@ class Plots(list):
         return [f"no {name}: {why}" for name, why in self.missing.items()]
 
 
-def _pyplot():
-    """matplotlib.pyplot on the Agg backend: only for plot_process._warm_up, which goes with
-    the plot process (the drawing here uses no pyplot)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def plot_jobs(folder: str | Path, field: str = "von_mises", animation: bool = False) -> list[Callable[[], Path | None]]:
     """The pictures the folder's files allow (and forming.gif if asked), each a function
-    that draws it and returns its file (None when there is nothing to draw): independent of
-    each other, so that they can be drawn in parallel (plot_process)."""
+    that draws it and returns its file (None when there is nothing to draw), independent of
+    each other."""
     folder = Path(folder)
     info = FolderInfo.read(folder)
     history = read_history(folder / "history.csv") if (folder / "history.csv").exists() else {}
