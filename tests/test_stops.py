@@ -1,6 +1,5 @@
 """A stop names the cause a user can act on before the element that failed."""
 
-import numpy as np
 
 from axiform.case.schema import build, parse
 from axiform.solve.controls import LoadControl, NewtonOptions
@@ -50,4 +49,3 @@ def test_the_cause_comes_before_the_failure(monkeypatch):
     res = solver.solve(built.model, built.control, built.options)
     assert res.status == "stopped"
     assert res.message.startswith("step 1: the cause; no convergence")
-    assert np.isfinite(res.newton_iterations)

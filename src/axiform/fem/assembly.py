@@ -84,15 +84,16 @@ class SolidAssembly:
         for sl, x in self.chunks(u_full):
             m = sl.stop - sl.start
             GdV_T = self._GdV[sl].transpose(0, 2, 1)
-            if tangent:
+            if memory is not None:  # the law's parts apart: the Prony series acts on the isochoric one
+                P, A = self.material.iso_stress_tangent(x)
+                P_vol, A_vol = self.material.volumetric_stress_tangent(x)
+                dP, dA = memory.add(sl, x, P, A if tangent else None)
+                P = P + P_vol + dP
+                A = A + A_vol + dA if tangent else None
+            elif tangent:
                 P, A = self.material.stress_tangent(x)
             else:
                 P, A = self.material.stress(x), None
-            if memory is not None:
-                P_iso, A_iso = self.material.iso_stress_tangent(x) if tangent else (self.material.iso_stress(x), None)
-                dP, dA = memory.add(sl, x, P_iso, A_iso)
-                P = P + dP
-                A = None if A is None else A + dA
             if tangent:
                 AG = np.matmul(A, self.G[sl]).reshape(m, q * 5, nd)
                 np.matmul(GdV_T, AG, out=Ke[sl])

@@ -14,7 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .labels import short, unit_of, with_unit
+from .labels import short, unit_of
+from .section_plot import finish_axes
 
 # sizes as fractions of the drawing's size: pressure arrows and the least gap between two of
 # them, the normal ticks along a mould and their spacing
@@ -150,12 +151,7 @@ def check_figure(built):
     _draw_cavities(ax, case, model)
     _draw_moulds(ax, model, moulds, size, _end_time(built))
     _draw_monitors(ax, case, built)
-    ax.set_xlim(lo[0], hi[0])
-    ax.set_ylim(lo[1], hi[1])
-    ax.set_aspect("equal")
-    ax.ticklabel_format(useOffset=False)
-    ax.set_xlabel(with_unit("r", "length", units))
-    ax.set_ylabel(with_unit("z", "length", units))
+    finish_axes(ax, lo, hi, units)
     fig.suptitle(case.title or "case", fontsize=10, x=0.02, ha="left")
     fig.set_layout_engine("constrained")
     fig.legend(loc="outside right lower", fontsize=7, frameon=False)

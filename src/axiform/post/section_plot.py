@@ -139,7 +139,8 @@ def _draw(ax, X, x, outline, cell_values, norm, cmap, moulds, thin: bool) -> Non
         ax.plot(pts[:, 0], pts[:, 1], "-", color="tab:red", lw=1.5)
 
 
-def _finish_axes(ax, lo, hi, units) -> None:
+def finish_axes(ax, lo, hi, units) -> None:
+    """The frame lo..hi of a section drawing, equal scales, r and z axes with their unit."""
     ax.set_xlim(lo[0], hi[0])
     ax.set_ylim(lo[1], hi[1])
     ax.set_aspect("equal")
@@ -173,7 +174,7 @@ def deformed_figure(vtu: Path, info: FolderInfo, field: str = "von_mises", surfa
     cmap = colormap("viridis")
     norm = _norm(values)
     _draw(ax, X, x, outline, values[cells].mean(axis=1), norm, cmap, moulds, thin)
-    _finish_axes(ax, lo, hi, info.units)
+    finish_axes(ax, lo, hi, info.units)
     _colourbar(fig, ax, norm, cmap, label, beside)
     step = int(Path(vtu).stem.split("_")[-1])
     note = "grey: initial" + (", red: moulds" if moulds else "") + (", wall drawn wider than it is" if thin else "")
@@ -220,7 +221,7 @@ def animate(folder: Path, out: Path, info: FolderInfo | None = None, fps: float 
         for f, (X, x, cells, outline, _), (v, _), mould in zip(files, frames, values, moulds):
             ax.clear()
             _draw(ax, X, x, outline, v[cells].mean(axis=1), norm, cmap, mould, thin)
-            _finish_axes(ax, lo, hi, info.units)
+            finish_axes(ax, lo, hi, info.units)
             ax.set_title(wrapped(info.state(int(f.stem.split("_")[-1]), history), 0.8 * size[0], 10), fontsize=10)
             writer.grab_frame()
     return out
