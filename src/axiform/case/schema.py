@@ -37,6 +37,7 @@ from .contact import (
 )
 from .loads import FixSpec, PointLoadSpec, PressureSpec, apply_loads, prescribe_fixes
 from .material import MaterialSpec
+from .temperature import TemperatureSpec
 from .mesh import ArcPiece, LinePiece, MeshSpec, PieceSpec, build_mesh
 from .monitor import HISTORY_COLUMNS, Monitor, MonitorSpec, build_monitors
 from .output import MAX_REVOLVED_POINTS, OutputSpec, RestartSpec, Unit, UnitsSpec
@@ -73,6 +74,7 @@ class Case(Strict):
     output: OutputSpec = OutputSpec()
     restart: RestartSpec = RestartSpec()
     units: UnitsSpec = UnitsSpec()
+    temperature: TemperatureSpec | None = None
 
 
 # the names pydantic gives the members of a union in an error's location: not keys
@@ -230,14 +232,22 @@ def build(case: Case, base: str | Path = ".") -> Built:
     if sectors and mesh.n_nodes * sectors > MAX_REVOLVED_POINTS:
         raise CaseError(f"output.revolved: {sectors} sectors of a mesh of {mesh.n_nodes:,} nodes make a 3D copy of "
                         f"{mesh.n_nodes * sectors:,} points (at most {MAX_REVOLVED_POINTS:,}): use fewer sectors")
+    heat = case.temperature
     try:
-        material = case.material.build()
+        material = case.material.build(None if heat is None else heat.representative())
     except ValueError as exc:
-        raise CaseError(f"material: {exc}") from None
+        raise CaseError(f"material.{exc}" if str(exc).split(":")[0] in case.material.tables()
+                        else f"material: {exc}") from None
     try:
         model = Model(mesh, material, formulation=case.mesh.formulation, sfr_edges=case.mesh.sfr_edges)
     except MeshError as exc:
         raise CaseError(f"mesh: {exc}") from None
+    if heat is not None:
+        try:
+            model.heat(heat.nodal(mesh), heat.build_shift())
+        except ValueError as exc:
+            key = "wlf.C2" if heat.shift is not None and heat.shift.wlf is not None else "arrhenius"
+            raise CaseError(f"temperature.shift.{key}: {exc}") from None
     crossing = boundary_crossing(mesh.points, mesh.boundary_edges)
     if crossing is not None:
         p = mesh.points[mesh.boundary_edges[crossing[0], 0]]

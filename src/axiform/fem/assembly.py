@@ -28,6 +28,7 @@ class SolidAssembly:
     def __init__(self, mesh: Mesh, material):
         self.mesh = mesh
         self.material = material
+        self.temperature: np.ndarray | None = None  # (e, q) at the points, where the law's constants depend on it
         self.G, self.dV = gradient_operator(mesh.element, mesh.points[mesh.cells])
         self.dofs = element_dofs(mesh.cells, mesh.element.dofs_per_node)
         e, q, _, nd = self.G.shape
@@ -42,9 +43,17 @@ class SolidAssembly:
         ue = u_full[self.dofs]
         return deformation_gradient(np.matmul(self._G2, ue[:, :, None]).reshape(e, q, 5))
 
+    def law(self, sl: slice = slice(None)):
+        """The law at the points of the elements sl: the material, or where its constants are
+        tables of T (materials.temperature) the law at those points' temperatures, one
+        value per point in the order of x[sl].reshape(-1, 5)."""
+        if self.temperature is None or not hasattr(self.material, "at"):
+            return self.material
+        return self.material.at(self.temperature[sl])
+
     def stress(self, x: np.ndarray, sl: slice = slice(None)) -> np.ndarray:
         """First Piola-Kirchhoff stress P (e, q, 5) at the gradients x of the elements sl."""
-        return self.material.stress(x)
+        return self.law(sl).stress(x)
 
     @staticmethod
     def check_inverted(x: np.ndarray, offset: int = 0) -> None:
@@ -84,16 +93,17 @@ class SolidAssembly:
         for sl, x in self.chunks(u_full):
             m = sl.stop - sl.start
             GdV_T = self._GdV[sl].transpose(0, 2, 1)
+            law = self.law(sl)
             if memory is not None:  # the law's parts apart: the Prony series acts on the isochoric one
-                P, A = self.material.iso_stress_tangent(x)
-                P_vol, A_vol = self.material.volumetric_stress_tangent(x)
+                P, A = law.iso_stress_tangent(x)
+                P_vol, A_vol = law.volumetric_stress_tangent(x)
                 dP, dA = memory.add(sl, x, P, A if tangent else None)
                 P = P + P_vol + dP
                 A = A + A_vol + dA if tangent else None
             elif tangent:
-                P, A = self.material.stress_tangent(x)
+                P, A = law.stress_tangent(x)
             else:
-                P, A = self.material.stress(x), None
+                P, A = law.stress(x), None
             if tangent:
                 AG = np.matmul(A, self.G[sl]).reshape(m, q * 5, nd)
                 np.matmul(GdV_T, AG, out=Ke[sl])

@@ -102,13 +102,20 @@ class MixedAssembly(SolidAssembly):
         m, q = self.Np[sl].shape[:2]
         h = np.matmul(self._NpdV_T[sl], J.reshape(m, q, 1))  # int N_p J dV (m, np, 1)
         Jbar = np.matmul(self.Np[sl], np.matmul(self.Minv[sl], h))  # (m, q, 1)
-        return self.material.kappa * (Jbar.reshape(-1) - 1.0), dJ
+        return (self.bulk_modulus(sl)[:, None] * (Jbar[..., 0] - 1.0)).reshape(-1), dJ
+
+    def bulk_modulus(self, sl: slice) -> np.ndarray:
+        """kappa (m,) of the elements sl: the law's, or where it is a table of T the mean of
+        the element's points (one pressure field per element needs one kappa)."""
+        m = len(range(*sl.indices(self.dV.shape[0])))
+        kappa = np.asarray(self.law(sl).kappa, float)
+        return np.broadcast_to(kappa, (m,)) if kappa.ndim == 0 else kappa.reshape(m, -1).mean(1)
 
     def stress(self, x: np.ndarray, sl: slice = slice(None)) -> np.ndarray:
         """P = P_iso + p dJ/dF (e, q, 5) with the element pressure p."""
         xt, shape = to_rows(x)
         p, dJ = self._pressure(xt, sl)
-        P = self.material.stress_rows(xt, 0.0, False)[0]
+        P = self.law(sl).stress_rows(xt, 0.0, False)[0]
         P += p * dJ
         return from_rows(P, None, shape)[0]
 
@@ -121,12 +128,11 @@ class MixedAssembly(SolidAssembly):
         contiguous component rows (5, n), then brought to (m, q, 5, 5) once."""
         e, q, _, nd = self.G.shape
         fe, Ke = out if out is not None else self.buffers(tangent)
-        kappa = self.material.kappa
         for sl, x in self.chunks(u_full):
             m = sl.stop - sl.start
             xt, shape = to_rows(x)
             p, dJ = self._pressure(xt, sl)
-            P, A = self.material.stress_rows(xt, 0.0, tangent)
+            P, A = self.law(sl).stress_rows(xt, 0.0, tangent)
             if memory is not None:  # the Prony series on the isochoric part (rows viewed as points)
                 dP, dA = memory.add(sl, xt.T.reshape(shape + (5,)), P.T.reshape(shape + (5,)),
                                     None if A is None else A.transpose(2, 0, 1).reshape(shape + (5, 5)))
@@ -146,5 +152,6 @@ class MixedAssembly(SolidAssembly):
                 # K += kappa B^T M^-1 B
                 W = self._NpdV_T[sl][:, :, :, None] * dJ.T.reshape(m, 1, q, 5)  # (m, np, q, 5)
                 B = np.matmul(W.reshape(m, -1, q * 5), self._G2[sl])
+                kappa = self.bulk_modulus(sl)[:, None, None]
                 Ke[sl] += np.matmul(B.transpose(0, 2, 1), kappa * np.matmul(self.Minv[sl], B))
         return fe, Ke

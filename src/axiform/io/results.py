@@ -295,9 +295,12 @@ class ResultsWriter:
         mesh = self.model.mesh
         self._last_written = step.number
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
-        self._thickness = thickness_table(mesh, u, step.state.contacts)
+        T = self.model.temperature
+        self._thickness = thickness_table(mesh, u, step.state.contacts, T)
         if self._thickness is not None:
             self.summary["thickness"] = thickness_summary(self._thickness)
+        if T is not None:
+            self.summary["temperature"] = {"min": float(T.min()), "max": float(T.max())}
         if self.vtu and self.model.contacts:
             write_atomic(self.out / "fields" / f"surfaces_{step.number:04d}.csv",
                          mould_outlines(self.model.contacts, float(step.lam)))
@@ -329,7 +332,7 @@ class ResultsWriter:
     def _write_thickness_step(self, step):
         """thickness/step_NNNN.csv: the thickness table of one step."""
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
-        table = thickness_table(self.model.mesh, u, step.state.contacts)
+        table = thickness_table(self.model.mesh, u, step.state.contacts, self.model.temperature)
         if table is not None:
             write_thickness_csv(self.out / "thickness" / f"step_{step.number:04d}.csv", table)
 

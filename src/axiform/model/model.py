@@ -17,6 +17,7 @@ from ..fem.assembly import SolidAssembly
 from ..fem.constraints import DofMap, SparsePattern
 from ..fem.cavity import Cavity
 from ..fem.curves import PROPORTIONAL, Curve
+from ..fem.elements import gauss_quad
 from ..fem.graphs import connected_components
 from ..fem.loads import FollowerPressure
 from ..fem.mixed import MixedAssembly
@@ -96,6 +97,8 @@ class Model:
     point_loads: list[tuple[int, float, Curve]] = field(default_factory=list)
     contacts: list = field(default_factory=list)
     cavities: list[Cavity] = field(default_factory=list)
+    temperature: np.ndarray | None = None
+    shift: object = None
 
     def __post_init__(self):
         if self.sfr_edges not in SFR_EDGE_RULES:
@@ -127,6 +130,21 @@ class Model:
         self.dofmap = None
 
     fix = prescribe
+
+    def heat(self, T: float | np.ndarray, shift=None) -> None:
+        """The temperature of the material: T a number or one value per node (n_nodes,),
+        carried with the material (the nodes' values interpolated to the quadrature points
+        by the element's shape functions); shift: the shift of the relaxation times
+        (materials.temperature.WLF or Arrhenius), None for none.  The law's constants that
+        are tables of T are taken at the points' temperatures.  ValueError where a
+        temperature lies beyond the shift's domain."""
+        T = np.broadcast_to(np.asarray(T, float), (self.mesh.n_nodes,)).copy()
+        if not np.isfinite(T).all():
+            raise ValueError("every temperature must be a finite number")
+        if shift is not None:
+            shift.check(T)
+        self.temperature, self.shift = T, shift
+        self.dofmap = None
 
     def pressure(self, edges: np.ndarray, value: float, curve: Curve = PROPORTIONAL) -> None:
         """Follower pressure value * f(t) on boundary edges (indices of mesh.boundary_edges)."""
@@ -219,10 +237,13 @@ class Model:
             self.solid = MixedAssembly(self.mesh, self.material, self.pressure_space)
         else:
             self.solid = SolidAssembly(self.mesh, self.material)
+        self.solid.temperature = self.point_temperatures()
+        if self.solid.temperature is None and _tabled(self.material):
+            raise ValueError("the law's constants are tables of temperature: give the model a temperature (heat)")
         by_curve: dict[Curve, np.ndarray] = {}  # point loads grouped by curve
         for d, v, c in self.point_loads:
             by_curve.setdefault(c, np.zeros(n))[d] += v
-        self.loads = ([SolidTerm(self.solid, n)] + [PressureTerm(p, n) for p in self.pressures]
+        self.loads = ([SolidTerm(self.solid, n, self.reduced_rate())] + [PressureTerm(p, n) for p in self.pressures]
                       + ([PointLoadTerm(by_curve, n)] if by_curve else []))
         self.contact_terms = [ContactTerm(pair, self.dpn, n) for pair in self.contacts]
         self.cavity_terms = [CavityTerm(c, n) for c in self.cavities]
@@ -244,6 +265,21 @@ class Model:
         k = max(float(getattr(self.material, "shear_modulus", 1.0)), float(getattr(self.material, "kappa", 0.0)))
         self._noise_floor = 16 * np.finfo(float).eps * 2 * np.pi * k * self.ring_size() * np.sqrt(dm.nf)
         return self
+
+    def point_temperatures(self) -> np.ndarray | None:
+        """The temperature (e, q) at the quadrature points of the solid, from the nodes'
+        (None without a temperature)."""
+        if self.temperature is None:
+            return None
+        kind = self.mesh.element
+        N = kind.shape(gauss_quad(kind.gauss)[0])[0]  # (q, k)
+        return self.temperature[self.mesh.cells] @ N.T
+
+    def reduced_rate(self) -> np.ndarray | None:
+        """dxi/dt = 1 / a_T (e, q) at the quadrature points (None without a shift)."""
+        if self.shift is None or self.temperature is None:
+            return None
+        return 1.0 / self.shift.shift(self.point_temperatures())
 
     def ring_size(self) -> float:
         """L R_max: the body's span L times its largest radius (at least L), the area by which
@@ -309,7 +345,9 @@ class Model:
     def strain_energy(self, u_full: np.ndarray) -> float:
         """The strain energy stored in the body at the displacements u_full (n_full,): the
         law's W at every quadrature point, integrated over the revolved body."""
-        return float((self.material.energy(self.solid.gradient(u_full)) * self.solid.dV).sum())
+        x = self.solid.gradient(u_full)
+        W = self.solid.law().energy(x.reshape(-1, 5)).reshape(x.shape[:-1])
+        return float((W * self.solid.dV).sum())
 
     def external_load(self, u_full: np.ndarray, t: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         """The applied external load at time t (pressures and point loads, full vector) and
@@ -393,3 +431,9 @@ class Model:
             Cp = np.diag([c.c_p for c in constraints])
             K = sp.bmat([[K, sp.csr_matrix(-G)], [sp.csr_matrix(Cu), sp.csr_matrix(Cp)]], format="csr")
         return np.concatenate([r, C]), np.concatenate([dr_dt, dC_dt]), K
+
+
+def _tabled(material) -> bool:
+    """Whether the law (or the law under a Prony series) has constants that are tables of T."""
+    law = getattr(material, "law", material)
+    return bool(getattr(law, "tables", None))

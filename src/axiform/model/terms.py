@@ -55,11 +55,13 @@ class SolidTerm:
     laws carry no history: its state is an empty dict (a law with memory keeps its arrays
     per quadrature point there, (e, q, ...)).  The element arrays are written into scratch
     buffers reused from call to call (work space, not state: nothing of one call is read by
-    the next)."""
+    the next).  With a shift of the relaxation times (materials.temperature) each point's
+    history advances by its reduced time dxi = dt / a_T(T) (`reduced_rate` = 1 / a_T)."""
 
-    def __init__(self, assembly, n_full: int):
+    def __init__(self, assembly, n_full: int, reduced_rate: np.ndarray | None = None):
         self.assembly = assembly
         self.n_full = n_full
+        self.reduced_rate = reduced_rate  # dxi/dt = 1 / a_T (e, q) at the points, None: dxi = dt
         self.blocks = (assembly.dofs,)
         self._scratch: dict[bool, tuple] = {}
 
@@ -79,7 +81,8 @@ class SolidTerm:
         if state:  # a law with memory: the step from the committed state's time to t
             history = {k: v for k, v in state.items() if k != "t"}
             dt = max(float(t) - float(state["t"]), 0.0)
-            memory = Memory(history, self.assembly.material.prony.factors(dt))
+            dxi = dt if self.reduced_rate is None else dt * self.reduced_rate
+            memory = Memory(history, self.assembly.material.prony.factors(dxi))
         fe, Ke = self.assembly.evaluate(u, tangent, self._scratch[tangent], memory)
         dofs = self.assembly.dofs
         trial = {} if memory is None else memory.trial | {"t": np.asarray(float(t))}
