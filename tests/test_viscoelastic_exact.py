@@ -127,7 +127,7 @@ def test_a_sphere_inflated_at_a_constant_stretch_rate_against_the_thick_wall_sol
     assert np.abs(richardson / thick - 1).max() < 5e-5
     assert np.abs(richardson / membrane - 1).max() < 1.5e-4
     assert abs(A + res.last.u[bore_dof] - bore(duration)) < 1e-5 * A  # the wall took the volume evenly
-    assert np.ptp(thick) > 0.3 * thick.max()  # the pressure rises and falls: far from a linear response
+    assert 0 < thick.argmax() < len(t) - 1  # the pressure rises and falls: far from a linear response
 
 
 def test_a_sphere_under_held_pressure_creeps_from_the_elastic_to_the_long_term_stretch():
@@ -138,10 +138,10 @@ def test_a_sphere_under_held_pressure_creeps_from_the_elastic_to_the_long_term_s
     from PronySphere.bore, the incompressible thick-wall solution.  Tolerance 1e-5 of the
     radius: what the ramp lets the history take (g_i RAMP / tau_i ~ 1e-5 of the stress) and
     the wall's compressibility (sigma / kappa ~ 6e-7) (measured 2e-7 and 1.3e-6).  On the
-    way (hold knots 0.01 x 1.25^k, then with their geometric means too): the creep curve of
-    PronySphere.creep; the time steps' error (measured 5.8e-4 and 1.8e-4 of the radius) is
-    removed by Richardson extrapolation, within 1e-4 (measured 4.9e-5: the steps are up to
-    twice the retardation time, so the remainder is not yet small)."""
+    way (hold knots 0.01 x 1.25^k, then with their midpoints too: every step halved): the
+    creep curve of PronySphere.creep; the time steps' error (measured 5.8e-4 and 1.8e-4 of
+    the radius: a ratio 3.2, the longest steps being twice tau_2, short of the asymptotic 4)
+    is removed by Richardson extrapolation, within 1e-4 (measured 4.6e-5)."""
     scale = 1.0 - sum(G)
     oracle = PronySphere(A, A + H0, C1, C2, G, TAU)
     p_limit = max(scale * oracle.pressure(a) for a in A * np.linspace(1.0, 2.0, 201))
@@ -151,7 +151,7 @@ def test_a_sphere_under_held_pressure_creeps_from_the_elastic_to_the_long_term_s
     ramp = 1.0e-6
     knots = np.append(0.01 * 1.25 ** np.arange(36), 40.0)
     curves = [np.array([[ramp * k / 8, k / 8] for k in range(9)] + [[t, 1.0] for t in hold]) for hold in
-              (knots, np.sort(np.append(knots, np.sqrt(knots[1:] * knots[:-1]))))]
+              (knots, np.sort(np.append(knots, (knots[1:] + knots[:-1]) / 2)))]
     radii = []
     for table in curves:
         model, bore_dof, _ = sphere(lambda model, mesh: model.pressure(mesh.edge_sets["inner"], p, Curve(table)))
