@@ -38,6 +38,7 @@ from .contact import (
 from .loads import FixSpec, PointLoadSpec, PressureSpec, apply_loads, prescribe_fixes
 from .material import MaterialSpec
 from .temperature import TemperatureSpec
+from .thermal import ConvectionSpec, ThermalSpec, build_conduction
 from .mesh import ArcPiece, LinePiece, MeshSpec, PieceSpec, build_mesh
 from .monitor import HISTORY_COLUMNS, Monitor, MonitorSpec, build_monitors
 from .output import MAX_REVOLVED_POINTS, OutputSpec, RestartSpec, Unit, UnitsSpec
@@ -75,6 +76,8 @@ class Case(Strict):
     restart: RestartSpec = RestartSpec()
     units: UnitsSpec = UnitsSpec()
     temperature: TemperatureSpec | None = None
+    thermal: ThermalSpec | None = None
+    convection: list[ConvectionSpec] = []
 
 
 # the names pydantic gives the members of a union in an error's location: not keys
@@ -260,12 +263,14 @@ def build(case: Case, base: str | Path = ".") -> Built:
         pairs = [contact_pair(mesh, model, c, base, f"contact[{i}]") for i, c in enumerate(case.contact)]
         for pair in pairs:
             model.contact(pair)
+        build_conduction(model, mesh, case.thermal, case.convection, case.contact)
         monitors = build_monitors(model, mesh, case.monitor, cavities, pairs, case.mesh.element)
         control = build_control(model, mesh, case.solver)
         moving = any(c.motion.ur or c.motion.uz for c in case.contact)
         gas = any(c.control != "pressure" or c.pressure for c in case.cavity)
         loads = [*case.pressure, *case.point_load, *case.fix]
-        if not any(item.value for item in loads) and not moving and not gas:
+        heated = case.thermal is not None and (case.convection or any(c.conductance for c in case.contact))
+        if not any(item.value for item in loads) and not moving and not gas and not heated:
             raise CaseError("pressure: nothing loads the model: every [[pressure]], [[point_load]] and [[fix]] "
                             "value is zero (or absent), no [[contact]] surface moves and no [[cavity]] is loaded")
     except SelectorError as exc:

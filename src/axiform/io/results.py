@@ -295,7 +295,7 @@ class ResultsWriter:
         mesh = self.model.mesh
         self._last_written = step.number
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
-        T = self.model.temperature
+        T = step.state.temperature
         self._thickness = thickness_table(mesh, u, step.state.contacts, T)
         if self._thickness is not None:
             self.summary["thickness"] = thickness_summary(self._thickness)
@@ -332,7 +332,7 @@ class ResultsWriter:
     def _write_thickness_step(self, step):
         """thickness/step_NNNN.csv: the thickness table of one step."""
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
-        table = thickness_table(self.model.mesh, u, step.state.contacts, self.model.temperature)
+        table = thickness_table(self.model.mesh, u, step.state.contacts, step.state.temperature)
         if table is not None:
             write_thickness_csv(self.out / "thickness" / f"step_{step.number:04d}.csv", table)
 
