@@ -6,8 +6,10 @@ Which quantity goes on which axis depends on what drives the run (summary.json, 
 - a tool's stroke or a prescribed displacement: each monitor on y against the stroke on x
   (force–stroke); a monitor that only follows the stroke (a node under the punch: a straight
   line) gets no panel, and the figure says so;
-- a multi-stage process (curves with several knots, tools and cavities): every applied
-  quantity and every monitor against the process time t;
+- a multi-stage process (curves with several knots, tools and cavities) or a case whose load
+  factor is a physical time (a law with memory): every applied quantity (orange: each
+  pressure, force, prescribed displacement, tool motion, cavity volume or gas content as the
+  case's curves give it) and every monitor (blue) against the process time t, one panel each;
 - nothing but the loaded quantity (no other monitor): the loaded quantity against the load
   factor or time, or a cavity's pressure against its volume.
 `load_curve_reason` says why there is no picture when there is none.
@@ -22,10 +24,9 @@ import numpy as np
 
 from .figures import new_figure, save, title
 from .labels import load_values, with_unit
-from .results_folder import FolderInfo, read_history
+from .results_folder import HISTORY_COLUMNS, FolderInfo, read_history
 
 _STARTS_AT_ZERO = ("displacement", "rotation", "force", "area")
-_NOT_MONITORS = ("step", "load_factor", "iterations", "time")
 
 
 @dataclass
@@ -41,7 +42,7 @@ class Panel:
 
 def _monitors(h: dict[str, np.ndarray], info: FolderInfo) -> list[str]:
     own = (info.load or {}).get("monitor")
-    return [k for k in h if k not in _NOT_MONITORS and k != own]
+    return [k for k in h if k not in HISTORY_COLUMNS and k != own]
 
 
 def _label(name: str, info: FolderInfo) -> str:
@@ -108,7 +109,7 @@ def _alone_panels(h, info: FolderInfo) -> list[Panel]:
     """Without other monitors: a cavity's pressure against its volume (volume control), else
     the loaded quantity against the load factor or the time."""
     load = info.load_of(h)
-    lam = h["load_factor"]
+    lam = _time(h)
     for a in info.applied:
         if a.get("quantity") == "volume" and a.get("cavity") in info.cavities and info.load.get("monitor"):
             return [Panel(info.applied_values(a, lam), load, with_unit(a["name"], "volume", info.units),
@@ -123,7 +124,7 @@ def load_curve_panels(h: dict[str, np.ndarray], info: FolderInfo) -> tuple[list[
     out because they only follow the stroke."""
     if not h:
         return [], []
-    if info.process:
+    if info.process or info.real_time:
         return _process_panels(h, info), []
     if not _monitors(h, info):
         return (_alone_panels(h, info) if info.load is not None else []), []
