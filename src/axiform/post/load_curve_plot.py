@@ -9,7 +9,8 @@ Which quantity goes on which axis depends on what drives the run (summary.json, 
 - a multi-stage process (curves with several knots, tools and cavities) or a case whose load
   factor is a physical time (a law with memory): every applied quantity (orange: each
   pressure, force, prescribed displacement, tool motion, cavity volume or gas content as the
-  case's curves give it) and every monitor (blue) against the process time t, one panel each;
+  case's curves give it) and every monitor (blue) against the process time t, one panel each,
+  on the same t axis, the knots of the curves (where a stage ends) as dotted lines;
 - nothing but the loaded quantity (no other monitor): the loaded quantity against the load
   factor or time, or a cavity's pressure against its volume.
 `load_curve_reason` says why there is no picture when there is none.
@@ -73,6 +74,13 @@ def _process_panels(h, info: FolderInfo) -> list[Panel]:
     for name in ([own] if own in h else []) + _monitors(h, info):
         panels.append(Panel(_time(h), h[name], xlabel, _label(name, info)))
     return panels
+
+
+def _knots(h, info: FolderInfo) -> list[float]:
+    """The times where an applied quantity changes its rate (the inner knots of the case's
+    curves) within the run: the stages of a process."""
+    end = float(_time(h)[-1])
+    return sorted({float(k[0]) for a in info.applied for k in a.get("curve") or () if 0.0 < k[0] < end})
 
 
 def _stroke_panels(h, info: FolderInfo) -> tuple[list[Panel], list[str]]:
@@ -150,13 +158,18 @@ def load_curve_figure(history: Path, info: FolderInfo):
     panels, dropped = load_curve_panels(h, info)
     if not panels:
         return None
+    timed = info.process or info.real_time
+    knots = _knots(h, info) if timed else []
     n = len(panels)
     ncols = 1 if n == 1 else 2 if n in (2, 4) else 3
     nrows = -(-n // ncols)
     fig = new_figure((4.6 * ncols, 3.6 * nrows + 0.5 + 0.3 * bool(dropped)))
-    axes = fig.subplots(nrows, ncols, squeeze=False)
+    axes = fig.subplots(nrows, ncols, squeeze=False, sharex=timed)
     for ax, p in zip(axes.flat, panels):
         ax.plot(p.x, p.y, "o-", ms=2.5, lw=1.2, color=p.colour)
+        for t in knots:
+            ax.axvline(t, color="0.55", ls=":", lw=1.0, zorder=0)
+        ax.xaxis.set_tick_params(labelbottom=True)
         ax.set_xlabel(p.xlabel)
         ax.set_ylabel(p.ylabel)
         ax.ticklabel_format(useOffset=False)
@@ -166,7 +179,8 @@ def load_curve_figure(history: Path, info: FolderInfo):
         ax.set_visible(False)
     text = info.title or "load curve"
     if any(p.colour == "C1" for p in panels):
-        text += "\n(orange: applied, by the case's curves; blue: results)"
+        text += "\n(orange: applied, by the case's curves; blue: results" + ("; dotted: the curves' knots)" if knots
+                                                                          else ")")
     if dropped:
         text += f"\n({', '.join(dropped)} follows {info.load['name']}: not drawn)"
     title(fig, text)
