@@ -2,12 +2,13 @@
 thickness.csv, optional GiD files and a 3D revolved copy, and PNG plots at the end.
 
 history.csv: one row per converged step (step, load_factor, time, iterations, then one column
-per monitor; time = load_factor, the process time t).  summary.json: status, steps, newton_iterations, wall_time_s, dofs, elements,
-element, units, load (what the load factor scales), monitor_quantities, the case's origin
-and fingerprint (and more).  fields/: a ParaView series (step_NNNN.vtu listed in fields.pvd
-with the time t of its step as timestep, files.write_pvd; surfaces_NNNN.csv the moulds at that
-step).  thickness.csv: the wall thickness along the body
-at the last written step; thickness/step_NNNN.csv every `thickness_every` steps.
+per monitor; time = load_factor, the process time t).  summary.json: status, steps,
+newton_iterations, wall_time_s, dofs, elements, element, units, load (what the load factor
+scales), monitor_quantities, the case's origin and fingerprint (and more).  fields/: a
+ParaView series (step_NNNN.vtu listed in fields.pvd with the time t of its step as timestep,
+files.write_pvd; surfaces_NNNN.csv the moulds at that step).  thickness.csv: the wall
+thickness along the body at the last written step; thickness/step_NNNN.csv every
+`thickness_every` steps.
 Every file is written whole to a temporary name, then renamed over the old one (`atomic`).
 """
 
@@ -22,6 +23,7 @@ import time
 from collections.abc import Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
+
 import numpy as np
 
 from . import gid
@@ -183,9 +185,8 @@ class ResultsWriter:
                 rows = list(csv.reader(fh))
         except OSError as exc:
             raise ValueError(f"{self.out}: no history.csv to resume ({exc})") from None
-        if rows and rows[0] == [c for c in header if c != "time"]:
-            rows = [r[:2] + r[1:2] + r[2:] if r else r for r in rows[1:]]
-            rows.insert(0, header)
+        if rows and rows[0] == [c for c in header if c != "time"]:  # written before the column time
+            rows = [header] + [[*r[:2], r[1], *r[2:]] if r else r for r in rows[1:]]
         if not rows or rows[0] != header:
             raise ValueError(f"{self.out}/history.csv has other columns than this case's monitors")
         kept = [r for r in rows[1:] if r and int(r[0]) <= step]

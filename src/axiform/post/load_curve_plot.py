@@ -10,7 +10,8 @@ Which quantity goes on which axis depends on what drives the run (summary.json, 
   factor is a physical time (a law with memory): every applied quantity (orange: each
   pressure, force, prescribed displacement, tool motion, cavity volume or gas content as the
   case's curves give it) and every monitor (blue) against the process time t, one panel each,
-  on the same t axis, the knots of the curves (where a stage ends) as dotted lines;
+  on the same t axis, the inner knots of the curves (where a stage ends and the next begins)
+  as dotted lines;
 - nothing but the loaded quantity (no other monitor): the loaded quantity against the load
   factor or time, or a cavity's pressure against its volume.
 `load_curve_reason` says why there is no picture when there is none.
@@ -77,8 +78,8 @@ def _process_panels(h, info: FolderInfo) -> list[Panel]:
 
 
 def _knots(h, info: FolderInfo) -> list[float]:
-    """The times where an applied quantity changes its rate (the inner knots of the case's
-    curves) within the run: the stages of a process."""
+    """The times within the run where an applied quantity may change its rate (the inner
+    knots of the case's curves): where a stage of a process ends and the next begins."""
     end = float(_time(h)[-1])
     return sorted({float(k[0]) for a in info.applied for k in a.get("curve") or () if 0.0 < k[0] < end})
 
@@ -179,8 +180,8 @@ def load_curve_figure(history: Path, info: FolderInfo):
         ax.set_visible(False)
     text = info.title or "load curve"
     if any(p.colour == "C1" for p in panels):
-        text += "\n(orange: applied, by the case's curves; blue: results" + ("; dotted: the curves' knots)" if knots
-                                                                          else ")")
+        legend = "orange: applied, by the case's curves; blue: results" + ("; dotted: the curves' knots" if knots else "")
+        text += f"\n({legend})"
     if dropped:
         text += f"\n({', '.join(dropped)} follows {info.load['name']}: not drawn)"
     title(fig, text)

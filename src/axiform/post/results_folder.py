@@ -18,6 +18,7 @@ from .labels import load_values, short, unit_of, with_unit
 # history.csv's first columns, before one column per monitor (time = load_factor: the process time t)
 HISTORY_COLUMNS = ("step", "load_factor", "time", "iterations")
 
+
 class FieldError(ValueError):
     """A field (or component) that the results folder does not have."""
 
