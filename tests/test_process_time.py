@@ -228,7 +228,7 @@ def test_time_is_no_monitor_name_and_no_monitor_of_a_sweep(tmp_path):
     data = {"mesh": {"kind": "rectangle", "r": [0.0, 1.0], "z": [0.0, 1.0], "divisions": [1, 1]},
             "material": {"model": "neo-hooke", "C1": 0.5, "kappa": 50.0},
             "monitor": [{"name": "time", "at": {"r": 0.0, "z": 1.0}, "dof": "uz"}]}
-    with pytest.raises(Exception, match="time"):
+    with pytest.raises(Exception, match="monitor.*'time'.*one of the columns step, load_factor, time, iterations"):
         parse(data)
     (tmp_path / "history.csv").write_text("step,load_factor,time,iterations,w\n1,0.5,0.5,3,-1.0\n2,1.0,1.0,4,-3.0\n")
     assert monitor_extremes(tmp_path / "history.csv") == {"w": (-3.0, -1.0)}
