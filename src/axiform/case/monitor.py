@@ -15,8 +15,7 @@ from ..contact.pair import ContactPair
 from ..fem.mesh import Mesh
 from ..model.model import Model
 from ..fem.selectors import select_nodes
-
-HISTORY_COLUMNS = ("step", "load_factor", "iterations")  # history.csv's first columns
+from ..post.results_folder import HISTORY_COLUMNS
 # characters a monitor name may not hold (besides the unprintable ones): the CSV separators and quotes
 NOT_IN_NAMES = frozenset(',;"\t')
 
