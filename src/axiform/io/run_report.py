@@ -142,4 +142,6 @@ def column_units(summary: dict) -> dict[str, dict[str, str]]:
         out[file] = {c: length for c in columns} if length else {}
     if units.get("pressure"):
         out["contact.csv"]["pressure"] = units["pressure"]
+    if units.get("temperature"):
+        out["thickness.csv"]["temperature"] = units["temperature"]
     return out

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 QUANTITY_UNIT = {"pressure": "pressure", "stress": "pressure", "force": "force", "displacement": "length",
-                 "length": "length", "time": "time"}  # quantity -> key of [units]
+                 "length": "length", "time": "time", "temperature": "temperature"}  # quantity -> key of [units]
 
 
 def case_labels(case: Any) -> dict[str, Any]:
@@ -42,12 +42,17 @@ def case_labels(case: Any) -> dict[str, Any]:
 
 def time_is_real(case: Any) -> bool:
     """Whether the load factor of a validated case is a physical time (its result depends on
-    how fast the loads come): a material with a Prony series (`[material] viscoelastic`)."""
-    return getattr(getattr(case, "material", None), "viscoelastic", None) is not None
+    how fast the loads come): a material with a Prony series (`[material] viscoelastic`), or
+    heat conduction (`[thermal]`)."""
+    return (getattr(getattr(case, "material", None), "viscoelastic", None) is not None
+            or getattr(case, "thermal", None) is not None)
 
 
 def monitor_quantity(m: Any) -> str:
-    """"displacement", "rotation", "force", "area", "pressure" or "volume" of a monitor spec."""
+    """"displacement", "rotation", "force", "area", "pressure", "volume" or "temperature" of a
+    monitor spec."""
+    if getattr(m, "quantity", None) == "temperature":
+        return "temperature"
     cavity_quantity = getattr(m, "cavity", None) is not None and m.quantity
     if cavity_quantity:
         return cavity_quantity
