@@ -34,7 +34,7 @@ from .run import prepare_folder
 HEADERS = {"relaxation": ("time", "modulus"), "dynamic": ("frequency", "storage", "loss"),
            "wlf": ("temperature", "log10_shift")}
 LONG_TERM_MIN = 1e-6  # E_inf / E0 below this: the data relax to nothing (no solid)
-WLF_POLE_MARGIN = 1e-6  # C2 + T - T_ref at the data, relative to their span: at the pole
+WLF_POLE_MARGIN = 1e-3  # C2 + T - T_ref at the data below this x their span: the fit at the pole
 
 
 @dataclass
@@ -149,11 +149,13 @@ def run(paths: list[str], model: str, terms: int | None, out: str | None, kappa:
 
 
 def read_prony(path: str) -> Table:
-    """A relaxation modulus or DMA table, checked: positive, times or frequencies increasing."""
+    """A relaxation modulus or DMA table, checked: positive, times or frequencies increasing,
+    the modulus falling with time (the storage modulus rising with frequency) over the span."""
     table = read_table(path, ("relaxation", "dynamic"))
     keys = HEADERS[table.kind]
     check_positive(table, keys)
     check_monotone(table, keys[0], 1, "increase")
+    check_trend(table)
     return table
 
 
@@ -176,16 +178,18 @@ def prony_terms(table: Table, terms: int | None) -> tuple[int, tuple[float, floa
     return n, span
 
 
-def prony_notes(table: Table) -> list[str]:
-    """Data a Prony series cannot follow: a relaxation modulus that rises, a storage modulus
-    that falls."""
-    key, sign = ("modulus", -1) if table.kind == "relaxation" else ("storage", 1)
-    rows = np.flatnonzero(sign * np.diff(table.columns[key]) < 0) + 1
-    if not rows.size:
-        return []
-    which = "rises" if sign < 0 else "falls"
-    return [f"{table.path}: {key} {which} at {rows.size} row(s) (line {table.lines[rows[0]]} first): a Prony "
-            f"series cannot follow that, the fit passes between"]
+def check_trend(table: Table) -> None:
+    """FitDataError where the data run the wrong way over their span (row to row, noise may
+    go either way): a relaxation modulus that ends above its start, a storage modulus that
+    ends below its start."""
+    if table.kind == "relaxation":
+        key, along, wrong, right = "modulus", "time", "rises", "a relaxation modulus falls with time"
+    else:
+        key, along, wrong, right = "storage", "frequency", "falls", "a storage modulus rises with frequency"
+    v = table.columns[key]
+    if (v[-1] - v[0]) * (1 if wrong == "rises" else -1) > 0:
+        raise FitDataError(f"{table.path} line {table.lines[-1]}: {key} {wrong} from {v[0]:g} at the first {along} "
+                           f"to {v[-1]:g} at the last: {right}")
 
 
 def run_prony(path: str, terms: int | None, out: str | None) -> int:
@@ -195,8 +199,6 @@ def run_prony(path: str, terms: int | None, out: str | None) -> int:
         n, span = prony_terms(table, terms)
     except FitDataError as exc:
         return _error(str(exc))
-    for note in prony_notes(table):
-        print(f"axiform fit: {note}", file=sys.stderr)
     folder = _folder(out, "prony")
     if folder is None:
         return 2
@@ -299,7 +301,7 @@ def run_wlf(path: str, reference: float | None, out: str | None) -> int:
         return 2
     result = fit_wlf(T, y, reference, given)
     margin = result.C2 + T.min() - reference
-    if margin <= WLF_POLE_MARGIN * (np.ptp(T) + abs(result.C2)) or result.C1 <= 0:
+    if margin < WLF_POLE_MARGIN * np.ptp(T):
         print(f"axiform fit: {path}: the shifts do not follow WLF: the fit runs into its pole (C2 + T - T_ref = "
               f"{margin:.3g} at T = {T.min():g}; C1 = {result.C1:.6g}, C2 = {result.C2:.6g} at T_ref = "
               f"{reference:g}); C2 + T - T_ref must stay > 0 over the data", file=sys.stderr)
