@@ -152,6 +152,8 @@ BAD = [
     ("header", "time,stress\n0.1,10\n", ["--model", "prony"], r"line 1: the header must be time,modulus or "
                                                               r"frequency,storage,loss"),
     ("text", "time,modulus\n0.1,10\n1,x\n", ["--model", "prony"], r"line 3: modulus 'x' is not a number"),
+    ("magnitude", "time,modulus\n1e-300,10\n1,8\n10,6\n", ["--model", "prony"],
+     r"line 2: time 1e-300 is beyond the magnitude"),
     ("zero time", "time,modulus\n0,10\n1,8\n10,6\n", ["--model", "prony"], r"line 2: time must be > 0"),
     ("negative modulus", "time,modulus\n0.1,10\n1,-8\n10,6\n", ["--model", "prony"], r"line 3: modulus must be > 0"),
     ("zero loss", "frequency,storage,loss\n1,5,0.1\n2,6,0\n", ["--model", "prony"], r"line 3: loss must be > 0"),

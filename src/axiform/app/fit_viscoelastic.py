@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..case.schema import MAX_MAGNITUDE, MIN_MAGNITUDE
 from ..materials.viscoelastic import MAX_TERMS
 from ..materials.viscoelastic_fit import (PronyFit, WLFFit, decades, fit_dynamic, fit_relaxation, fit_wlf,
                                           zero_crossing)
@@ -80,6 +81,9 @@ def read_table(path: str | Path, kinds: tuple[str, ...]) -> Table:
                 raise FitDataError(f"{where}: {key} '{cell}' is not a number") from None
             if not math.isfinite(values[-1]):
                 raise FitDataError(f"{where}: {key} must be finite, got {cell}")
+            if abs(values[-1]) > MAX_MAGNITUDE or 0 < abs(values[-1]) < MIN_MAGNITUDE:
+                raise FitDataError(f"{where}: {key} {cell} is beyond the magnitude of a number of axiform "
+                                   f"(nonzero, {MIN_MAGNITUDE:g} to {MAX_MAGNITUDE:g})")
         rows.append(values)
         lines.append(number)
     if header is None:
@@ -314,7 +318,7 @@ def run_wlf(path: str, reference: float | None, out: str | None) -> int:
           f"{reference:.6g} ({'--reference' if given else 'where the data shift is 0'})")
     if given:
         print(f"the data's log10 a_T at T_ref: {result.offset:.6g} (tau of a master curve at the data's own "
-              f"reference x {10 ** result.offset:.6g} at T_ref)")
+              f"reference x 10^{result.offset:.6g} at T_ref)")
     print(f"C2 + T - T_ref >= {margin:.6g} over the data (the pole at T = {reference - result.C2:.6g}); "
           f"RMS error of log10 a_T {summary['rms_error']:.3g}")
     print(f"\nwrote {folder / 'material.toml'}, fit.json, fit_wlf.png")
@@ -347,6 +351,6 @@ def wlf_snippet(table: Table, result: WLFFit, margin: float) -> str:
              f"# C2 + T - T_ref >= {margin:.6g} over the data: the pole at T = {result.reference - result.C2:.6g}"]
     if result.offset:
         lines += [f"# the data's log10 a_T at this reference is {result.offset:.6g}: the relaxation times of a",
-                  f"# master curve at the data's own reference (shift 0) x {10 ** result.offset:.6g} here"]
+                  f"# master curve at the data's own reference (shift 0) x 10^{result.offset:.6g} here"]
     return "\n".join(lines + ["[temperature]", f"reference = {_digits(result.reference)[0]}",
                               f"shift = {{ wlf = {{ C1 = {C1}, C2 = {C2} }} }}", ""])

@@ -26,6 +26,15 @@ def _taus(ax, x: np.ndarray, label: str) -> None:
         ax.axvline(v, color="0.7", ls=":", lw=0.9, label=label if i == 0 else None)
 
 
+def _plain_log(ax) -> None:
+    """A log scale on the y axis of `ax` labelled 2, 5, 10, 20 ... rather than 2 x 10^0."""
+    from matplotlib.ticker import LogFormatter
+
+    ax.set_yscale("log")
+    for set_formatter in (ax.yaxis.set_major_formatter, ax.yaxis.set_minor_formatter):
+        set_formatter(LogFormatter(labelOnlyBase=False, minor_thresholds=(2, 0.5)))
+
+
 def _series_text(fit: PronyFit) -> str:
     return f"{len(fit.g)} terms, E0 = {fit.E0:.4g}, E∞ = {fit.long_term:.4g}"
 
@@ -42,10 +51,10 @@ def plot_relaxation(t: np.ndarray, modulus: np.ndarray, fit: PronyFit, path: Pat
     _taus(ax, fit.tau, "τ_i")
     ax.set_xscale("log")
     if max(modulus.max(), fit.E0) > 10 * min(modulus.min(), fit.long_term):
-        ax.set_yscale("log")
+        _plain_log(ax)
     ax.set_ylabel("relaxation modulus (units of the data)")
     ax.set_title(f"Prony series: {_series_text(fit)}")
-    ax.legend(loc="lower left", fontsize=9)
+    ax.legend(loc="center right", fontsize=9)
     ax.grid(alpha=0.3, which="both")
     res.plot(t, 100 * fit.residual, "o-", ms=3, color=DATA, lw=0.8)
     res.axhline(0.0, color="0.6", lw=0.8)
@@ -67,7 +76,7 @@ def plot_dynamic(f: np.ndarray, storage: np.ndarray, loss: np.ndarray, fit: Pron
     ax.plot(grid, l, "-", color=FIT)
     _taus(ax, 1.0 / (2.0 * np.pi * fit.tau), "1 / (2π τ_i)")
     ax.set_xscale("log")
-    ax.set_yscale("log")
+    _plain_log(ax)
     ax.set_ylabel("modulus (units of the data)")
     ax.set_title(f"Prony series from DMA: {_series_text(fit)}")
     ax.legend(loc="best", fontsize=9)
