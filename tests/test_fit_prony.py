@@ -200,11 +200,15 @@ def test_two_files_refused(tmp_path, capsys):
 
 
 def test_no_admissible_series_or_shift_exits_1(tmp_path, capsys):
-    """A melt's curve relaxing to nothing has no long-term modulus; shifts steeper at their
-    coldest point than any WLF curve drive the fit into the pole."""
+    """A melt's curve relaxing to nothing has no long-term modulus, a constant one no
+    relaxation; shifts steeper at their coldest point than any WLF curve drive the fit into
+    the pole."""
     melt = write_csv(tmp_path / "melt.csv", "time,modulus", TIMES, 10.0 * np.exp(-TIMES / 0.5) + 1e-9)
     assert main(["fit", str(melt), "--model", "prony", "--out", str(tmp_path / "o1")]) == 1
     assert "no long-term modulus" in capsys.readouterr().err
+    flat = write_csv(tmp_path / "flat.csv", "time,modulus", TIMES, np.full(TIMES.size, 3.0))
+    assert main(["fit", str(flat), "--model", "prony", "--out", str(tmp_path / "o3")]) == 1
+    assert "no relaxation" in capsys.readouterr().err
     steep = write_csv(tmp_path / "steep.csv", "temperature,log10_shift", [100, 101, 110, 130, 150], [40, 1, 0, -2, -3])
     assert main(["fit", str(steep), "--model", "wlf", "--out", str(tmp_path / "o2")]) == 1
     assert "C2 + T - T_ref must stay > 0" in capsys.readouterr().err

@@ -187,11 +187,11 @@ def check_trend(table: Table) -> None:
     go either way): a relaxation modulus that ends above its start, a storage modulus that
     ends below its start."""
     if table.kind == "relaxation":
-        key, along, wrong, right = "modulus", "time", "rises", "a relaxation modulus falls with time"
+        key, along, sign, wrong, right = "modulus", "time", 1.0, "rises", "a relaxation modulus falls with time"
     else:
-        key, along, wrong, right = "storage", "frequency", "falls", "a storage modulus rises with frequency"
+        key, along, sign, wrong, right = "storage", "frequency", -1.0, "falls", "a storage modulus rises with frequency"
     v = table.columns[key]
-    if (v[-1] - v[0]) * (1 if wrong == "rises" else -1) > 0:
+    if sign * (v[-1] - v[0]) > 0:
         raise FitDataError(f"{table.path} line {table.lines[-1]}: {key} {wrong} from {v[0]:g} at the first {along} "
                            f"to {v[-1]:g} at the last: {right}")
 
