@@ -11,10 +11,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from axiform.case.material import MaterialSpec
 from axiform.cli import main
 from axiform.materials.viscoelastic import Prony, Viscoelastic
+from test_fuzz_files import _settings, call, csv_texts, judge, seeded, spoil_text
 from axiform.materials.viscoelastic_fit import (decades, dynamic_moduli, fit_dynamic, fit_relaxation, fit_wlf,
                                                 relaxation_modulus, time_grid, wlf_shift, zero_crossing)
 
@@ -212,3 +215,32 @@ def test_no_admissible_series_or_shift_exits_1(tmp_path, capsys):
     steep = write_csv(tmp_path / "steep.csv", "temperature,log10_shift", [100, 101, 110, 130, 150], [40, 1, 0, -2, -3])
     assert main(["fit", str(steep), "--model", "wlf", "--out", str(tmp_path / "o2")]) == 1
     assert "C2 + T - T_ref must stay > 0" in capsys.readouterr().err
+
+
+FUZZ_FILES = [("relaxation", ["time", "modulus"], [["0.1", "10"], ["1", "8"], ["10", "6"], ["100", "5"]], []),
+              ("dma", ["frequency", "storage", "loss"], [["0.1", "5", "1"], ["1", "7", "2"], ["10", "9", "1"]], []),
+              ("wlf", ["temperature", "log10_shift"], [["100", "2"], ["110", "0"], ["120", "-1.5"]], []),
+              ("wlf", ["temperature", "log10_shift"], [["100", "2"], ["110", "0"], ["120", "-1.5"]],
+               ["--reference", "115"])]
+
+
+@_settings
+@given(st.data())
+def _fuzz_viscoelastic(folder, data):
+    name, header, rows, extra = data.draw(st.sampled_from(FUZZ_FILES))
+    csv = folder / f"{name}.csv"
+    csv.write_bytes(spoil_text(data.draw, data.draw(csv_texts(header, rows))))
+    model = "wlf" if name == "wlf" else "prony"
+    terms = data.draw(st.sampled_from([[], [], ["--terms", "1"], ["--terms", "2"]])) if model == "prony" else []
+    code, out, err = call(["fit", str(csv), "--model", model, *terms, *extra, "--out", str(folder / "o")])
+    judge(code, out, err, (str(csv),))
+
+
+def test_fuzzed_data_never_crash(tmp_path, monkeypatch):
+    """Hypothesis's broken files (tests/test_fuzz_files.py): exit 0, 1 or 2, no traceback, an
+    exit 2 naming the file or the option."""
+    import axiform.app.fit_viscoelastic as command
+
+    for plot in ("plot_relaxation", "plot_dynamic", "plot_wlf"):  # the PNGs: not the reader
+        monkeypatch.setattr(command, plot, lambda *args: None)
+    seeded(_fuzz_viscoelastic)(tmp_path)
