@@ -21,7 +21,9 @@ Both are linear in (E_inf, E_1..E_n) at fixed tau_i.  The fit:
 
 WLF: log10 a_T = -C1 (T - T_ref) / (C2 + T - T_ref) (+ b, the shift of T_ref in the data's
 own convention, when T_ref is not where the data's shift is 0), least squares on log10 a_T
-from the linearised solution (T - T_ref) / log10 a_T = -(C2 + T - T_ref) / C1.
+from the linearised solution (T - T_ref) / log10 a_T = -(C2 + T - T_ref) / C1, with C1 >= 0
+and C2 + T - T_ref >= 0 over the data (the iterates never cross the pole; a fit that ends on
+it is the caller's to refuse).
 """
 
 from __future__ import annotations
