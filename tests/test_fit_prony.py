@@ -15,6 +15,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from axiform.case.material import MaterialSpec
+from axiform.case.temperature import TemperatureSpec
 from axiform.cli import main
 from axiform.materials.viscoelastic import Prony, Viscoelastic
 from test_fuzz_files import _settings, call, csv_texts, judge, seeded, spoil_text
@@ -130,9 +131,11 @@ def test_wlf_command_writes_the_temperature_table(tmp_path):
                      wlf_shift(TEMPERATURES, C1, C2, T_REF))
     out = tmp_path / "fit"
     assert main(["fit", str(data), "--model", "wlf", "--out", str(out)]) == 0
-    table = tomllib.loads((out / "material.toml").read_text())
-    assert table["temperature"]["reference"] == T_REF
-    assert table["temperature"]["shift"]["wlf"] == {"C1": pytest.approx(C1, rel=1e-7), "C2": pytest.approx(C2, rel=1e-7)}
+    table = tomllib.loads((out / "material.toml").read_text())["temperature"]
+    assert table["reference"] == T_REF
+    assert table["shift"]["wlf"] == {"C1": pytest.approx(C1, rel=1e-7), "C2": pytest.approx(C2, rel=1e-7)}
+    shift = TemperatureSpec.model_validate(table | {"initial": 150.0}).build_shift()
+    assert np.allclose(np.log10(shift.shift(TEMPERATURES)), wlf_shift(TEMPERATURES, C1, C2, T_REF), atol=1e-6)
     summary = json.loads((out / "fit.json").read_text())
     assert summary["reference_from"] == "data"
     assert summary["pole_margin"] == pytest.approx(C2 + TEMPERATURES[0] - T_REF, rel=1e-9)
@@ -215,6 +218,9 @@ def test_no_admissible_series_or_shift_exits_1(tmp_path, capsys):
     steep = write_csv(tmp_path / "steep.csv", "temperature,log10_shift", [100, 101, 110, 130, 150], [40, 1, 0, -2, -3])
     assert main(["fit", str(steep), "--model", "wlf", "--out", str(tmp_path / "o2")]) == 1
     assert "C2 + T - T_ref must stay > 0" in capsys.readouterr().err
+    # a reference below the data whose shifts want the pole above it: C2 would be <= 0
+    assert main(["fit", str(steep), "--model", "wlf", "--reference", "50", "--out", str(tmp_path / "o4")]) == 1
+    assert "must stay > 0 over the data and at T_ref" in capsys.readouterr().err
 
 
 FUZZ_FILES = [("relaxation", ["time", "modulus"], [["0.1", "10"], ["1", "8"], ["10", "6"], ["100", "5"]], []),

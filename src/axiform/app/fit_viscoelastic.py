@@ -35,7 +35,7 @@ from .run import prepare_folder
 HEADERS = {"relaxation": ("time", "modulus"), "dynamic": ("frequency", "storage", "loss"),
            "wlf": ("temperature", "log10_shift")}
 LONG_TERM_MIN = 1e-6  # E_inf / E0 below this: the data relax to nothing (no solid)
-WLF_POLE_MARGIN = 1e-3  # C2 + T - T_ref at the data below this x their span: the fit at the pole
+WLF_POLE_MARGIN = 1e-3  # C2 + T - T_ref at the data or T_ref below this x their span: at the pole
 
 
 @dataclass
@@ -304,11 +304,11 @@ def run_wlf(path: str, reference: float | None, out: str | None) -> int:
     if folder is None:
         return 2
     result = fit_wlf(T, y, reference, given)
-    margin = result.C2 + T.min() - reference
+    margin = result.C2 + min(T.min() - reference, 0.0)  # C2 + T - T_ref over the data and at T_ref
     if margin < WLF_POLE_MARGIN * np.ptp(T):
         print(f"axiform fit: {path}: the shifts do not follow WLF: the fit runs into its pole (C2 + T - T_ref = "
-              f"{margin:.3g} at T = {T.min():g}; C1 = {result.C1:.6g}, C2 = {result.C2:.6g} at T_ref = "
-              f"{reference:g}); C2 + T - T_ref must stay > 0 over the data", file=sys.stderr)
+              f"{margin:.3g} at T = {min(T.min(), reference):g}; C1 = {result.C1:.6g}, C2 = {result.C2:.6g} at "
+              f"T_ref = {reference:g}); C2 + T - T_ref must stay > 0 over the data and at T_ref", file=sys.stderr)
         return 1
     summary = wlf_summary(table, result, given, margin)
     (folder / "material.toml").write_text(wlf_snippet(table, result, margin))
@@ -319,7 +319,7 @@ def run_wlf(path: str, reference: float | None, out: str | None) -> int:
     if given:
         print(f"the data's log10 a_T at T_ref: {result.offset:.6g} (tau of a master curve at the data's own "
               f"reference x 10^{result.offset:.6g} at T_ref)")
-    print(f"C2 + T - T_ref >= {margin:.6g} over the data (the pole at T = {reference - result.C2:.6g}); "
+    print(f"C2 + T - T_ref >= {margin:.6g} over the data and at T_ref (the pole at T = {reference - result.C2:.6g}); "
           f"RMS error of log10 a_T {summary['rms_error']:.3g}")
     print(f"\nwrote {folder / 'material.toml'}, fit.json, fit_wlf.png")
     return 0
@@ -348,9 +348,11 @@ def wlf_snippet(table: Table, result: WLFFit, margin: float) -> str:
     """material.toml of a WLF fit: the [temperature] reference and shift."""
     C1, C2 = _digits([result.C1, result.C2])
     lines = [f"# axiform fit --model wlf: {table.path} ({len(table.lines)} rows)",
-             f"# C2 + T - T_ref >= {margin:.6g} over the data: the pole at T = {result.reference - result.C2:.6g}"]
+             f"# C2 + T - T_ref >= {margin:.6g} over the data and at T_ref: the pole at T = "
+             f"{result.reference - result.C2:.6g}"]
     if result.offset:
         lines += [f"# the data's log10 a_T at this reference is {result.offset:.6g}: the relaxation times of a",
                   f"# master curve at the data's own reference (shift 0) x 10^{result.offset:.6g} here"]
-    return "\n".join(lines + ["[temperature]", f"reference = {_digits(result.reference)[0]}",
+    return "\n".join(lines + ["[temperature]", "# initial = ...  (the part's temperature, which the table needs)",
+                              f"reference = {_digits(result.reference)[0]}",
                               f"shift = {{ wlf = {{ C1 = {C1}, C2 = {C2} }} }}", ""])

@@ -22,8 +22,8 @@ Both are linear in (E_inf, E_1..E_n) at fixed tau_i.  The fit:
 WLF: log10 a_T = -C1 (T - T_ref) / (C2 + T - T_ref) (+ b, the shift of T_ref in the data's
 own convention, when T_ref is not where the data's shift is 0), least squares on log10 a_T
 from the linearised solution (T - T_ref) / log10 a_T = -(C2 + T - T_ref) / C1, with C1 >= 0
-and C2 + T - T_ref >= 0 over the data (the iterates never cross the pole; a fit that ends on
-it is the caller's to refuse).
+and C2 + T - T_ref >= 0 over the data and at T_ref (C2 >= 0): the iterates never cross the
+pole; a fit that ends on it is the caller's to refuse.
 """
 
 from __future__ import annotations
@@ -181,7 +181,7 @@ def fit_wlf(T: np.ndarray, log_shift: np.ndarray, reference: float, offset: bool
         slope, intercept = np.polyfit(dT[use], dT[use] / (y[use] - b0), 1)
         if slope < 0 and -intercept / slope + dT.min() > 0:
             C1, C2 = -1.0 / slope, intercept / slope
-    pole = -dT.min()  # C2 > pole keeps C2 + dT > 0 over the data
+    pole = max(-dT.min(), 0.0)  # C2 above it: C2 + dT > 0 over the data and at T_ref
 
     def residual(p):
         return wlf_shift(T, p[0], p[1], reference) + (p[2] if offset else 0.0) - y
