@@ -10,8 +10,14 @@ Euler over a step dt, on the geometry x = X + u at the step's end:
 
     (C / dt + K(x) + H(x)) T' = C / dt T + f(x),
 
-C = int rho0 c N N^T dV0 the heat capacity (mass is conserved: rho dv = rho0 dV0, so C is
-that of the reference configuration), K(x) = int k grad_x N . grad_x N^T dv the conduction of
+C the heat capacity of the reference configuration (mass is conserved, rho dv = rho0 dV0),
+int rho0 c N N^T dV0, lumped (row sums) for the four-node elements: a consistent C under
+backward Euler with steps much shorter than an element's diffusion time h^2 / alpha (a
+mould touching a hot sheet for a tenth of a second) overshoots, the temperature beyond its
+initial and boundary values, while the lumped one keeps it between them.  Q8 keeps the
+consistent C: its lumped one (HRZ; row sums are negative at the corners) left an error of
+0.8 % of T0 - T_inf on the slab that did not fall with the mesh (12 to 40 elements), against
+0.1 % for Q4 lumped and 0.05 % for Q8 consistent, K(x) = int k grad_x N . grad_x N^T dv the conduction of
 the current configuration, H and f from the films and contact conductances.  dv = 2 pi r da.
 The properties k, rho c are numbers (or, for tables of T, taken at the step's start
 temperature per element: lagged, first order in dt like the time integration itself).
@@ -87,11 +93,14 @@ class Conduction:
         return T[self.cells] @ self.N.T
 
     def capacity(self, T: np.ndarray) -> sp.csr_matrix:
-        """C = int rho0 c N N^T dV0 (n, n), the properties at the points' T."""
+        """C (n, n), the properties at the points' T: int rho0 c N N^T dV0, lumped to its row
+        sums (a diagonal) for the four-node elements (module docstring)."""
         Tq = self.element_values(T)
         weight = self.rho(Tq) * self.c(Tq) * self.dV0  # (e, q)
-        Ce = np.einsum("eq,qi,qj->eij", weight, self.N, self.N)
-        return self._assemble(Ce)
+        if self.N.shape[1] == 4:  # row sums of N N^T: N, the shape functions summing to 1
+            diagonal = np.bincount(self.cells.ravel(), (weight @ self.N).ravel(), self.n)
+            return sp.diags_array(diagonal, format="csr")
+        return self._assemble(np.einsum("eq,qi,qj->eij", weight, self.N, self.N))
 
     def conduction(self, x: np.ndarray, T: np.ndarray) -> sp.csr_matrix:
         """K(x) = int k grad_x N . grad_x N^T dv (n, n) on the current positions x (n, 2)."""
