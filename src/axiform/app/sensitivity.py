@@ -3,7 +3,9 @@ along the load path (load control).
 
 At each converged step n the residual R_n(u_n; s, h_{n-1}) = 0 holds, h_{n-1} the history
 committed at the step before (contact stick points, sticky nodes and where they froze,
-positions for the crossing test), and h_n = H(u_n; s, h_{n-1}).  Differentiating,
+positions for the crossing test; the h_i of a viscoelastic law's Prony series and the
+isochoric stress they were updated with, per quadrature point), and h_n = H(u_n; s,
+h_{n-1}).  Differentiating,
 
     K_n du_n/ds = -( dR_n/ds |_u  +  dR_n/dh dh_{n-1}/ds )
 
@@ -23,8 +25,8 @@ residuals at the next step holds dR/dh dh/ds.  The linear solves reuse one facto
 K_n per step for all variables.
 
 Cost per converged step: one tangent evaluation and one factorization of K_n, 2 m residual
-evaluations for m variables (4 m with contact: the shadows' history), one back-substitution
-with m right-hand sides.
+evaluations for m variables (4 m with contact or a law with memory: the shadows' history),
+one back-substitution with m right-hand sides.
 """
 
 from __future__ import annotations
@@ -121,7 +123,7 @@ def sensitivity(build: Callable[[np.ndarray], Model], design: np.ndarray, contro
             _same_numbering(model, shadow, k)
         shadows.append(pair)
     dx_ds = np.stack([(p.mesh.points - q.mesh.points) / (2 * hk) for (p, q), hk in zip(shadows, h)], axis=-1)
-    history = bool(model.contacts)
+    history = bool(model.contacts) or bool(model.initial_state().solid)  # contacts, a law with memory
     dm = model.dofmap
     out = Sensitivity(SolveResult("running"), model, s, dx_ds)
 
@@ -132,7 +134,7 @@ def sensitivity(build: Callable[[np.ndarray], Model], design: np.ndarray, contro
         nonlocal lag_state
         u_f, lam = step.u_f, step.lam
         ev = model.evaluate(u_f, lam, lag_state)
-        lag_state = ev.trial
+        lag_state = step.state  # committed by the solver: h_n, the history of the next step's K
         dR = np.empty((model.n_free, m))
         for k, ((plus, minus), (s_plus, s_minus)) in enumerate(zip(shadows, shadow_states)):
             dR[:, k] = (plus.evaluate(u_f, lam, s_plus, tangent=False).r
