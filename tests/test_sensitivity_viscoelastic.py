@@ -93,7 +93,8 @@ def history_held(tree, sens) -> np.ndarray:
 
 
 @pytest.mark.parametrize("control, formulation, element", [("volume", "mixed", "q4"), ("pressure", "mixed", "q4"),
-                                                           ("volume", "displacement", "q8")])
+                                                           ("volume", "displacement", "q8"),
+                                                           ("pressure", "displacement", "sfr")])
 def test_derivatives_carry_the_history_of_the_prony_series(control, formulation, element):
     tree = tube(control, formulation, element)
     sens, built = differentiate(tree)
