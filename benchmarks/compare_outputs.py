@@ -7,8 +7,10 @@
 
 For every example and output file (history.csv, contact.csv, thickness.csv, where written)
 it prints the largest relative difference |a - b| / max(|a|, |b|, floor) over the numeric
-cells, floor = 1e-12 times the column's largest magnitude (cells near zero compared to the
-column's scale), and whether the non-numeric cells (status, ...) and the shapes agree.
+cells of the columns both files have (matched by their header's names; a column only one
+has is named, e.g. history.csv's `time` against a tree from before it), floor = 1e-12 times
+the column's largest magnitude (cells near zero compared to the column's scale), and whether
+the non-numeric cells (status, ...) and the shapes agree.
 Plots off (they do not change the CSVs).  Existing output folders are reused with --reuse.
 """
 
@@ -48,10 +50,25 @@ def number(cell: str) -> float | None:
         return None
 
 
+def common_columns(ra: list[list[str]], rb: list[list[str]]) -> tuple[list[list[str]], list[list[str]], list[str]]:
+    """The rows of both tables on the columns both headers name (in a's order), and the
+    names only one of them has."""
+    if not ra or not rb or ra[0] == rb[0]:
+        return ra, rb, []
+    names = [c for c in ra[0] if c in rb[0]]
+
+    def pick(rows: list[list[str]]) -> list[list[str]]:
+        where = [rows[0].index(c) for c in names]
+        return [[r[k] if k < len(r) else "" for k in where] for r in rows]
+
+    return pick(ra), pick(rb), sorted(set(ra[0]) ^ set(rb[0]))
+
+
 def compare(a: Path, b: Path) -> str:
-    ra, rb = read(a), read(b)
+    ra, rb, only = common_columns(read(a), read(b))
+    extra = f"; columns in one file only: {', '.join(only)}" if only else ""
     if len(ra) != len(rb) or any(len(x) != len(y) for x, y in zip(ra, rb)):
-        return f"shapes differ ({len(ra)} vs {len(rb)} rows)"
+        return f"shapes differ ({len(ra)} vs {len(rb)} rows){extra}"
     ncol = max((len(r) for r in ra), default=0)
     scale = np.zeros(ncol)
     for r in ra + rb:
@@ -70,7 +87,7 @@ def compare(a: Path, b: Path) -> str:
             if np.isnan(u) and np.isnan(v) or u == v:
                 continue
             worst = max(worst, abs(u - v) / max(abs(u), abs(v), 1e-12 * scale[j], 1e-300))
-    return f"{worst:.1e} over {cells} numbers" + (f"; {text_diff} text cells differ" if text_diff else "")
+    return f"{worst:.1e} over {cells} numbers" + (f"; {text_diff} text cells differ" if text_diff else "") + extra
 
 
 def main() -> None:

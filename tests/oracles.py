@@ -9,6 +9,14 @@ Thick-walled cylinder r in [A, B] in plane strain (axial stretch 1) under intern
   the 1D radial boundary-value problem and solved with scipy's solve_bvp.  Only the
   constitutive routine is shared with the code under test; kinematics, equilibrium, boundary
   conditions and the discretization are independent.
+
+Viscoelasticity (a Prony series on the isochoric 2nd Piola-Kirchhoff stress, DESIGN.md
+section 11.2), with Mooney-Rivlin written anew in principal stretches
+(`mooney_rivlin_iso_pk2`) and the history integrated by scipy, no code of axiform used:
+
+- `uniaxial_prony`: a homogeneous compressible bar stretched along z, lateral faces free.
+- `PronySphere`: an incompressible thick sphere (one Gauss point: the thin membrane), its
+  pressure under a prescribed bore radius, the bore at a pressure, and its creep.
 """
 
 from __future__ import annotations
@@ -159,3 +167,139 @@ class SphereBVP:
         if sol.status != 0:
             raise RuntimeError(f"solve_bvp did not converge at p = {p}: {sol.message}")
         return float(sol.y[0, 0])
+
+
+def mooney_rivlin_iso_pk2(stretches, C1: float, C2: float) -> np.ndarray:
+    """Principal isochoric 2nd Piola-Kirchhoff stresses S_a (..., 3) of Mooney-Rivlin,
+    W_iso = C1 (I1_bar - 3) + C2 (I2_bar - 3), at principal stretches (..., 3), written in
+    principal stretches (not as the code writes it): with lbar_a = J^(-1/3) lambda_a and
+    w_a = lbar_a dW_iso/dlbar_a = 2 C1 lbar_a^2 - 2 C2 lbar_a^-2 (I2_bar = sum lbar_a^-2 on
+    det = 1), the Kirchhoff stress tau_a = w_a - mean(w), and S_a = tau_a / lambda_a^2."""
+    lam = np.asarray(stretches, float)
+    bar = lam / np.cbrt(lam.prod(-1))[..., None]
+    w = 2.0 * C1 * bar**2 - 2.0 * C2 * bar**-2
+    return (w - w.mean(-1, keepdims=True)) / lam**2
+
+
+def uniaxial_prony(stretch, times, C1: float, C2: float, kappa: float, g, tau, rtol: float = 1e-12):
+    """Nominal stress P_zz (n,) and lateral stretch (n,) at `times` (n,) of a homogeneous bar
+    of compressible Mooney-Rivlin (kappa/2 (J - 1)^2) with a Prony series (g_i, tau_i) on
+    its isochoric 2nd Piola-Kirchhoff stress, stretched along z as stretch(t) (a function,
+    stretch(0) = 1), its lateral faces free.
+
+    The history h_i (rr = tt and zz components; the tensor, not the uniaxial stress) obeys
+    dh_i/dt = (g_i S_iso - h_i) / tau_i, integrated with scipy (DOP853, rtol); at every time
+    the lateral stretch s makes S_rr = kappa (J - 1) J / s^2 + S_iso_rr - sum h_rr = 0 (J =
+    s^2 lambda; brentq), and P_zz = lambda (kappa (J - 1) J / lambda^2 + S_iso_zz - sum h_zz)."""
+    from scipy.integrate import solve_ivp
+    from scipy.optimize import brentq
+
+    g, tau = np.asarray(g, float), np.asarray(tau, float)
+
+    def state(t, h):
+        lam = stretch(t)
+        hr, hz = h.reshape(2, -1).sum(-1)
+
+        def S(s):
+            J = s * s * lam
+            iso = mooney_rivlin_iso_pk2(np.array([s, lam, s]), C1, C2)
+            vol = kappa * (J - 1.0) * J
+            return iso, vol / (s * s) + iso[0] - hr, vol / lam**2 + iso[1] - hz
+
+        s = brentq(lambda s: S(s)[1], 0.5 / np.sqrt(lam), 2.0 / np.sqrt(lam), xtol=1e-15, rtol=1e-15)
+        iso, _, Szz = S(s)
+        return s, iso, lam * Szz
+
+    def rate(t, h):
+        iso = state(t, h)[1]
+        return ((np.outer(iso[:2], g) - h.reshape(2, -1)) / tau).ravel()
+
+    sol = solve_ivp(rate, (0.0, float(np.max(times))), np.zeros(2 * len(g)), method="DOP853", t_eval=times,
+                    rtol=rtol, atol=1e-14)
+    if not sol.success:
+        raise RuntimeError(sol.message)
+    out = [state(t, h) for t, h in zip(sol.t, sol.y.T)]
+    return np.array([o[2] for o in out]), np.array([o[0] for o in out])
+
+
+class PronySphere:
+    """An incompressible thick sphere R in [A, B] of Mooney-Rivlin with a Prony series (g_i,
+    tau_i) on its isochoric 2nd Piola-Kirchhoff stress, under internal pressure p.
+
+    Incompressibility fixes the motion by the bore radius a: r^3 = R^3 + a^3 - A^3, hoop
+    stretch l = r / R, radial 1 / l^2.  The history h_i (radial and hoop components) of a
+    material point obeys dh_i/dt = (g_i S_iso - h_i) / tau_i; the pressure of the law's
+    volumetric part cancels from sigma_hoop - sigma_rad = l^2 (S_iso - sum h)_hoop - l^-4
+    (S_iso - sum h)_rad, and radial equilibrium gives p = int_A^B 2 (sigma_hoop - sigma_rad)
+    / r (R^2 / r^2) dR, by Gauss-Legendre over `points` material points (1 point: the
+    thin-membrane formula p = 2 (H / R) sigma / l^3 at the mid-surface)."""
+
+    def __init__(self, A: float, B: float, C1: float, C2: float, g, tau, points: int = 8):
+        self.A, self.C1, self.C2 = A, C1, C2
+        self.g, self.tau = np.asarray(g, float), np.asarray(tau, float)
+        x, w = np.polynomial.legendre.leggauss(points)
+        self.R = A + (B - A) * (x + 1) / 2
+        self.w = w * (B - A) / 2
+
+    def _iso(self, a: float):
+        """Hoop stretch l (q,), current radius r (q,) and S_iso (q, 2) (radial, hoop) at bore a."""
+        r = np.cbrt(self.R**3 + a**3 - self.A**3)
+        lam = r / self.R
+        S = mooney_rivlin_iso_pk2(np.stack([lam**-2, lam, lam], -1), self.C1, self.C2)
+        return lam, r, S[:, :2]
+
+    def pressure(self, a: float, h: np.ndarray | None = None) -> float:
+        """p at bore radius a with the summed history h (q, 2) (None: none, the elastic law)."""
+        lam, r, S = self._iso(a)
+        if h is not None:
+            S = S - h
+        diff = lam**2 * S[:, 1] - lam**-4 * S[:, 0]
+        return float((self.w * 2.0 * diff / r * (self.R / r) ** 2).sum())
+
+    def _rate(self, S: np.ndarray, h: np.ndarray) -> np.ndarray:
+        return ((self.g * S[:, :, None] - h.reshape(S.shape + (-1,))) / self.tau).ravel()
+
+    def _summed(self, h: np.ndarray) -> np.ndarray:
+        return h.reshape(len(self.R), 2, -1).sum(-1)
+
+    def inflation(self, bore, times, rtol: float = 1e-11) -> np.ndarray:
+        """p (n,) at times (n,) with the bore radius a prescribed as bore(t), bore(0) = A."""
+        from scipy.integrate import solve_ivp
+
+        sol = solve_ivp(lambda t, h: self._rate(self._iso(bore(t))[2], h), (0.0, float(np.max(times))),
+                        np.zeros(2 * len(self.R) * len(self.g)), method="DOP853", t_eval=times, rtol=rtol,
+                        atol=1e-14, max_step=np.min(self.tau) / 4)
+        return np.array([self.pressure(bore(t), self._summed(h)) for t, h in zip(sol.t, sol.y.T)])
+
+    def bore(self, p: float, h: np.ndarray | None = None, scale: float = 1.0, bracket=None) -> float:
+        """The bore radius a of the rising branch where scale x pressure(a, h) = p (scale: the
+        law's moduli times it, e.g. the long-term 1 - sum g_i): in `bracket` if given, else the
+        first root on a grid of steps A / 50 up to 3 A, refined by brentq."""
+        from scipy.optimize import brentq
+
+        def f(a):
+            return scale * self.pressure(a, h) - p
+
+        if bracket is not None:
+            return brentq(f, *bracket, xtol=1e-14, rtol=1e-15)
+        grid = self.A * (1.0 + np.arange(1, 101) / 50)
+        above = np.nonzero([f(a) > 0 for a in grid])[0]
+        if not len(above):
+            raise ValueError(f"p = {p} is above the limit point")
+        low = grid[above[0] - 1] if above[0] else self.A
+        return brentq(f, low, grid[above[0]], xtol=1e-14, rtol=1e-15)
+
+    def creep(self, p: float, times, rtol: float = 1e-11) -> np.ndarray:
+        """The bore radius a (n,) at times (n,) under a pressure p applied at t = 0 and held:
+        from the law's elastic bore to the long-term one (1 - sum g_i) x the law."""
+        from scipy.integrate import solve_ivp
+
+        ends = (self.bore(p), self.bore(p, scale=1.0 - self.g.sum()))
+        bracket = (ends[0] - 1e-9 * self.A, ends[1] + 1e-9 * self.A)
+
+        def rate(t, h):
+            return self._rate(self._iso(self.bore(p, self._summed(h), bracket=bracket))[2], h)
+
+        sol = solve_ivp(rate, (0.0, float(np.max(times))), np.zeros(2 * len(self.R) * len(self.g)),
+                        method="DOP853", t_eval=times, rtol=rtol, atol=1e-14)
+        return np.array([self.bore(p, self._summed(h), bracket=bracket) for h in sol.y.T])

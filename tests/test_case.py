@@ -68,7 +68,7 @@ def test_plate_runs_and_writes_results(tmp_path, element):
     assert run(tmp_path, PLATE.format(element=element)) == 0
     out = tmp_path / "out"
     rows = list(csv.DictReader(open(out / "history.csv")))
-    assert list(rows[0]) == ["step", "load_factor", "iterations", "w_center", "rim_fz"]
+    assert list(rows[0]) == ["step", "load_factor", "time", "iterations", "w_center", "rim_fz"]
     assert float(rows[-1]["w_center"]) == pytest.approx(3.0)
     lam = np.array([float(r["load_factor"]) for r in rows])
     assert (np.diff(lam) > 0).all()

@@ -87,7 +87,7 @@ def test_kill_9_leaves_files_that_parse(tmp_path):
         proc.kill()
         proc.communicate()
         h = rows(out)
-        assert all(None not in r.values() and len(r) == 5 for r in h)
+        assert all(None not in r.values() and len(r) == 6 for r in h)
         s = summary(out)
         assert s["status"] == "running" and s["steps"] in (len(h), len(h) - 1)
         files = [d.get("file") for d in ET.parse(out / "fields.pvd").getroot().iter("DataSet")]

@@ -262,15 +262,21 @@ def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], st
     return _solve(job, out_dir, note, writer, quiet, stops, stream)
 
 
-def time_name(model) -> str:
-    """What the progress calls the load factor: `t` where it is the process time (load curves
-    or moving tools follow it, or a law with memory), else `lambda`."""
-    return "t" if model.timed() else "lambda"
+def time_name(case, model) -> tuple[str, str]:
+    """What the progress calls the load factor, and its unit: `t` with the unit of [units] time
+    (if given) where it is the process time (a physical time, labels.time_is_real; or load
+    curves with knots or moving tools follow it), else `lambda` and no unit."""
+    from ..post.labels import time_is_real
+
+    if time_is_real(case) or model.timed():
+        return "t", case.units.time or ""
+    return "lambda", ""
 
 
 def fitted(head: str, tail: list[str], width: int) -> str:
-    """head, then as many of the parts in tail as fit within width columns (two spaces apart)."""
-    text = head
+    """head (cut to width), then as many of the parts in tail as fit within width columns (two
+    spaces apart)."""
+    text = head[:width]
     for part in tail:
         if len(text) + 2 + len(part) > width:
             break
@@ -285,17 +291,19 @@ BAR_COLUMNS = 27
 def _step_progress(job: Job, quiet: bool, stream):
     """The progress of a run, called with each converged step and its monitor values: the
     driven dof, the stop dof of an arc length, or the load factor, against its goal.  A line
-    within COLUMNS: step, t (or lambda), Newton iterations, seconds, then the monitors that fit."""
+    within COLUMNS: step, t with its unit (or lambda), Newton iterations, seconds, then the
+    monitors that fit."""
     control = job.built.control
     driven, goal = getattr(control, "dof", None), control.target
     if getattr(control, "stop_dof", None) is not None:
         driven, goal = control.stop_dof, control.stop_value
     line = ProgressLine(stream, 1.0, quiet)
-    lam = time_name(job.built.model)
+    lam, unit = time_name(job.case, job.built.model)
+    unit = f" {unit}" if unit else ""
 
     def show(step, values: dict[str, float]) -> None:
         frac = (step.u[driven] if driven is not None else step.lam) / goal
-        head = f"step {step.number}  {lam} {step.lam:.4g}  its {step.iterations}  {line.elapsed:.1f} s"
+        head = f"step {step.number}  {lam} {step.lam:.4g}{unit}  its {step.iterations}  {line.elapsed:.1f} s"
         mon = [f"{k} {v:.4g}" for k, v in list(values.items())[:3]]
         line.show(frac, f"{100 * min(max(frac, 0.0), 1.0):5.1f}%  " + fitted(head, mon, COLUMNS - BAR_COLUMNS),
                   fitted(head, mon, COLUMNS))

@@ -44,7 +44,7 @@ from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, Field, StrictStr, ValidationError, field_validator, model_validator
 
-from ..case.schema import CaseError, fingerprint, parse, read
+from ..case.schema import HISTORY_COLUMNS, CaseError, fingerprint, parse, read
 from ..post.sweep_plots import plot_sweep
 from .console import ProgressLine
 
@@ -230,7 +230,8 @@ def summary_row(folder: Path) -> dict[str, Any]:
 
 
 def monitor_extremes(history: Path) -> dict[str, tuple[float, float]]:
-    """(min, max) of every monitor column of a history.csv over its rows; {} without one."""
+    """(min, max) of every monitor column (not one of HISTORY_COLUMNS) of a history.csv over
+    its rows; {} without one."""
     try:
         with open(history, newline="") as fh:
             rows = list(csv.reader(fh))
@@ -239,7 +240,9 @@ def monitor_extremes(history: Path) -> dict[str, tuple[float, float]]:
     if len(rows) < 2:
         return {}
     extremes = {}
-    for k, name in enumerate(rows[0][3:], start=3):
+    for k, name in enumerate(rows[0]):
+        if name in HISTORY_COLUMNS:
+            continue
         values = [float(r[k]) for r in rows[1:] if len(r) > k and r[k]]
         if values:
             extremes[name] = (min(values), max(values))

@@ -11,7 +11,7 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from .base import CaseError, CurveMixin, PositiveFloat, Selector, Strict
+from .base import CaseError, CurveKnots, CurveMixin, PositiveFloat, Selector, Strict
 from ..contact.dxf import DxfError, read_dxf
 from ..contact.pair import ContactPair
 from ..contact.surfaces import Circle, Polyline
@@ -108,11 +108,19 @@ class ContactSpec(Strict):
     # contact stabilization, a fraction of the normal penalty (ContactPair); absent: on for a
     # body held only by contact, off elsewhere
     stabilization: Annotated[float, Field(ge=0, le=1)] | None = None
+    # heat to the mould ([thermal]): h_c (T - temperature x f(t)) through the slave nodes in contact
+    temperature: float | None = None
+    temperature_curve: CurveKnots | None = None
+    conductance: Annotated[float, Field(gt=0)] | None = None
 
     @model_validator(mode="after")
     def _law(self):
         if self.sticky and self.friction:
             raise ValueError("give friction or sticky = true, not both")
+        if (self.temperature is None) != (self.conductance is None):
+            raise ValueError("temperature (the mould's) and conductance go together")
+        if self.temperature_curve is not None and self.temperature is None:
+            raise ValueError("temperature_curve needs temperature")
         return self
 
 

@@ -6,15 +6,19 @@ with the law's keys (KEYS), and `kappa`, or `E` and `nu` (kappa = E / (3 (1 - 2 
 one constant sets the initial shear modulus (SHEAR_KEY) it may be left out when E and nu are
 given: the law's mu then stands for E / (2 (1 + nu)).  Every number must be finite and in
 range; an error names the key (material.KEY) or, for a missing or cross-key problem, the table.
+A constant other than Ogden's lists may be a table of the temperature [[T, value], ...]
+(T increasing, every value in range; piecewise linear, constant outside), which needs the
+case's [temperature].
 """
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, ValidationInfo, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
 from ..materials import ArrudaBoyce, Gent, Hyperelastic, MooneyRivlin, Ogden, Yeoh
+from ..materials.temperature import Table, TemperatureDependent
 from ..materials.viscoelastic import Prony, Viscoelastic
 
 Model = Literal["neo-hooke", "mooney-rivlin", "yeoh", "ogden", "gent", "arruda-boyce"]
@@ -43,6 +47,27 @@ _RANGE = {
     "E": (lambda v: v > 0, "must be > 0"),
     "nu": (lambda v: -1 < v < 0.5, "must lie in (-1, 0.5)"),
 }
+
+
+# a constant as a table of the temperature: [[T, value], ...]
+Tabled = float | list[Annotated[list[float], Field(min_length=2, max_length=2)]] | None
+
+
+def _check_number(value: Any, test, need: str) -> Any:
+    """A number passing `test`, or a table [[T, value], ...] (T increasing) whose every value does."""
+    if not isinstance(value, list):
+        if not test(value):
+            raise ValueError(f"{need}, got {value}")
+        return value
+    if not value:
+        raise ValueError("a table of the temperature needs at least one row [T, value]")
+    T = [row[0] for row in value]
+    if any(b <= a for a, b in zip(T, T[1:])):
+        raise ValueError("a table of the temperature: T must increase from row to row")
+    for t, v in value:
+        if not test(v):
+            raise ValueError(f"every value of the table {need}, got {v} at T = {t}")
+    return value
 
 
 def _belongs(key: str, info: ValidationInfo) -> str | None:
@@ -87,18 +112,18 @@ class MaterialSpec(BaseModel):
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     model: Model
-    C1: float | None = None
-    C2: float | None = None
-    C10: float | None = None
-    C20: float | None = None
-    C30: float | None = None
+    C1: Tabled = None
+    C2: Tabled = None
+    C10: Tabled = None
+    C20: Tabled = None
+    C30: Tabled = None
     mu: Any = None  # a number (gent, arruda-boyce) or a list (ogden)
     alpha: Any = None
-    Jm: float | None = None
-    lambda_m: float | None = None
-    kappa: float | None = None
-    E: float | None = None
-    nu: float | None = None
+    Jm: Tabled = None
+    lambda_m: Tabled = None
+    kappa: Tabled = None
+    E: Tabled = None
+    nu: Tabled = None
     viscoelastic: ViscoelasticSpec | None = None
 
     @field_validator(*_RANGE, mode="before")
@@ -112,10 +137,7 @@ class MaterialSpec(BaseModel):
     @classmethod
     def _number(cls, value: float, info: ValidationInfo) -> float:
         _belongs(info.field_name, info)
-        test, need = _RANGE[info.field_name]
-        if not test(value):
-            raise ValueError(f"{need}, got {value}")
-        return value
+        return _check_number(value, *_RANGE[info.field_name])
 
     @field_validator("mu", mode="before")
     @classmethod
@@ -123,9 +145,12 @@ class MaterialSpec(BaseModel):
         model = _belongs("mu", info)
         if model == "ogden":
             return _numbers(value, "ogden mu")
+        if isinstance(value, list) and all(isinstance(row, list) and len(row) == 2 for row in value):
+            rows = [_numbers(row, "a row [T, value] of the table") for row in value]
+            return _check_number([tuple(r) for r in rows], lambda v: v > 0, "must be > 0")
         if isinstance(value, bool) or not isinstance(value, int | float) or value != value \
                 or abs(value) == float("inf"):
-            raise ValueError(f"must be a finite number, got {value!r}")
+            raise ValueError(f"must be a finite number (or a table [[T, value], ...]), got {value!r}")
         if not value > 0:
             raise ValueError(f"must be > 0, got {value}")
         return float(value)
@@ -159,27 +184,53 @@ class MaterialSpec(BaseModel):
             raise ValueError(f"missing material constant: {', '.join(missing)}")
         return self
 
-    def build(self) -> Hyperelastic | Viscoelastic:
-        """The law (with its Prony series where `viscoelastic` is given)."""
-        law = self.elastic_law()
+    def tables(self) -> dict[str, Table]:
+        """The constants given as tables of the temperature."""
+        out = {}
+        for k in CONSTANTS:
+            v = getattr(self, k)
+            if isinstance(v, list) and k != "alpha" and not (k == "mu" and self.model == "ogden"):
+                out[k] = Table.of(v)
+        return out
+
+    def build(self, temperature: float | None = None) -> Hyperelastic | Viscoelastic | TemperatureDependent:
+        """The law (with its Prony series where `viscoelastic` is given); where constants are
+        tables of T, a TemperatureDependent law whose scales are taken at `temperature`
+        (ValueError naming the key when it is None)."""
+        tables = self.tables()
+        if not tables:
+            law = self.elastic_law()
+        elif temperature is None:
+            raise ValueError(f"{next(iter(tables))}: a table of the temperature needs the case's [temperature]")
+        else:
+            fixed = {k: getattr(self, k) for k in CONSTANTS if k not in tables}
+            law = TemperatureDependent(self.elastic_law, tables, fixed, temperature)
         if self.viscoelastic is None:
             return law
         return Viscoelastic(law, Prony(tuple(self.viscoelastic.g), tuple(self.viscoelastic.tau)))
 
-    def elastic_law(self) -> Hyperelastic:
-        """The law, with kappa given or from E and nu, and the shear constant from E and nu
-        where it was left out."""
-        kappa = self.kappa if self.kappa is not None else self.E / (3.0 * (1.0 - 2.0 * self.nu))
-        mu0 = self.E / (2.0 * (1.0 + self.nu)) if self.E is not None else None
+    def elastic_law(self, constants: dict[str, Any] | None = None) -> Hyperelastic:
+        """The law from its constants (the spec's, or `constants`: name -> number, or array of
+        one value per point), with kappa given or from E and nu, and the shear constant from
+        E and nu where it was left out."""
+        c = constants if constants is not None else {k: getattr(self, k) for k in CONSTANTS}
+        E, nu = c["E"], c["nu"]
+        kappa = c["kappa"] if c["kappa"] is not None else E / (3.0 * (1.0 - 2.0 * nu))
+        mu0 = E / (2.0 * (1.0 + nu)) if E is not None else None
         m = self.model
         if m in ("neo-hooke", "mooney-rivlin"):
-            return MooneyRivlin(self.C1 if self.C1 is not None else mu0 / 2.0, self.C2 or 0.0, kappa)
+            return MooneyRivlin(c["C1"] if c["C1"] is not None else mu0 / 2.0,
+                                c["C2"] if c["C2"] is not None else 0.0, kappa)
         if m == "yeoh":
-            return Yeoh(self.C10 if self.C10 is not None else mu0 / 2.0, self.C20, self.C30, kappa)
+            return Yeoh(c["C10"] if c["C10"] is not None else mu0 / 2.0, c["C20"], c["C30"], kappa)
         if m == "ogden":
-            return Ogden(tuple(self.mu), tuple(self.alpha), kappa)
+            return Ogden(tuple(c["mu"]), tuple(c["alpha"]), kappa)
         if m == "gent":
-            return Gent(self.mu if self.mu is not None else mu0, self.Jm, kappa)
+            return Gent(c["mu"] if c["mu"] is not None else mu0, c["Jm"], kappa)
         # Abaqus' mu from the initial shear modulus: mu0 / mu depends on lambda_m alone
-        mu = self.mu if self.mu is not None else mu0 / ArrudaBoyce(1.0, self.lambda_m, kappa).shear_modulus
-        return ArrudaBoyce(mu, self.lambda_m, kappa)
+        mu = c["mu"] if c["mu"] is not None else mu0 / ArrudaBoyce(1.0, c["lambda_m"], kappa).shear_modulus
+        return ArrudaBoyce(mu, c["lambda_m"], kappa)
+
+
+# the law's constants (ogden's mu and alpha are lists, never tables)
+CONSTANTS = ("C1", "C2", "C10", "C20", "C30", "mu", "alpha", "Jm", "lambda_m", "kappa", "E", "nu")

@@ -1,5 +1,5 @@
 """The [[monitor]] tables of the case file: named scalars read off each converged step (one
-dof, a sum of reactions, a quantity of a contact pair or of a cavity)."""
+dof, a sum of reactions, a node's temperature, a quantity of a contact pair or of a cavity)."""
 
 from __future__ import annotations
 
@@ -15,8 +15,7 @@ from ..contact.pair import ContactPair
 from ..fem.mesh import Mesh
 from ..model.model import Model
 from ..fem.selectors import select_nodes
-
-HISTORY_COLUMNS = ("step", "load_factor", "iterations")  # history.csv's first columns
+from ..post.results_folder import HISTORY_COLUMNS
 # characters a monitor name may not hold (besides the unprintable ones): the CSV separators and quotes
 NOT_IN_NAMES = frozenset(',;"\t')
 
@@ -31,7 +30,7 @@ class MonitorSpec(Strict):
     dof: DofName | None = None
     contact: Annotated[int, Field(ge=0)] | None = None
     cavity: str | None = None
-    quantity: Literal["force-r", "force-z", "area", "penetration", "pressure", "volume"] | None = None
+    quantity: Literal["force-r", "force-z", "area", "penetration", "pressure", "volume", "temperature"] | None = None
 
     @field_validator("name")
     @classmethod
@@ -58,6 +57,10 @@ class MonitorSpec(Strict):
             return self
         if self.quantity in ("pressure", "volume"):
             raise ValueError(f"quantity = \"{self.quantity}\" belongs to a cavity monitor")
+        if self.quantity == "temperature":
+            if self.at is None or self.dof is not None:
+                raise ValueError("a temperature monitor needs 'at' (one node) and no 'dof'")
+            return self
         if self.contact is None:
             if self.dof is None:
                 raise ValueError(f"a monitor with '{given[0]}' needs 'dof'")
@@ -77,8 +80,9 @@ _CONTACT_QUANTITY = {"force-r": "force_r", "force-z": "force_z", "area": "contac
 
 @dataclass
 class Monitor:
-    """A named scalar read off each converged step: one dof, a sum of reactions, a contact
-    pair's total force, contact area or penetration, or a cavity's pressure or volume."""
+    """A named scalar read off each converged step: one dof, a sum of reactions, a node's
+    temperature, a contact pair's total force, contact area or penetration, or a cavity's
+    pressure or volume."""
 
     name: str
     dofs: np.ndarray | None = None
@@ -86,7 +90,7 @@ class Monitor:
     pair: object = None
     quantity: str = ""
     cavity: object = None
-    index: int = 0  # of the pair or cavity in the model (the state's order)
+    index: int = 0  # of the pair or cavity in the model (the state's order); the node of a temperature
 
     def value(self, step) -> float:
         """The monitored scalar at a converged step (solve.solver.Step), read off its
@@ -94,6 +98,8 @@ class Monitor:
         if self.cavity is not None:
             held = step.state.cavities[self.index]
             return float(held.pressure if self.quantity == "pressure" else held.volume)
+        if self.quantity == "temperature":
+            return float(step.state.temperature[self.index])
         if self.pair is not None:
             return float(self.pair.report(step.state.contacts[self.index])[_CONTACT_QUANTITY[self.quantity]])
         if self.reaction:
@@ -118,6 +124,11 @@ def build_monitors(model: Model, mesh: Mesh, specs: list[MonitorSpec], cavities:
                 raise CaseError(f"monitor[{i}].contact: there are {len(pairs)} [[contact]] tables (from 0)")
             monitors.append(Monitor(m.name, pair=pairs[m.contact], quantity=m.quantity,
                                     index=model.contacts.index(pairs[m.contact])))
+            continue
+        if m.quantity == "temperature":
+            if model.temperature is None:
+                raise CaseError(f"monitor[{i}].quantity: \"temperature\" needs the case's [temperature]")
+            monitors.append(Monitor(m.name, quantity="temperature", index=one_node(mesh, m.at, f"monitor[{i}].at")))
             continue
         if m.dof == "rot" and model.dpn == 2:
             raise CaseError(f"monitor[{i}].dof: element '{element}' has no rotation dof")

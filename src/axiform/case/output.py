@@ -34,6 +34,7 @@ class UnitsSpec(Strict):
     pressure: Unit | None = None
     force: Unit | None = None
     time: Unit | None = None
+    temperature: Unit | None = None
 
 
 class RestartSpec(Strict):

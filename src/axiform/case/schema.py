@@ -37,6 +37,8 @@ from .contact import (
 )
 from .loads import FixSpec, PointLoadSpec, PressureSpec, apply_loads, prescribe_fixes
 from .material import MaterialSpec
+from .temperature import TemperatureSpec
+from .thermal import ConvectionSpec, ThermalSpec, build_conduction
 from .mesh import ArcPiece, LinePiece, MeshSpec, PieceSpec, build_mesh
 from .monitor import HISTORY_COLUMNS, Monitor, MonitorSpec, build_monitors
 from .output import MAX_REVOLVED_POINTS, OutputSpec, RestartSpec, Unit, UnitsSpec
@@ -73,6 +75,9 @@ class Case(Strict):
     output: OutputSpec = OutputSpec()
     restart: RestartSpec = RestartSpec()
     units: UnitsSpec = UnitsSpec()
+    temperature: TemperatureSpec | None = None
+    thermal: ThermalSpec | None = None
+    convection: list[ConvectionSpec] = []
 
 
 # the names pydantic gives the members of a union in an error's location: not keys
@@ -230,14 +235,22 @@ def build(case: Case, base: str | Path = ".") -> Built:
     if sectors and mesh.n_nodes * sectors > MAX_REVOLVED_POINTS:
         raise CaseError(f"output.revolved: {sectors} sectors of a mesh of {mesh.n_nodes:,} nodes make a 3D copy of "
                         f"{mesh.n_nodes * sectors:,} points (at most {MAX_REVOLVED_POINTS:,}): use fewer sectors")
+    heat = case.temperature
     try:
-        material = case.material.build()
+        material = case.material.build(None if heat is None else heat.representative())
     except ValueError as exc:
-        raise CaseError(f"material: {exc}") from None
+        raise CaseError(f"material.{exc}" if str(exc).split(":")[0] in case.material.tables()
+                        else f"material: {exc}") from None
     try:
         model = Model(mesh, material, formulation=case.mesh.formulation, sfr_edges=case.mesh.sfr_edges)
     except MeshError as exc:
         raise CaseError(f"mesh: {exc}") from None
+    if heat is not None:
+        try:
+            model.heat(heat.nodal(mesh), heat.build_shift())
+        except ValueError as exc:
+            key = "wlf.C2" if heat.shift is not None and heat.shift.wlf is not None else "arrhenius"
+            raise CaseError(f"temperature.shift.{key}: {exc}") from None
     crossing = boundary_crossing(mesh.points, mesh.boundary_edges)
     if crossing is not None:
         p = mesh.points[mesh.boundary_edges[crossing[0], 0]]
@@ -250,12 +263,14 @@ def build(case: Case, base: str | Path = ".") -> Built:
         pairs = [contact_pair(mesh, model, c, base, f"contact[{i}]") for i, c in enumerate(case.contact)]
         for pair in pairs:
             model.contact(pair)
+        build_conduction(model, mesh, case.thermal, case.convection, case.contact)
         monitors = build_monitors(model, mesh, case.monitor, cavities, pairs, case.mesh.element)
         control = build_control(model, mesh, case.solver)
         moving = any(c.motion.ur or c.motion.uz for c in case.contact)
         gas = any(c.control != "pressure" or c.pressure for c in case.cavity)
         loads = [*case.pressure, *case.point_load, *case.fix]
-        if not any(item.value for item in loads) and not moving and not gas:
+        heated = case.thermal is not None and (case.convection or any(c.conductance for c in case.contact))
+        if not any(item.value for item in loads) and not moving and not gas and not heated:
             raise CaseError("pressure: nothing loads the model: every [[pressure]], [[point_load]] and [[fix]] "
                             "value is zero (or absent), no [[contact]] surface moves and no [[cavity]] is loaded")
     except SelectorError as exc:

@@ -66,8 +66,10 @@ def build_control(model: Model, mesh: Mesh, spec: SolverSpec) -> LoadControl | D
     """The path-following control of the [solver] table, on the model with its [[fix]] tables
     prescribed (a driven or stop dof that is also fixed is refused).  A law with memory makes
     the load factor the process time: only load control advances it."""
-    if spec.control != "load" and getattr(model.material, "prony", None) is not None:
-        raise CaseError(f"solver.control: \"{spec.control}\" does not work with a viscoelastic material: the load "
+    timed = ("a viscoelastic material" if getattr(model.material, "prony", None) is not None
+             else "heat conduction ([thermal])" if model.conduction is not None else None)
+    if spec.control != "load" and timed:
+        raise CaseError(f"solver.control: \"{spec.control}\" does not work with {timed}: the load "
                         "factor is the process time there, and time must advance; use control = \"load\" with a "
                         "cavity under volume or gas control, or a prescribed motion with its curve")
     if spec.control == "displacement":

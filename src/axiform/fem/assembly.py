@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .elements import gradient_operator
+from .elements import gauss_quad, gradient_operator
 from ..materials import InvertedElementError, deformation_gradient
 from ..materials.viscoelastic import Memory
 from .mesh import Mesh
@@ -42,9 +42,25 @@ class SolidAssembly:
         ue = u_full[self.dofs]
         return deformation_gradient(np.matmul(self._G2, ue[:, :, None]).reshape(e, q, 5))
 
-    def stress(self, x: np.ndarray, sl: slice = slice(None)) -> np.ndarray:
-        """First Piola-Kirchhoff stress P (e, q, 5) at the gradients x of the elements sl."""
-        return self.material.stress(x)
+    def point_values(self, nodal: np.ndarray) -> np.ndarray:
+        """A nodal field (n,) at the quadrature points (e, q), by the element's shape
+        functions (SFR: its Q4 ones)."""
+        kind = self.mesh.element
+        N = kind.shape(gauss_quad(kind.gauss)[0])[0]  # (q, k)
+        return nodal[self.mesh.cells] @ N.T
+
+    def law(self, sl: slice = slice(None), temperature: np.ndarray | None = None):
+        """The law at the points of the elements sl: the material, or where its constants are
+        tables of T (materials.temperature) the law at the points' temperatures (temperature:
+        (e, q) of all elements), one value per point in the order of x[sl].reshape(-1, 5)."""
+        if temperature is None or not hasattr(self.material, "at"):
+            return self.material
+        return self.material.at(temperature[sl])
+
+    def stress(self, x: np.ndarray, sl: slice = slice(None), temperature: np.ndarray | None = None) -> np.ndarray:
+        """First Piola-Kirchhoff stress P (e, q, 5) at the gradients x of the elements sl
+        (temperature: (e, q) at the points of all elements, or None)."""
+        return self.law(sl, temperature).stress(x)
 
     @staticmethod
     def check_inverted(x: np.ndarray, offset: int = 0) -> None:
@@ -74,26 +90,28 @@ class SolidAssembly:
         return np.empty((e, nd)), np.empty((e, nd, nd)) if tangent else None
 
     def evaluate(self, u_full: np.ndarray, tangent: bool = True, out: tuple | None = None,
-                 memory: Memory | None = None):
+                 memory: Memory | None = None, temperature: np.ndarray | None = None):
         """Element internal forces fe (e, nd) and, if asked, element tangents Ke (e, nd, nd),
         written into out = (fe, Ke) when given (from `buffers`) and returned.  memory: the
         step of a law with a history per quadrature point (materials.viscoelastic.Memory),
-        whose trial arrays are filled here."""
+        whose trial arrays are filled here; temperature: (e, q) at the points (the law's
+        constants that are tables of T), or None."""
         e, q, _, nd = self.G.shape
         fe, Ke = out if out is not None else self.buffers(tangent)
         for sl, x in self.chunks(u_full):
             m = sl.stop - sl.start
             GdV_T = self._GdV[sl].transpose(0, 2, 1)
+            law = self.law(sl, temperature)
             if memory is not None:  # the law's parts apart: the Prony series acts on the isochoric one
-                P, A = self.material.iso_stress_tangent(x)
-                P_vol, A_vol = self.material.volumetric_stress_tangent(x)
+                P, A = law.iso_stress_tangent(x)
+                P_vol, A_vol = law.volumetric_stress_tangent(x)
                 dP, dA = memory.add(sl, x, P, A if tangent else None)
                 P = P + P_vol + dP
                 A = A + A_vol + dA if tangent else None
             elif tangent:
-                P, A = self.material.stress_tangent(x)
+                P, A = law.stress_tangent(x)
             else:
-                P, A = self.material.stress(x), None
+                P, A = law.stress(x), None
             if tangent:
                 AG = np.matmul(A, self.G[sl]).reshape(m, q * 5, nd)
                 np.matmul(GdV_T, AG, out=Ke[sl])

@@ -96,37 +96,43 @@ class MixedAssembly(SolidAssembly):
         self.NpdV = NpdV
         self._NpdV_T = np.ascontiguousarray(NpdV.transpose(0, 2, 1))  # (e, np, q)
 
-    def _pressure(self, xt: np.ndarray, sl: slice) -> tuple[np.ndarray, np.ndarray]:
+    def _pressure(self, xt: np.ndarray, sl: slice, temperature=None) -> tuple[np.ndarray, np.ndarray]:
         """p = kappa (J_bar - 1) (n,) and dJ (5, n) at the rows xt (5, n) of the elements sl."""
         J, dJ = volumetric_rows(xt)
         m, q = self.Np[sl].shape[:2]
         h = np.matmul(self._NpdV_T[sl], J.reshape(m, q, 1))  # int N_p J dV (m, np, 1)
         Jbar = np.matmul(self.Np[sl], np.matmul(self.Minv[sl], h))  # (m, q, 1)
-        return self.material.kappa * (Jbar.reshape(-1) - 1.0), dJ
+        return (self.bulk_modulus(sl, temperature)[:, None] * (Jbar[..., 0] - 1.0)).reshape(-1), dJ
 
-    def stress(self, x: np.ndarray, sl: slice = slice(None)) -> np.ndarray:
+    def bulk_modulus(self, sl: slice, temperature: np.ndarray | None = None) -> np.ndarray:
+        """kappa (m,) of the elements sl: the law's, or where it is a table of T the mean of
+        the element's points (one pressure field per element needs one kappa)."""
+        m = len(range(*sl.indices(self.dV.shape[0])))
+        kappa = np.asarray(self.law(sl, temperature).kappa, float)
+        return np.broadcast_to(kappa, (m,)) if kappa.ndim == 0 else kappa.reshape(m, -1).mean(1)
+
+    def stress(self, x: np.ndarray, sl: slice = slice(None), temperature: np.ndarray | None = None) -> np.ndarray:
         """P = P_iso + p dJ/dF (e, q, 5) with the element pressure p."""
         xt, shape = to_rows(x)
-        p, dJ = self._pressure(xt, sl)
-        P = self.material.stress_rows(xt, 0.0, False)[0]
+        p, dJ = self._pressure(xt, sl, temperature)
+        P = self.law(sl, temperature).stress_rows(xt, 0.0, False)[0]
         P += p * dJ
         return from_rows(P, None, shape)[0]
 
     def evaluate(self, u_full: np.ndarray, tangent: bool = True, out: tuple | None = None,
-                 memory=None):
+                 memory=None, temperature: np.ndarray | None = None):
         """Element internal forces fe (e, nd) and, if asked, element tangents Ke (e, nd, nd),
-        written into out = (fe, Ke) when given (from `buffers`) and returned (memory: as for
-        SolidAssembly.evaluate).  The law's
+        written into out = (fe, Ke) when given (from `buffers`) and returned (memory,
+        temperature: as for SolidAssembly.evaluate).  The law's
         isochoric part (`stress_rows` with kappa = 0) and the pressure terms are computed on the
         contiguous component rows (5, n), then brought to (m, q, 5, 5) once."""
         e, q, _, nd = self.G.shape
         fe, Ke = out if out is not None else self.buffers(tangent)
-        kappa = self.material.kappa
         for sl, x in self.chunks(u_full):
             m = sl.stop - sl.start
             xt, shape = to_rows(x)
-            p, dJ = self._pressure(xt, sl)
-            P, A = self.material.stress_rows(xt, 0.0, tangent)
+            p, dJ = self._pressure(xt, sl, temperature)
+            P, A = self.law(sl, temperature).stress_rows(xt, 0.0, tangent)
             if memory is not None:  # the Prony series on the isochoric part (rows viewed as points)
                 dP, dA = memory.add(sl, xt.T.reshape(shape + (5,)), P.T.reshape(shape + (5,)),
                                     None if A is None else A.transpose(2, 0, 1).reshape(shape + (5, 5)))
@@ -146,5 +152,6 @@ class MixedAssembly(SolidAssembly):
                 # K += kappa B^T M^-1 B
                 W = self._NpdV_T[sl][:, :, :, None] * dJ.T.reshape(m, 1, q, 5)  # (m, np, q, 5)
                 B = np.matmul(W.reshape(m, -1, q * 5), self._G2[sl])
+                kappa = self.bulk_modulus(sl, temperature)[:, None, None]
                 Ke[sl] += np.matmul(B.transpose(0, 2, 1), kappa * np.matmul(self.Minv[sl], B))
         return fe, Ke

@@ -1,5 +1,5 @@
 """Files of a results folder written whole or not at all: an atomic replace, a VTU file of the
-mesh with point data, the mould outlines as CSV text."""
+mesh with point data, the ParaView series of the VTU files, the mould outlines as CSV text."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import io
 import os
 from contextlib import contextmanager
 from pathlib import Path
+from xml.etree import ElementTree as ET
 
 import numpy as np
 
@@ -41,6 +42,27 @@ def write_vtu(path: Path, mesh, data: dict[str, np.ndarray]) -> None:
     pts = np.column_stack([mesh.points, np.zeros(mesh.n_nodes)])
     with atomic(path) as tmp:
         meshio.write(tmp, meshio.Mesh(pts, [(cell_type, mesh.cells)], point_data=data), file_format="vtu")
+
+
+def series_times(entries: list[tuple[int, float, str]]) -> list[float]:
+    """The `timestep` of each entry (step, t, file) of fields.pvd: the process time t of its
+    step when the times increase strictly along the series (a reader orders the frames by
+    it); else (arc length past a limit point, where the load factor goes back) the step numbers."""
+    times = [t for _, t, _ in entries]
+    if all(a < b for a, b in zip(times, times[1:])):
+        return times
+    return [float(step) for step, _, _ in entries]
+
+
+def write_pvd(path: Path, entries: list[tuple[int, float, str]]) -> None:
+    """fields.pvd, atomically: a ParaView collection of the VTU files of the entries (step, t,
+    file), in their order, with their timesteps (series_times)."""
+    root = ET.Element("VTKFile", type="Collection", version="0.1")
+    coll = ET.SubElement(root, "Collection")
+    for (_, _, name), t in zip(entries, series_times(entries)):
+        ET.SubElement(coll, "DataSet", timestep=repr(t), part="0", file=name)
+    with atomic(path) as tmp:
+        ET.ElementTree(root).write(tmp)
 
 
 def mould_outlines(pairs, lam: float) -> str:

@@ -1,12 +1,14 @@
 """The results folder, written as steps converge: history.csv, summary.json, a VTU series,
 thickness.csv, optional GiD files and a 3D revolved copy, and PNG plots at the end.
 
-history.csv: one row per converged step (step, load_factor, iterations, then one column per
-monitor).  summary.json: status, steps, newton_iterations, wall_time_s, dofs, elements,
-element, units, load (what the load factor scales), monitor_quantities, the case's origin
-and fingerprint (and more).  fields/: a ParaView series (step_NNNN.vtu listed in fields.pvd;
-surfaces_NNNN.csv the moulds at that step).  thickness.csv: the wall thickness along the body
-at the last written step; thickness/step_NNNN.csv every `thickness_every` steps.
+history.csv: one row per converged step (step, load_factor, time, iterations, then one column
+per monitor; time = load_factor, the process time t).  summary.json: status, steps,
+newton_iterations, wall_time_s, dofs, elements, element, units, load (what the load factor
+scales), monitor_quantities, the case's origin and fingerprint (and more).  fields/: a
+ParaView series (step_NNNN.vtu listed in fields.pvd with the time t of its step as timestep,
+files.write_pvd; surfaces_NNNN.csv the moulds at that step).  thickness.csv: the wall
+thickness along the body at the last written step; thickness/step_NNNN.csv every
+`thickness_every` steps.
 Every file is written whole to a temporary name, then renamed over the old one (`atomic`).
 """
 
@@ -21,14 +23,14 @@ import time
 from collections.abc import Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
-from xml.etree import ElementTree as ET
 
 import numpy as np
 
 from . import gid
 from ..post.fields import point_fields, with_components
+from ..post.results_folder import HISTORY_COLUMNS
 from ..post.thickness import thickness_table, write_thickness_csv
-from .files import atomic, mould_outlines, write_atomic, write_vtu
+from .files import atomic, mould_outlines, write_atomic, write_pvd, write_vtu
 from .run_report import RunRecord, column_units, thickness_summary
 
 
@@ -75,10 +77,12 @@ STALE = ("thickness.csv", "contact.csv", "surfaces.csv", "fields.pvd", "revolved
          "thickness.png", "deformed.png", "forming.gif")
 
 
-def clear_folder(out: Path, kept: int, vtu: bool, thickness_steps: bool) -> list[tuple[float, str]]:
-    """Make the folders; remove the temporary files, the per-step files after step `kept`
-    and the files written at the end of a run (STALE).  Returns the fields.pvd entries of
-    the VTU files kept (a resumed run)."""
+def clear_folder(out: Path, times: dict[int, float], vtu: bool, thickness_steps: bool) -> list[tuple[int, float, str]]:
+    """Make the folders; remove the temporary files, the per-step files after the last step
+    kept (times: the time t of each step kept, {} for a new run) and the files written at the
+    end of a run (STALE).  Returns the fields.pvd entries (step, t, file) of the VTU files
+    kept (a resumed run)."""
+    kept = max(times, default=0)
     for tmp in out.glob(".*.tmp"):
         tmp.unlink()
     if vtu:
@@ -93,7 +97,8 @@ def clear_folder(out: Path, kept: int, vtu: bool, thickness_steps: bool) -> list
         (out / stale).unlink(missing_ok=True)
     if not (kept and vtu):
         return []
-    return [(float(int(f.stem.split("_")[-1])), f"fields/{f.name}") for f in sorted((out / "fields").glob("step_*.vtu"))]
+    steps = sorted(int(f.stem.split("_")[-1]) for f in (out / "fields").glob("step_*.vtu"))
+    return [(n, times[n], f"fields/step_{n:04d}.vtu") for n in steps]
 
 
 class ResultsWriter:
@@ -133,9 +138,9 @@ class ResultsWriter:
         self.t0 = time.perf_counter()
         self.steps = 0
         self.newton_iterations = 0
-        self._pvd: list[tuple[float, str]] = []
+        self._pvd: list[tuple[int, float, str]] = []  # step, time t, file of each VTU file written
         self._vtu_writer: ThreadPoolExecutor | None = None  # writes the VTU files (write_vtu)
-        self._vtu_pending: list[tuple[float, str, Future]] = []  # submitted, not yet in _pvd
+        self._vtu_pending: list[tuple[int, float, str, Future]] = []  # submitted, not yet in _pvd
         self._last_written = 0
         self._unsaid: list[str] = []  # warnings to print to stderr at the end (not the pre-run ones)
         self.summary = initial_summary(model, title, labels, case, warnings)
@@ -147,15 +152,15 @@ class ResultsWriter:
     def _start_folder(self, resume: dict | None) -> None:
         """history.csv (with the kept rows of a resumed run), the folders, no stale files,
         the GiD mesh, and a first summary.json."""
-        header = ["step", "load_factor", "iterations"] + [m.name for m in self.monitors]
+        header = list(HISTORY_COLUMNS) + [m.name for m in self.monitors]
         self._history = io.StringIO()
         self._csv = csv.writer(self._history, lineterminator="\n")
         self._csv.writerow(header)
         earlier = _read_summary(self.out).get("contact") if resume is not None else None  # the run's maxima so far
-        kept = self._resume(resume, header) if resume is not None else 0
-        self.record = RunRecord(self.model, earlier if kept else None)
+        times = self._resume(resume, header) if resume is not None else {}
+        self.record = RunRecord(self.model, earlier if times else None)
         write_atomic(self.out / "history.csv", self._history.getvalue())
-        self._pvd = clear_folder(self.out, kept, self.vtu, bool(self.thickness_every and self.model.mesh.fibres is not None))
+        self._pvd = clear_folder(self.out, times, self.vtu, bool(self.thickness_every and self.model.mesh.fibres is not None))
         if self.gid:
             with atomic(self.out / "axiform.post.msh") as tmp:
                 gid.write_mesh(tmp, self.model.mesh.points, self.model.mesh.cells)
@@ -171,14 +176,17 @@ class ResultsWriter:
             self.summary["warnings"].append(line)
             self._unsaid.append(line)
 
-    def _resume(self, checkpoint: dict, header: list[str]) -> int:
-        """Keep history.csv's rows up to the checkpoint's step; returns that step."""
+    def _resume(self, checkpoint: dict, header: list[str]) -> dict[int, float]:
+        """Keep history.csv's rows up to the checkpoint's step (a folder written before the
+        column `time` gets it, = load_factor); returns the time t of each step kept."""
         step = int(checkpoint["step"])
         try:
             with open(self.out / "history.csv", newline="") as fh:
                 rows = list(csv.reader(fh))
         except OSError as exc:
             raise ValueError(f"{self.out}: no history.csv to resume ({exc})") from None
+        if rows and rows[0] == [c for c in header if c != "time"]:  # written before the column time
+            rows = [header] + [[*r[:2], r[1], *r[2:]] if r else r for r in rows[1:]]
         if not rows or rows[0] != header:
             raise ValueError(f"{self.out}/history.csv has other columns than this case's monitors")
         kept = [r for r in rows[1:] if r and int(r[0]) <= step]
@@ -189,7 +197,7 @@ class ResultsWriter:
         self.steps = self._last_written = step
         self.newton_iterations = int(checkpoint["newton_iterations"])
         self.summary.update(steps=step, newton_iterations=self.newton_iterations, load_factor=float(kept[-1][1]))
-        return step
+        return {int(r[0]): float(r[2]) for r in kept}
 
     def _write_summary(self):
         self.summary["wall_time_s"] = round(time.perf_counter() - self.t0, 4)
@@ -220,12 +228,7 @@ class ResultsWriter:
                 write_thickness_csv(tmp, self._thickness)
             self._thickness = None
         if self._pvd_written != len(self._pvd):
-            root = ET.Element("VTKFile", type="Collection", version="0.1")
-            coll = ET.SubElement(root, "Collection")
-            for t, f in self._pvd:
-                ET.SubElement(coll, "DataSet", timestep=repr(t), part="0", file=f)
-            with atomic(self.out / "fields.pvd") as tmp:
-                ET.ElementTree(root).write(tmp)
+            write_pvd(self.out / "fields.pvd", self._pvd)
             self._pvd_written = len(self._pvd)
         self._write_summary()
         self._flushed = time.perf_counter()
@@ -238,7 +241,7 @@ class ResultsWriter:
         self._wait_for_vtu(wait=False)
         values = {m.name: m.value(step) for m in self.monitors}
         self._guard(step, values)
-        self._csv.writerow([step.number, repr(float(step.lam)), step.iterations]
+        self._csv.writerow([step.number, repr(float(step.lam)), repr(float(step.lam)), step.iterations]
                            + [repr(v) for v in values.values()])
         if self.model.contacts:
             self._write_contact(step)
@@ -295,9 +298,12 @@ class ResultsWriter:
         mesh = self.model.mesh
         self._last_written = step.number
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
-        self._thickness = thickness_table(mesh, u, step.state.contacts)
+        T = step.state.temperature
+        self._thickness = thickness_table(mesh, u, step.state.contacts, T)
         if self._thickness is not None:
             self.summary["thickness"] = thickness_summary(self._thickness)
+        if T is not None:
+            self.summary["temperature"] = {"min": float(T.min()), "max": float(T.max())}
         if self.vtu and self.model.contacts:
             write_atomic(self.out / "fields" / f"surfaces_{step.number:04d}.csv",
                          mould_outlines(self.model.contacts, float(step.lam)))
@@ -315,21 +321,21 @@ class ResultsWriter:
         if self._vtu_writer is None:
             self._vtu_writer = ThreadPoolExecutor(max_workers=1, thread_name_prefix="axiform-vtu")
         job = self._vtu_writer.submit(write_vtu, self.out / "fields" / name, mesh, with_components(data))
-        self._vtu_pending.append((float(step.number), f"fields/{name}", job))
+        self._vtu_pending.append((step.number, float(step.lam), f"fields/{name}", job))
 
     def _wait_for_vtu(self, wait: bool = True) -> None:
         """List the VTU files written for fields.pvd, in their order: all those submitted
         (wait), or those already written (not wait).  The error of one that could not be
         written (a full disk) is raised here: at the next step, at the latest by `finish`."""
-        while self._vtu_pending and (wait or self._vtu_pending[0][2].done()):
-            t, name, job = self._vtu_pending.pop(0)
+        while self._vtu_pending and (wait or self._vtu_pending[0][3].done()):
+            number, t, name, job = self._vtu_pending.pop(0)
             job.result()
-            self._pvd.append((t, name))
+            self._pvd.append((number, t, name))
 
     def _write_thickness_step(self, step):
         """thickness/step_NNNN.csv: the thickness table of one step."""
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
-        table = thickness_table(self.model.mesh, u, step.state.contacts)
+        table = thickness_table(self.model.mesh, u, step.state.contacts, step.state.temperature)
         if table is not None:
             write_thickness_csv(self.out / "thickness" / f"step_{step.number:04d}.csv", table)
 

@@ -125,14 +125,14 @@ LENGTH_COLUMNS = {"thickness.csv": ("s", "r", "z", "thickness", "initial_thickne
 
 def column_units(summary: dict) -> dict[str, dict[str, str]]:
     """The unit of every CSV column that has one in the case's [units] (summary's `units`
-    and `monitor_quantities`), per file: {"history.csv": {monitor: unit}, "thickness.csv":
+    and `monitor_quantities`), per file: {"history.csv": {"time": unit, monitor: unit}, "thickness.csv":
     {...}, "contact.csv": {...}}.  The CSV headers stay the bare column names (every reader
     keys on them); this map is where a reader finds the units."""
     units = summary.get("units") or {}
     length = units.get("length")
     derived = {"area": f"{length}^2" if length else None, "volume": f"{length}^3" if length else None,
                "rotation": "rad"}
-    history = {}
+    history = {"time": units["time"]} if units.get("time") else {}
     for name, quantity in (summary.get("monitor_quantities") or {}).items():
         unit = derived.get(quantity) if quantity in derived else units.get(QUANTITY_UNIT.get(quantity, ""))
         if unit:
@@ -142,4 +142,6 @@ def column_units(summary: dict) -> dict[str, dict[str, str]]:
         out[file] = {c: length for c in columns} if length else {}
     if units.get("pressure"):
         out["contact.csv"]["pressure"] = units["pressure"]
+    if units.get("temperature"):
+        out["thickness.csv"]["temperature"] = units["temperature"]
     return out

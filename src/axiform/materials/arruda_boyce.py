@@ -7,7 +7,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.polynomial import polynomial
 
 from .invariant import InvariantLaw
 
@@ -24,21 +23,21 @@ class ArrudaBoyce(InvariantLaw):
     kappa: float
 
 
-    def coefficients(self) -> np.ndarray:
-        """a_i = mu c_i / lambda_m^(2i-2), i = 1..5, so that W_iso = sum a_i (I1_bar^i - 3^i)."""
-        return self.mu * SERIES / self.lambda_m ** (2.0 * np.arange(5))
+    def coefficients(self) -> list:
+        """a_i = mu c_i / lambda_m^(2i-2), i = 1..5, so that W_iso = sum a_i (I1_bar^i - 3^i)
+        (numbers, or arrays where mu or lambda_m are one per point)."""
+        return [self.mu * c / self.lambda_m ** (2.0 * i) for i, c in enumerate(SERIES)]
 
     @property
     def shear_modulus(self) -> float:
         """Initial shear modulus 2 dW/dI1_bar at I1_bar = 3."""
-        return 2.0 * float(polynomial.polyval(3.0, polynomial.polyder(np.r_[0.0, self.coefficients()])))
+        return 2.0 * sum(i * a * 3.0 ** (i - 1) for i, a in enumerate(self.coefficients(), 1))
 
     def psi(self, I1b: np.ndarray, I2b: np.ndarray | None) -> np.ndarray:
-        a = np.r_[0.0, self.coefficients()]
-        return polynomial.polyval(I1b, a) - polynomial.polyval(3.0, a)
+        return sum(a * (I1b**i - 3.0**i) for i, a in enumerate(self.coefficients(), 1))
 
     def psi_derivatives(self, I1b: np.ndarray, I2b: np.ndarray | None, tangent: bool) -> tuple:
-        a1 = polynomial.polyder(np.r_[0.0, self.coefficients()])
-        W1 = polynomial.polyval(I1b, a1)
-        W11 = polynomial.polyval(I1b, polynomial.polyder(a1)) if tangent else None
+        a = self.coefficients()
+        W1 = sum(i * ai * I1b ** (i - 1) for i, ai in enumerate(a, 1))
+        W11 = sum(i * (i - 1) * ai * I1b ** (i - 2) for i, ai in enumerate(a[1:], 2)) if tangent else None
         return W1, None, W11, None, None

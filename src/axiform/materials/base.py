@@ -147,6 +147,6 @@ class ReducedLaw(Hyperelastic):
             A[4, :4] = u
             A[:4, 4] = u
             A[4, 4] = H[5]
-        if kappa:
+        if np.any(kappa):  # a number, or one per point
             add_volumetric(xt, kappa, P, A)
         return P, A

@@ -48,11 +48,14 @@ class Prony:
         t = np.asarray(t, float)[..., None]
         return 1.0 - (np.asarray(self.g) * (1.0 - np.exp(-t / np.asarray(self.tau)))).sum(-1)
 
-    def factors(self, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Per term over a step dt >= 0: e_i, a_i = g_i (gamma_i - e_i), b_i = g_i (1 - gamma_i)."""
+    def factors(self, dxi: np.ndarray | float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per term over a step of reduced time dxi >= 0 (a number, or one per point (...)):
+        e_i, a_i = g_i (gamma_i - e_i), b_i = g_i (1 - gamma_i), each (..., m)."""
         g, tau = np.asarray(self.g, float), np.asarray(self.tau, float)
-        e = np.exp(-dt / tau)
-        gamma = (1.0 - e) * tau / dt if dt > 0 else np.ones_like(tau)
+        dxi = np.asarray(dxi, float)[..., None]
+        e = np.exp(-dxi / tau)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            gamma = np.where(dxi > 0, -np.expm1(-dxi / tau) * tau / np.where(dxi > 0, dxi, 1.0), 1.0)
         return e, g * (gamma - e), g * (1.0 - gamma)
 
     def initial(self, points: tuple[int, ...]) -> dict[str, np.ndarray]:
@@ -94,16 +97,16 @@ def d_f_times(H: np.ndarray) -> np.ndarray:
 def viscous_part(x: np.ndarray, P_iso: np.ndarray, A_iso: np.ndarray | None, history: dict[str, np.ndarray],
                  factors: tuple[np.ndarray, np.ndarray, np.ndarray]):
     """What the Prony series adds to the law's P (..., 5) and A (..., 5, 5) at F = x over a
-    step (its `factors`, Prony.factors) from the committed history (h (..., m, 4), S (...,
-    4)), and the trial history at its end."""
+    step (its `factors`, Prony.factors: (m,) for all points or (..., m) one set per point)
+    from the committed history (h (..., m, 4), S (..., 4)), and the trial history at its end."""
     e, a, b = factors
     h, S_n = history["h"], history["S"]
     S = second_piola(x, P_iso)
-    H0 = np.einsum("m,...mk->...k", e, h) + a.sum() * S_n
-    c = float(b.sum())
-    dP = -(f_times(x, H0) + c * P_iso)
-    dA = None if A_iso is None else -(d_f_times(H0) + c * A_iso)
-    trial = {"h": e[:, None] * h + a[:, None] * S_n[..., None, :] + b[:, None] * S[..., None, :], "S": S}
+    H0 = (e[..., None] * h).sum(-2) + a.sum(-1)[..., None] * S_n
+    c = b.sum(-1)
+    dP = -(f_times(x, H0) + c[..., None] * P_iso)
+    dA = None if A_iso is None else -(d_f_times(H0) + c[..., None, None] * A_iso)
+    trial = {"h": e[..., None] * h + a[..., None] * S_n[..., None, :] + b[..., None] * S[..., None, :], "S": S}
     return dP, dA, trial
 
 
@@ -115,14 +118,21 @@ class Viscoelastic:
         self.law = law
         self.prony = prony
 
+    def at(self, T: np.ndarray) -> "Viscoelastic":
+        """The same series on the law at the temperatures T of a batch of points (where its
+        constants are tables of T: materials.temperature.TemperatureDependent)."""
+        return Viscoelastic(self.law.at(T), self.prony) if hasattr(self.law, "at") else self
+
     def __getattr__(self, name: str):
+        if name in ("law", "prony"):
+            raise AttributeError(name)
         return getattr(self.law, name)
 
 
 class Memory:
     """One evaluation's use of the history of a law with memory: the committed history
-    (arrays (e, q, ...)), the step's factors (Prony.factors), and the trial history filled
-    chunk by chunk of elements (`add`)."""
+    (arrays (e, q, ...)), the step's factors (Prony.factors: (m,) for every point or (e, q, m)
+    one set per point), and the trial history filled chunk by chunk of elements (`add`)."""
 
     def __init__(self, committed: dict[str, np.ndarray], factors: tuple[np.ndarray, np.ndarray, np.ndarray]):
         self.committed = committed
@@ -132,7 +142,8 @@ class Memory:
     def add(self, sl: slice, x: np.ndarray, P_iso: np.ndarray, A_iso: np.ndarray | None):
         """What the memory adds to P and A at the points x (m, q, 5) of the elements sl."""
         history = {k: v[sl] for k, v in self.committed.items()}
-        dP, dA, trial = viscous_part(x, P_iso, A_iso, history, self.factors)
+        factors = self.factors if self.factors[0].ndim == 1 else tuple(f[sl] for f in self.factors)
+        dP, dA, trial = viscous_part(x, P_iso, A_iso, history, factors)
         for k, v in trial.items():
             self.trial[k][sl] = v
         return dP, dA

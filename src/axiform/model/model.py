@@ -6,7 +6,7 @@ of the follower pressure, so it is not symmetric.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Iterable, Sequence
 
@@ -96,6 +96,9 @@ class Model:
     point_loads: list[tuple[int, float, Curve]] = field(default_factory=list)
     contacts: list = field(default_factory=list)
     cavities: list[Cavity] = field(default_factory=list)
+    temperature: np.ndarray | None = None
+    shift: object = None
+    conduction: object = None
 
     def __post_init__(self):
         if self.sfr_edges not in SFR_EDGE_RULES:
@@ -127,6 +130,40 @@ class Model:
         self.dofmap = None
 
     fix = prescribe
+
+    def heat(self, T: float | np.ndarray, shift=None) -> None:
+        """The temperature of the material: T a number or one value per node (n_nodes,),
+        carried with the material (the nodes' values interpolated to the quadrature points
+        by the element's shape functions); shift: the shift of the relaxation times
+        (materials.temperature.WLF or Arrhenius), None for none.  The law's constants that
+        are tables of T are taken at the points' temperatures.  ValueError where a
+        temperature lies beyond the shift's domain."""
+        T = np.broadcast_to(np.asarray(T, float), (self.mesh.n_nodes,)).copy()
+        if not np.isfinite(T).all():
+            raise ValueError("every temperature must be a finite number")
+        if shift is not None:
+            shift.check(T)
+        self.temperature, self.shift = T, shift
+        self.dofmap = None
+
+    def conduct(self, conduction) -> None:
+        """Heat conduction in the body (fem.heat.Conduction; needs a temperature, `heat`):
+        after each converged step the nodes' temperature advances over the step by backward
+        Euler on the converged geometry (`settle`), and the next step's mechanics take it."""
+        if self.temperature is None:
+            raise ValueError("heat conduction needs the material's initial temperature (heat)")
+        self.conduction = conduction
+
+    def settle(self, committed: ModelState, trial: ModelState, u_full: np.ndarray) -> ModelState:
+        """The state to commit after a converged step: the trial state of its accepted
+        evaluation, with the temperature advanced from the committed state's over the step
+        on the converged positions X + u_full (staggered: the step's mechanics ran at the
+        temperatures of its start)."""
+        if self.conduction is None:
+            return trial
+        x = self.mesh.points + u_full.reshape(-1, self.dpn)[:, :2]
+        T = self.conduction.step(committed.temperature, trial.t - committed.t, x, trial.t, trial)
+        return replace(trial, temperature=T)
 
     def pressure(self, edges: np.ndarray, value: float, curve: Curve = PROPORTIONAL) -> None:
         """Follower pressure value * f(t) on boundary edges (indices of mesh.boundary_edges)."""
@@ -219,10 +256,12 @@ class Model:
             self.solid = MixedAssembly(self.mesh, self.material, self.pressure_space)
         else:
             self.solid = SolidAssembly(self.mesh, self.material)
+        if self.temperature is None and _tabled(self.material):
+            raise ValueError("the law's constants are tables of temperature: give the model a temperature (heat)")
         by_curve: dict[Curve, np.ndarray] = {}  # point loads grouped by curve
         for d, v, c in self.point_loads:
             by_curve.setdefault(c, np.zeros(n))[d] += v
-        self.loads = ([SolidTerm(self.solid, n)] + [PressureTerm(p, n) for p in self.pressures]
+        self.loads = ([SolidTerm(self.solid, n, self.shift)] + [PressureTerm(p, n) for p in self.pressures]
                       + ([PointLoadTerm(by_curve, n)] if by_curve else []))
         self.contact_terms = [ContactTerm(pair, self.dpn, n) for pair in self.contacts]
         self.cavity_terms = [CavityTerm(c, n) for c in self.cavities]
@@ -268,6 +307,7 @@ class Model:
         """Whether the load factor is the process time: load curves with knots, moving tools,
         or a law with memory follow it."""
         return (bool(self.knots().size) or getattr(self.material, "prony", None) is not None
+                or self.conduction is not None
                 or any(np.any(np.asarray(c.surface.motion, float) != 0) for c in self.contacts))
 
     def prescribed(self, t: float) -> tuple[np.ndarray, np.ndarray]:
@@ -286,7 +326,8 @@ class Model:
         """The history before the first step (t = 0): contact pairs untouched, cavities at
         their initial volume and no gauge pressure."""
         return ModelState(0.0, tuple(pair.initial_state() for pair in self.contacts),
-                          tuple(CavityState(0.0, c.V0) for c in self.cavities), self.loads[0].initial_state())
+                          tuple(CavityState(0.0, c.V0) for c in self.cavities), self.loads[0].initial_state(),
+                          None if self.temperature is None else self.temperature.copy())
 
     def restore(self, saved: dict) -> ModelState:
         """The state saved by ModelState.to_dict (a checkpoint), checked against this model."""
@@ -296,20 +337,28 @@ class Model:
         solid = {k: np.asarray(v) for k, v in saved.get("solid", {}).items()}
         if solid.keys() != start.solid.keys() or any(v.shape != start.solid[k].shape for k, v in solid.items()):
             raise ValueError("the saved state has another history of the solid than this model's material")
+        if ("temperature" in saved) != (start.temperature is not None):
+            raise ValueError("the saved state has another temperature field than this model")
+        temperature = np.asarray(saved["temperature"], float) if "temperature" in saved else None
         return ModelState(float(saved.get("t", 0.0)),
                           tuple(s.from_dict(d) for s, d in zip(start.contacts, saved["contacts"])),
                           tuple(CavityState(float(d["pressure"]), float(d["volume"])) for d in saved["cavities"]),
-                          solid)
+                          solid, temperature)
 
     # ---- evaluation ------------------------------------------------------------------------
     def expand(self, u_f: np.ndarray, t: float) -> np.ndarray:
         """Full displacement vector (n_full,) from the unknowns and the time t."""
         return self.dofmap.expand(u_f, self.prescribed(t)[0])
 
-    def strain_energy(self, u_full: np.ndarray) -> float:
-        """The strain energy stored in the body at the displacements u_full (n_full,): the
-        law's W at every quadrature point, integrated over the revolved body."""
-        return float((self.material.energy(self.solid.gradient(u_full)) * self.solid.dV).sum())
+    def strain_energy(self, u_full: np.ndarray, state: ModelState | None = None) -> float:
+        """The strain energy stored in the body at the displacements u_full (n_full,) (at the
+        temperatures of `state`, default the initial ones): the law's W at every quadrature
+        point, integrated over the revolved body."""
+        x = self.solid.gradient(u_full)
+        T = (state or self.initial_state()).temperature
+        law = self.solid.law(slice(None), None if T is None else self.solid.point_values(T))
+        W = law.energy(x.reshape(-1, 5)).reshape(x.shape[:-1])
+        return float((W * self.solid.dV).sum())
 
     def external_load(self, u_full: np.ndarray, t: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         """The applied external load at time t (pressures and point loads, full vector) and
@@ -336,7 +385,7 @@ class Model:
         nf = dm.nf
         presc, dpresc = self.prescribed(t)
         u = dm.expand(u_f, presc)
-        parts = [(self.loads[0], self.loads[0].evaluate(u, t, state.solid, tangent))]
+        parts = [(self.loads[0], self.loads[0].evaluate(u, t, state.solid, tangent, state.temperature))]
         parts += [(term, term.evaluate(u, t, None, tangent)) for term in self.loads[1:]]
         parts += [(term, term.evaluate(u, t, held, tangent, predicting))
                   for term, held in zip(self.contact_terms, state.contacts)]
@@ -374,7 +423,7 @@ class Model:
         scale = float(np.linalg.norm(parts[0][1].magnitude) + np.linalg.norm(f_ext))
         trial = ModelState(float(t), tuple(part.trial for term, part in parts if isinstance(term, ContactTerm)),
                            tuple(part.trial for term, part in parts if isinstance(term, CavityTerm)),
-                           parts[0][1].trial)
+                           parts[0][1].trial, state.temperature)
         return Evaluation(r, dr_dt, K, r_full, f_ext, scale, self._noise_floor, nf, constraint_error,
                           float(np.linalg.norm(u)), trial)
 
@@ -393,3 +442,21 @@ class Model:
             Cp = np.diag([c.c_p for c in constraints])
             K = sp.bmat([[K, sp.csr_matrix(-G)], [sp.csr_matrix(Cu), sp.csr_matrix(Cp)]], format="csr")
         return np.concatenate([r, C]), np.concatenate([dr_dt, dC_dt]), K
+
+
+def _tabled(material) -> bool:
+    """Whether the law (or the law under a Prony series) has constants that are tables of T."""
+    law = getattr(material, "law", material)
+    return bool(getattr(law, "tables", None))
+
+
+def contact_conductance(k: int):
+    """The nodes in contact of the model's contact pair k at a model state and their current
+    ring areas: (nodes (m,), areas (m,)) for fem.heat.Conductance."""
+    def in_contact(state: ModelState) -> tuple[np.ndarray, np.ndarray]:
+        held = state.contacts[k]
+        if held.seen is None:
+            return np.zeros(0, np.int64), np.zeros(0)
+        touching = held.seen.status > 0
+        return held.nodes[touching], held.seen.a[touching]
+    return in_contact

@@ -29,15 +29,20 @@ class ModelState:
     """The committed (or trial) history of a model at process time t: one ContactState per
     contact pair, one CavityState per cavity, in the model's order, and the solid's history
     per quadrature point (`solid`: a dict of arrays (e, q, ...), empty for elastic laws,
-    which have none).  dt = t_trial - t_committed is what a term integrates over."""
+    which have none), and the nodes' temperature (n,) (None without one).  dt = t_trial -
+    t_committed is what a term integrates over."""
 
     t: float
     contacts: tuple[ContactState, ...] = ()
     cavities: tuple[CavityState, ...] = ()
     solid: dict = field(default_factory=dict)
+    temperature: np.ndarray | None = None
 
     def to_dict(self) -> dict:
         """Plain arrays and numbers (a checkpoint)."""
-        return {"t": float(self.t), "contacts": [c.to_dict() for c in self.contacts],
-                "cavities": [{"pressure": c.pressure, "volume": c.volume} for c in self.cavities],
-                "solid": {k: np.array(v, copy=True) for k, v in self.solid.items()}}
+        out = {"t": float(self.t), "contacts": [c.to_dict() for c in self.contacts],
+               "cavities": [{"pressure": c.pressure, "volume": c.volume} for c in self.cavities],
+               "solid": {k: np.array(v, copy=True) for k, v in self.solid.items()}}
+        if self.temperature is not None:
+            out["temperature"] = np.array(self.temperature, copy=True)
+        return out

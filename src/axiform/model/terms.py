@@ -55,11 +55,15 @@ class SolidTerm:
     laws carry no history: its state is an empty dict (a law with memory keeps its arrays
     per quadrature point there, (e, q, ...)).  The element arrays are written into scratch
     buffers reused from call to call (work space, not state: nothing of one call is read by
-    the next)."""
+    the next).  With a temperature (the nodes' T of the committed state: a step's mechanics
+    at the temperatures of its start) the law's constants that are tables of T are taken at
+    the points' T, and with a shift of the relaxation times (materials.temperature) each
+    point's history advances by its reduced time dxi = dt / a_T(T)."""
 
-    def __init__(self, assembly, n_full: int):
+    def __init__(self, assembly, n_full: int, shift=None):
         self.assembly = assembly
         self.n_full = n_full
+        self.shift = shift  # of the relaxation times (materials.temperature.WLF, Arrhenius) or None
         self.blocks = (assembly.dofs,)
         self._scratch: dict[bool, tuple] = {}
 
@@ -72,15 +76,19 @@ class SolidTerm:
             return {}
         return prony.initial(self.assembly.dV.shape) | {"t": np.zeros(())}
 
-    def evaluate(self, u: np.ndarray, t: float, state: dict | None = None, tangent: bool = True) -> Contribution:
+    def evaluate(self, u: np.ndarray, t: float, state: dict | None = None, tangent: bool = True,
+                 temperature: np.ndarray | None = None) -> Contribution:
+        """state: the solid's history per point (or None); temperature: the nodes' T (n,) or None."""
         if tangent not in self._scratch:
             self._scratch[tangent] = self.assembly.buffers(tangent)
+        T = None if temperature is None else self.assembly.point_values(temperature)
         memory = None
         if state:  # a law with memory: the step from the committed state's time to t
             history = {k: v for k, v in state.items() if k != "t"}
             dt = max(float(t) - float(state["t"]), 0.0)
-            memory = Memory(history, self.assembly.material.prony.factors(dt))
-        fe, Ke = self.assembly.evaluate(u, tangent, self._scratch[tangent], memory)
+            dxi = dt if self.shift is None or T is None else dt / self.shift.shift(T)
+            memory = Memory(history, self.assembly.material.prony.factors(dxi))
+        fe, Ke = self.assembly.evaluate(u, tangent, self._scratch[tangent], memory, T)
         dofs = self.assembly.dofs
         trial = {} if memory is None else memory.trial | {"t": np.asarray(float(t))}
         return Contribution(assemble(dofs, fe, self.n_full), K=(Ke,) if tangent else (),

@@ -23,7 +23,7 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
     """Nodal fields (n,) or (n, k) of the state u_full (all dofs) with the committed history
     `state` (model.state.ModelState; None: the initial one): displacement (ur, uz, 0),
     J, cauchy_stress (rr, zz, tt, rz), von_mises, principal_stretches (in-plane major, minor,
-    hoop), hydrostatic_pressure (-tr sigma / 3); fibre_rotation (SFR); thickness (meshes with fibres); contact_pressure and
+    hoop), hydrostatic_pressure (-tr sigma / 3); fibre_rotation (SFR); temperature (with one); thickness (meshes with fibres); contact_pressure and
     first_contact (the time a slave node first touched, -1 where never) with contact, and
     first_contact_K per piece K where several record it."""
     mesh = model.mesh
@@ -31,7 +31,8 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
     u = u_full.reshape(-1, dpn)
     solid = model.solid
     x = solid.gradient(u_full)
-    P = solid.stress(x)  # the formulation's stress (mixed: with the element pressure)
+    T = (state or model.initial_state()).temperature  # the nodes' (n,) or None
+    P = solid.stress(x, temperature=None if T is None else solid.point_values(T))  # mixed: with the element pressure
     history = (state.solid if state is not None else {}).get("h")
     if history is not None:  # a law with memory: S = S_law - sum h_i, P = F S
         P = P - f_times(x, history.sum(axis=-2))
@@ -64,6 +65,8 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
     }
     if dpn == 3:
         out["fibre_rotation"] = u[:, 2].copy()
+    if T is not None:
+        out["temperature"] = T.copy()
     table = thickness_table(mesh, u[:, :2])
     if table is not None:
         out["thickness"] = nodal_thickness(mesh, table)

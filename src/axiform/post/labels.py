@@ -10,9 +10,13 @@ column} when a cavity pressure monitor of history.csv carries it.
 
 `applied` lists every applied quantity of the case the same way (each pressure, point load,
 prescribed displacement, mould motion and cavity target: a cavity under volume control as
-{"quantity": "volume", "cavity": name, "value": V, ...}, its volume V0 + f(t) (V - V0));
+{"quantity": "volume", "cavity": name, "value": V, ...}, its volume V0 + f(t) (V - V0); a gas
+cavity as {"quantity": "content", "cavity": name, "value": C, "ambient": p0, ...}, its gas
+content p_abs V = p0 V0 + f(t) (C - p0 V0));
 `process` is true for a multi-stage process (a curve with more than two knots, or loads on
-different curves): its load curve panels are drawn against the process time t.
+different curves): its load curve panels are drawn against the process time t;
+`real_time` is true where the load factor is a physical time (time_is_real: a law with
+memory): the pictures and the progress line then say t with the unit of [units] time.
 """
 
 from __future__ import annotations
@@ -22,20 +26,33 @@ from typing import Any
 import numpy as np
 
 QUANTITY_UNIT = {"pressure": "pressure", "stress": "pressure", "force": "force", "displacement": "length",
-                 "length": "length", "time": "time"}  # quantity -> key of [units]
+                 "length": "length", "time": "time", "temperature": "temperature"}  # quantity -> key of [units]
 
 
 def case_labels(case: Any) -> dict[str, Any]:
-    """units, load and monitor_quantities of a validated case (axiform.case.schema.Case)."""
+    """units, load, monitor_quantities, applied, process and real_time of a validated case
+    (axiform.case.schema.Case)."""
     applied = applied_quantities(case)
     return {"units": {k: v for k, v in case.units.model_dump().items() if v},
             "load": loaded_quantity(case),
             "monitor_quantities": {m.name: monitor_quantity(m) for m in case.monitor},
-            "applied": applied, "process": is_process(applied, getattr(case, "cavity", []))}
+            "applied": applied, "process": is_process(applied, getattr(case, "cavity", [])),
+            "real_time": time_is_real(case)}
+
+
+def time_is_real(case: Any) -> bool:
+    """Whether the load factor of a validated case is a physical time (its result depends on
+    how fast the loads come): a material with a Prony series (`[material] viscoelastic`), or
+    heat conduction (`[thermal]`)."""
+    return (getattr(getattr(case, "material", None), "viscoelastic", None) is not None
+            or getattr(case, "thermal", None) is not None)
 
 
 def monitor_quantity(m: Any) -> str:
-    """"displacement", "rotation", "force", "area", "pressure" or "volume" of a monitor spec."""
+    """"displacement", "rotation", "force", "area", "pressure", "volume" or "temperature" of a
+    monitor spec."""
+    if getattr(m, "quantity", None) == "temperature":
+        return "temperature"
     cavity_quantity = getattr(m, "cavity", None) is not None and m.quantity
     if cavity_quantity:
         return cavity_quantity
@@ -94,15 +111,18 @@ def _piece(contact: Any, i: int) -> str:
 
 def applied_quantities(case: Any) -> list[dict[str, Any]]:
     """Every quantity the case applies, as loaded_quantity says one (the same pressures or
-    point loads on the same curve once): cavities under pressure or volume control, pressures,
-    point loads, prescribed displacements and mould motions (a gas cavity's pressure is its
-    monitor's)."""
+    point loads on the same curve once): cavities under pressure, volume or gas control (the
+    gas content; its pressure is its monitor's), pressures, point loads, prescribed
+    displacements and mould motions."""
     out: list[dict[str, Any]] = []
     for c in getattr(case, "cavity", []):
         if c.control == "pressure" and c.pressure:
             out.append(_scaled("pressure", c.pressure, f"{c.name} pressure", _curve(c)))
         elif c.control == "volume":
             out.append({**_scaled("volume", c.volume, f"{c.name} volume", _curve(c)), "cavity": c.name})
+        elif c.control == "gas":
+            out.append({**_scaled("content", c.content, f"{c.name} gas content p·V", _curve(c)), "cavity": c.name,
+                        "ambient": float(c.ambient)})
     for kind, specs in (("pressure", case.pressure), ("force", case.point_load)):
         seen = []
         for k, p in enumerate(specs):
@@ -143,8 +163,10 @@ def load_values(load: dict[str, Any], lam: np.ndarray, start: float = 0.0) -> np
 
 def unit_of(quantity: str, units: dict[str, str]) -> str:
     """The unit of a quantity from the case's [units] ("" when not given): area and volume
-    are length squared and cubed, rotations are in rad."""
+    are length squared and cubed, a gas content pressure times volume, rotations are in rad."""
     length = units.get("length")
+    if quantity == "content":
+        return f"{units['pressure']}·{length}³" if length and units.get("pressure") else ""
     if quantity == "area":
         return f"{length}²" if length else ""
     if quantity == "volume":

@@ -6,8 +6,12 @@ Which quantity goes on which axis depends on what drives the run (summary.json, 
 - a tool's stroke or a prescribed displacement: each monitor on y against the stroke on x
   (force–stroke); a monitor that only follows the stroke (a node under the punch: a straight
   line) gets no panel, and the figure says so;
-- a multi-stage process (curves with several knots, tools and cavities): every applied
-  quantity and every monitor against the process time t;
+- a multi-stage process (curves with several knots, tools and cavities) or a case whose load
+  factor is a physical time (a law with memory): every applied quantity (orange: each
+  pressure, force, prescribed displacement, tool motion, cavity volume or gas content as the
+  case's curves give it) and every monitor (blue) against the process time t, one panel each,
+  on the same t axis, the inner knots of the curves (where a stage ends and the next begins)
+  as dotted lines;
 - nothing but the loaded quantity (no other monitor): the loaded quantity against the load
   factor or time, or a cavity's pressure against its volume.
 `load_curve_reason` says why there is no picture when there is none.
@@ -22,10 +26,9 @@ import numpy as np
 
 from .figures import new_figure, save, title
 from .labels import load_values, with_unit
-from .results_folder import FolderInfo, read_history
+from .results_folder import HISTORY_COLUMNS, FolderInfo, read_history
 
 _STARTS_AT_ZERO = ("displacement", "rotation", "force", "area")
-_NOT_MONITORS = ("step", "load_factor", "iterations", "time")
 
 
 @dataclass
@@ -41,7 +44,7 @@ class Panel:
 
 def _monitors(h: dict[str, np.ndarray], info: FolderInfo) -> list[str]:
     own = (info.load or {}).get("monitor")
-    return [k for k in h if k not in _NOT_MONITORS and k != own]
+    return [k for k in h if k not in HISTORY_COLUMNS and k != own]
 
 
 def _label(name: str, info: FolderInfo) -> str:
@@ -72,6 +75,13 @@ def _process_panels(h, info: FolderInfo) -> list[Panel]:
     for name in ([own] if own in h else []) + _monitors(h, info):
         panels.append(Panel(_time(h), h[name], xlabel, _label(name, info)))
     return panels
+
+
+def _knots(h, info: FolderInfo) -> list[float]:
+    """The times within the run where an applied quantity may change its rate (the inner
+    knots of the case's curves): where a stage of a process ends and the next begins."""
+    end = float(_time(h)[-1])
+    return sorted({float(k[0]) for a in info.applied for k in a.get("curve") or () if 0.0 < k[0] < end})
 
 
 def _stroke_panels(h, info: FolderInfo) -> tuple[list[Panel], list[str]]:
@@ -108,7 +118,7 @@ def _alone_panels(h, info: FolderInfo) -> list[Panel]:
     """Without other monitors: a cavity's pressure against its volume (volume control), else
     the loaded quantity against the load factor or the time."""
     load = info.load_of(h)
-    lam = h["load_factor"]
+    lam = _time(h)
     for a in info.applied:
         if a.get("quantity") == "volume" and a.get("cavity") in info.cavities and info.load.get("monitor"):
             return [Panel(info.applied_values(a, lam), load, with_unit(a["name"], "volume", info.units),
@@ -123,7 +133,7 @@ def load_curve_panels(h: dict[str, np.ndarray], info: FolderInfo) -> tuple[list[
     out because they only follow the stroke."""
     if not h:
         return [], []
-    if info.process:
+    if info.process or info.real_time:
         return _process_panels(h, info), []
     if not _monitors(h, info):
         return (_alone_panels(h, info) if info.load is not None else []), []
@@ -149,13 +159,18 @@ def load_curve_figure(history: Path, info: FolderInfo):
     panels, dropped = load_curve_panels(h, info)
     if not panels:
         return None
+    timed = info.process or info.real_time
+    knots = _knots(h, info) if timed else []
     n = len(panels)
     ncols = 1 if n == 1 else 2 if n in (2, 4) else 3
     nrows = -(-n // ncols)
     fig = new_figure((4.6 * ncols, 3.6 * nrows + 0.5 + 0.3 * bool(dropped)))
-    axes = fig.subplots(nrows, ncols, squeeze=False)
+    axes = fig.subplots(nrows, ncols, squeeze=False, sharex=timed)
     for ax, p in zip(axes.flat, panels):
         ax.plot(p.x, p.y, "o-", ms=2.5, lw=1.2, color=p.colour)
+        for t in knots:
+            ax.axvline(t, color="0.55", ls=":", lw=1.0, zorder=0)
+        ax.xaxis.set_tick_params(labelbottom=True)
         ax.set_xlabel(p.xlabel)
         ax.set_ylabel(p.ylabel)
         ax.ticklabel_format(useOffset=False)
@@ -165,7 +180,8 @@ def load_curve_figure(history: Path, info: FolderInfo):
         ax.set_visible(False)
     text = info.title or "load curve"
     if any(p.colour == "C1" for p in panels):
-        text += "\n(orange: applied, by the case's curves; blue: results)"
+        legend = "orange: applied, by the case's curves; blue: results" + ("; dotted: the curves' knots" if knots else "")
+        text += f"\n({legend})"
     if dropped:
         text += f"\n({', '.join(dropped)} follows {info.load['name']}: not drawn)"
     title(fig, text)

@@ -15,6 +15,9 @@ import numpy as np
 
 from .labels import load_values, short, unit_of, with_unit
 
+# history.csv's first columns, before one column per monitor (time = load_factor: the process time t)
+HISTORY_COLUMNS = ("step", "load_factor", "time", "iterations")
+
 
 class FieldError(ValueError):
     """A field (or component) that the results folder does not have."""
@@ -33,6 +36,7 @@ class FolderInfo:
     applied: list[dict[str, Any]] = dc_field(default_factory=list)  # every applied quantity (labels)
     process: bool = False  # a multi-stage process: load curves against the time t
     cavities: dict[str, dict[str, float]] = dc_field(default_factory=dict)  # summary.json's cavities
+    real_time: bool = False  # the load factor is a physical time (labels.time_is_real)
 
     @classmethod
     def read(cls, folder: Path) -> "FolderInfo":
@@ -42,19 +46,28 @@ class FolderInfo:
         s = json.loads(path.read_text())
         contacts = [c.get("name", f"contact[{k}]") for k, c in enumerate(s.get("contact") or [])]
         return cls(s.get("title", ""), s.get("units") or {}, s.get("load"), s.get("monitor_quantities") or {},
-                   contacts, s.get("applied") or [], bool(s.get("process")), s.get("cavities") or {})
+                   contacts, s.get("applied") or [], bool(s.get("process")), s.get("cavities") or {},
+                   bool(s.get("real_time")))
+
+    @property
+    def timed(self) -> bool:
+        """Whether the pictures speak of the time t: a physical time, a multi-stage process or
+        a case with a time unit."""
+        return self.real_time or self.process or bool(self.units.get("time"))
 
     def time_label(self) -> str:
-        """The process time t with its unit, or the load factor λ of a case without a time unit
-        that is no multi-stage process."""
-        if self.process or self.units.get("time"):
+        """The process time t with its unit, or the load factor λ of a case that is not timed."""
+        if self.timed:
             return with_unit("time t", "time", self.units)
         return "load factor λ"
 
     def applied_values(self, applied: dict[str, Any], lam: np.ndarray) -> np.ndarray:
-        """An applied quantity (an entry of `applied`) at the load factors lam."""
-        cavity = self.cavities.get(applied.get("cavity", ""), {})
-        return load_values(applied, lam, float(cavity.get("initial_volume", 0.0)) if "cavity" in applied else 0.0)
+        """An applied quantity (an entry of `applied`) at the load factors lam: a cavity's
+        target starts from its initial volume V0 (volume) or gas content ambient × V0 (gas)."""
+        if "cavity" not in applied:
+            return load_values(applied, lam)
+        v0 = float(self.cavities.get(applied["cavity"], {}).get("initial_volume", 0.0))
+        return load_values(applied, lam, v0 * applied.get("ambient", 1.0))
 
     def contact_name(self, k: int) -> str:
         """The name of mould piece k (pair k of contact.csv)."""
@@ -76,25 +89,30 @@ class FolderInfo:
         return load_values(self.load, history["load_factor"])
 
     def state(self, step: int, history: dict[str, np.ndarray]) -> str:
-        """'step 40, p = 33.4 psi': the step and its load, rounded."""
+        """'step 40, p = 33.4 psi': the step and its load, rounded; with the time t where the
+        case is timed ('step 40, t = 1.2 s, p = ...'), first where it is a physical time
+        ('t = 0.35 s, step 40, ...')."""
         rows = np.flatnonzero(history.get("step", np.array([])) == step) if history else []
         if len(rows) == 0:
             return f"step {step}"
         value = self.load_of(history)[rows[0]]
         time = ""
-        if self.process or self.units.get("time"):
+        if self.timed:
             unit = unit_of("time", self.units)
-            time = f", t = {short(history['load_factor'][rows[0]])}" + (f" {unit}" if unit else "")
+            time = f"t = {short(history.get('time', history['load_factor'])[rows[0]])}" + (f" {unit}" if unit else "")
         if self.load is None:
-            return f"step {step}" + (time or f", λ = {short(value)}")
-        symbol = {"pressure": "p", "force": "F"}.get(self.load["quantity"], "")
-        name = symbol if self.load.get("name") in ("pressure", "force") else self.load.get("name", symbol)
-        unit = unit_of(self.load["quantity"], self.units)
-        return f"step {step}{time}, {name} = {short(value)}" + (f" {unit}" if unit else "")
+            load = "" if time else f"λ = {short(value)}"
+        else:
+            symbol = {"pressure": "p", "force": "F"}.get(self.load["quantity"], "")
+            name = symbol if self.load.get("name") in ("pressure", "force") else self.load.get("name", symbol)
+            unit = unit_of(self.load["quantity"], self.units)
+            load = f"{name} = {short(value)}" + (f" {unit}" if unit else "")
+        parts = [time, f"step {step}", load] if self.real_time else [f"step {step}", time, load]
+        return ", ".join(part for part in parts if part)
 
 
 def read_history(path: Path) -> dict[str, np.ndarray]:
-    """history.csv as columns (step, load_factor, iterations, monitors...); ValueError naming
+    """history.csv as columns (HISTORY_COLUMNS, then the monitors); ValueError naming
     the file and line of a row with another number of values than the header has columns, or
     a value that is not a number."""
     with open(path, newline="") as fh:

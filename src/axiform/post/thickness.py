@@ -8,7 +8,8 @@ current mid-surface), thickness, initial_thickness, ratio (= thickness / initial
 first_contact (the time t at which a node of the station's faces first touched a mould;
 empty where never) and s_current (the current arc length of the mid-surface); with several
 mould pieces, first_contact_K per piece K (the index of its [[contact]] table, the `pair` of
-contact.csv), first_contact being the earliest of them.
+contact.csv), first_contact being the earliest of them; with a [temperature], the column
+temperature (mid-wall) after s_current.
 """
 
 from __future__ import annotations
@@ -24,13 +25,15 @@ from ..fem.mesh import Mesh
 COLUMNS = ("s", "r", "z", "thickness", "initial_thickness", "ratio", "first_contact", "s_current")
 
 
-def thickness_table(mesh: Mesh, u: np.ndarray, contacts: Sequence = ()) -> dict[str, np.ndarray] | None:
+def thickness_table(mesh: Mesh, u: np.ndarray, contacts: Sequence = (),
+                    temperature: np.ndarray | None = None) -> dict[str, np.ndarray] | None:
     """Per station (arrays of shape (stations,)): reference arc length s, current r, z of the
     fibre's middle, current and initial thickness, their ratio, the time of first contact
     of the station's faces (NaN where never) and the current arc length s_current.
     u: nodal displacements (n, 2); contacts: the model's contact pairs.  With more than one
-    pair recording contact times, also first_contact_K per pair K.  None for meshes without
-    fibres."""
+    pair recording contact times, also first_contact_K per pair K; with the nodes'
+    temperature (n,), the column temperature (mid-wall: the mean of the fibre's two faces, as
+    r and z).  None for meshes without fibres."""
     if mesh.fibres is None:
         return None
     f = mesh.fibres
@@ -41,6 +44,8 @@ def thickness_table(mesh: Mesh, u: np.ndarray, contacts: Sequence = ()) -> dict[
     table = {"s": mesh.fibre_s, "r": mid[:, 0], "z": mid[:, 1], "thickness": t,
              "initial_thickness": t0, "ratio": t / t0,
              "first_contact": first_contact(mesh, contacts), "s_current": s_current}
+    if temperature is not None:
+        table["temperature"] = 0.5 * (temperature[f[:, 0]] + temperature[f[:, -1]])
     for k, pair in pieces(contacts):
         table[f"first_contact_{k}"] = first_contact(mesh, [pair])
     return table
@@ -134,7 +139,7 @@ def default_wall(points: np.ndarray, loaded_edges: Sequence[np.ndarray]) -> str:
 
 def write_thickness_csv(path: str | Path, table: dict[str, np.ndarray]) -> None:
     """thickness.csv: the header row first, one row per station, the COLUMNS
-    then any per-piece first_contact_K; the step and load factor are in summary.json; the
+    then temperature (where the table has it) and any per-piece first_contact_K; the step and load factor are in summary.json; the
     contact times are left empty where never."""
     names = list(COLUMNS) + [n for n in table if n not in COLUMNS]
     rows = np.column_stack([table[n] for n in names])

@@ -138,8 +138,8 @@ def _first_contact(ax, t: dict[str, np.ndarray], info: FolderInfo, arc: str, xli
     else:
         ax.plot(t["s"], t["first_contact"], "o", ms=3, color="C3")
     ax.set_xlabel(arc)
-    timed = info.process or bool(info.units.get("time"))  # else t is the load factor
-    ax.set_ylabel(with_unit("time of first contact t", "time", info.units) if timed else "load factor λ at first contact")
+    ax.set_ylabel(with_unit("time of first contact t", "time", info.units) if info.timed
+                  else "load factor λ at first contact")
     ax.set_xlim(xlim)
     ax.grid(True, alpha=0.3)
 

@@ -69,7 +69,7 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
                 break
             continue
         path.accept(u_new, lam_new, trial)
-        path.history = ev.trial  # the state of the accepted u, and only it
+        path.history = model.settle(path.history, ev.trial, model.expand(u_new, lam_new))  # of the accepted u only
         result.newton_iterations += its
         if its <= opts.easy_iterations:
             size *= opts.growth

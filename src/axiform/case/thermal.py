@@ -1,0 +1,112 @@
+"""The [thermal] and [[convection]] tables of the case file: heat conduction in the wall
+(fem.heat), and the films on its faces.
+
+    [thermal]
+    conductivity = 0.2            # k (a number > 0, or a table [[T, value], ...])
+    density = 1.0e-9              # rho, of the reference configuration
+    specific_heat = 1.9e9         # c (k / (rho c) is the diffusivity)
+    [[convection]]
+    on = { set = "outer" }        # boundary edges (as [[pressure]] on)
+    h = 1.0e-5                    # film coefficient
+    ambient = 25.0                # x curve (absent: constant)
+    curve = [[0.0, 1.0], [2.0, 0.8]]
+
+With [[contact]] `temperature` (the mould's) and `conductance` h_c, heat flows h_c (T -
+T_mould) through every slave node in contact.  Insulated where nothing is said.  Needs
+[temperature] (the initial field).  Errors name the key.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from pydantic import field_validator
+
+from ..fem.curves import Curve
+from ..fem.heat import Conductance, Conduction, Film, Property, constant
+from ..fem.mesh import Mesh
+from ..fem.selectors import select_edges
+from ..materials.temperature import Table
+from ..model.model import Model, contact_conductance
+from .base import CaseError, CurveMixin, Selector, Strict
+
+
+def _property(value: Any) -> Any:
+    """A number > 0, or a table [[T, value], ...] (T increasing, values > 0)."""
+    if isinstance(value, bool):
+        raise ValueError(f"must be a number or a table [[T, value], ...], got {value!r}")
+    if isinstance(value, int | float):
+        if not value > 0:
+            raise ValueError(f"must be > 0, got {value}")
+        return float(value)
+    if not isinstance(value, list) or not value or not all(isinstance(r, list) and len(r) == 2 for r in value):
+        raise ValueError(f"must be a number or a table [[T, value], ...] with no holes, got {value!r}")
+    T = [r[0] for r in value]
+    if any(b <= a for a, b in zip(T, T[1:])):
+        raise ValueError("a table of the temperature: T must increase from row to row")
+    if not all(isinstance(v, int | float) and not isinstance(v, bool) and v > 0 for _, v in value):
+        raise ValueError("every value of the table must be a number > 0")
+    return [[float(t), float(v)] for t, v in value]
+
+
+def _as_property(value: float | list) -> Property:
+    return constant(value) if isinstance(value, float) else Table.of(value)
+
+
+class ThermalSpec(Strict):
+    """The [thermal] table (see the module docstring)."""
+
+    conductivity: Any
+    density: Any
+    specific_heat: Any
+
+    @field_validator("conductivity", "density", "specific_heat", mode="before")
+    @classmethod
+    def _positive(cls, value: Any) -> Any:
+        return _property(value)
+
+
+class ConvectionSpec(CurveMixin):
+    """A [[convection]] table: a film h (T - ambient x f(t)) on boundary edges."""
+
+    on: Selector
+    h: float
+    ambient: float
+
+    @field_validator("h")
+    @classmethod
+    def _h(cls, value: float) -> float:
+        if not value > 0:
+            raise ValueError(f"must be > 0, got {value}")
+        return value
+
+    def ambient_of_time(self):
+        """ambient x f(t), f = 1 without a curve."""
+        curve = None if self.curve is None else Curve(self.curve)
+        return (lambda t: self.ambient) if curve is None else (lambda t: self.ambient * curve(t))
+
+
+def build_conduction(model: Model, mesh: Mesh, thermal: ThermalSpec | None, convection: list[ConvectionSpec],
+                     contacts: list) -> None:
+    """Give the model its heat conduction ([thermal], the films, the contact conductances of
+    the [[contact]] tables `contacts`); CaseError naming the key where one is missing."""
+    if thermal is None:
+        if convection:
+            raise CaseError("convection: a film needs the case's [thermal] (conductivity, density, specific_heat)")
+        for k, c in enumerate(contacts):
+            if c.conductance is not None:
+                raise CaseError(f"contact[{k}].conductance: needs the case's [thermal]")
+        return
+    if model.temperature is None:
+        raise CaseError("thermal: heat conduction needs the initial temperature: add [temperature] initial = ...")
+    films = [Film(select_edges(mesh, c.on.model_dump(), f"convection[{i}].on"), c.h, c.ambient_of_time())
+             for i, c in enumerate(convection)]
+    conductances = []
+    for k, c in enumerate(contacts):
+        if c.conductance is not None:
+            curve = None if c.temperature_curve is None else Curve(c.temperature_curve)
+            mould = (lambda t, v=c.temperature: v) if curve is None else \
+                (lambda t, v=c.temperature, f=curve: v * f(t))
+            conductances.append(Conductance(c.conductance, mould, contact_conductance(k)))
+    model.conduct(Conduction(mesh, *(_as_property(getattr(thermal, key))
+                                     for key in ("conductivity", "density", "specific_heat")), films, conductances))

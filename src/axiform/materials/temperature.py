@@ -1,0 +1,114 @@
+"""Temperature in the law: constants as tables of T, and the shift of the relaxation times.
+
+- `Table`: a constant as a piecewise-linear function of the temperature T, constant outside
+  its knots (which increase strictly).
+- `WLF` and `Arrhenius`: the shift factor a_T of the relaxation times (time-temperature
+  superposition): log10 a_T = -C1 (T - T_ref) / (C2 + T - T_ref) (Williams-Landel-Ferry), or
+  ln a_T = activation (1/T - 1/T_ref) with T in kelvin; the reduced time of a material point
+  advances by dxi = dt / a_T(T).
+- `TemperatureDependent`: a law whose constants are tables, evaluated at the temperatures of
+  a batch of material points (`at(T)`: a law with one value per point, the points in the order
+  of the batch's rows); its scalar properties (kappa, shear_modulus: the scales of the
+  solver) are those of the law at the reference temperature.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Table:
+    """A constant as a function of T: knots T (k,) increasing strictly, values (k,);
+    piecewise linear between the knots and constant outside."""
+
+    T: tuple[float, ...]
+    values: tuple[float, ...]
+
+    def __post_init__(self):
+        T = np.asarray(self.T, float)
+        if T.size < 1 or T.shape != np.shape(self.values):
+            raise ValueError("a table needs one value per temperature")
+        if (np.diff(T) <= 0).any():
+            raise ValueError("the temperatures of a table must increase")
+
+    @classmethod
+    def of(cls, rows) -> "Table":
+        """A table from its rows [[T, value], ...]."""
+        rows = np.asarray(rows, float)
+        return cls(tuple(rows[:, 0]), tuple(rows[:, 1]))
+
+    def __call__(self, T: np.ndarray | float) -> np.ndarray:
+        """The value at T (any shape)."""
+        return np.interp(T, self.T, self.values)
+
+
+@dataclass(frozen=True)
+class WLF:
+    """log10 a_T = -C1 (T - reference) / (C2 + T - reference); defined while C2 + T - T_ref > 0."""
+
+    C1: float
+    C2: float
+    reference: float
+
+    def check(self, T: np.ndarray) -> None:
+        """ValueError where T (any shape) lies at or beyond the pole T = T_ref - C2."""
+        T = np.asarray(T, float)
+        if T.size and not (self.C2 + T - self.reference > 0).all():
+            raise ValueError(f"a temperature of {float(T.min()):.6g} is at or below the WLF pole T_ref - C2 = "
+                             f"{self.reference - self.C2:.6g} (C2 + T - T_ref must be > 0)")
+
+    def shift(self, T: np.ndarray | float) -> np.ndarray:
+        """a_T (same shape as T)."""
+        dT = np.asarray(T, float) - self.reference
+        return 10.0 ** (-self.C1 * dT / (self.C2 + dT))
+
+
+@dataclass(frozen=True)
+class Arrhenius:
+    """ln a_T = activation (1/T - 1/reference), T and the reference in kelvin, activation = E/R (K)."""
+
+    activation: float
+    reference: float
+
+    def check(self, T: np.ndarray) -> None:
+        """ValueError where T (any shape) is not a positive (kelvin) temperature."""
+        T = np.asarray(T, float)
+        if T.size and not (T > 0).all():
+            raise ValueError(f"a temperature of {float(T.min()):.6g} is not in kelvin (an Arrhenius shift needs T > 0)")
+
+    def shift(self, T: np.ndarray | float) -> np.ndarray:
+        """a_T (same shape as T)."""
+        return np.exp(self.activation * (1.0 / np.asarray(T, float) - 1.0 / self.reference))
+
+
+Shift = WLF | Arrhenius
+
+
+class TemperatureDependent:
+    """A law whose constants are tables of T (`tables`: name -> Table; `fixed`: name ->
+    number), built by `make(constants)` from one value (or one array of values) per name."""
+
+    def __init__(self, make: Callable[[dict], object], tables: dict[str, Table], fixed: dict[str, float],
+                 reference: float):
+        self.make = make
+        self.tables = tables
+        self.fixed = fixed
+        self.reference = reference
+        self.reference_law = self.at(np.asarray(reference, float))
+
+    def at(self, T: np.ndarray):
+        """The law at the temperatures T of a batch of points: every table evaluated at
+        T.ravel() (one value per point, the batch's rows in order)."""
+        values = {name: table(np.ravel(T)) for name, table in self.tables.items()}
+        if np.ndim(T) == 0:
+            values = {name: float(v[0]) for name, v in values.items()}
+        return self.make(self.fixed | values)
+
+    def __getattr__(self, name: str):
+        if name in ("make", "tables", "fixed", "reference", "reference_law"):
+            raise AttributeError(name)
+        return getattr(self.reference_law, name)

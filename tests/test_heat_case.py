@@ -1,0 +1,154 @@
+"""Heat in the wall through the case file (DESIGN § 11.5): [thermal], [[convection]],
+[[contact]] temperature and conductance, monitors of a node's temperature, checkpoints,
+and the errors that name the key."""
+
+import re
+import tomllib
+
+import numpy as np
+import pytest
+import tomli_w
+
+from axiform.case.schema import build, parse
+from axiform import solve
+
+from test_heat import ALPHA, slab_series
+
+L, T0, T_INF = 2.0, 150.0, 25.0
+CASE = """
+[mesh]
+kind = "rectangle"
+r = [10.0, 11.0]
+z = [0.0, 2.0]
+divisions = [1, 12]
+element = "q8"
+[material]
+model = "neo-hooke"
+C1 = 0.5
+kappa = 1.0e3
+[temperature]
+initial = 150.0
+[thermal]
+conductivity = 0.2
+density = 1.0e-9
+specific_heat = 1.9e9
+[[convection]]
+on = { z = 2.0 }
+h = 0.2
+ambient = 25.0
+[[fix]]
+at = { z = 0.0 }
+dofs = ["uz"]
+[[fix]]
+at = { r = 10.0 }
+dofs = ["ur"]
+[[monitor]]
+name = "T_bottom"
+at = { r = 10.0, z = 0.0 }
+quantity = "temperature"
+[solver]
+target = 19.0
+steps = 100
+"""
+MOULD = {"name": "mould", "surface": {"polyline": [[12.0, 2.0], [9.0, 2.0]]},
+         "slaves": {"z": 2.0}, "motion": {"uz": -1.0e-3, "curve": [[0.0, 0.0], [0.5, 1.0], [100.0, 1.0]]},
+         "temperature": 25.0, "conductance": 0.2}
+
+
+def run(data: dict):
+    built = build(parse(data))
+    temps = []
+    res = solve(built.model, built.control, built.options,
+                on_step=lambda s: temps.append((s.lam, s.state.temperature.copy())))
+    assert res.status == "finished", res.message
+    return built, temps
+
+
+@pytest.mark.parametrize("through", ["film", "contact"])
+def test_a_slab_cools_through_a_film_or_a_mould_as_the_series(through):
+    """Bi = h L / k = 2 through the top face, by a film or by contact conductance with a mould
+    pressed on it: within 0.5 % of T0 - T_inf at Fo = 0.2 and 0.5 (the mechanics' tiny press
+    changes the wall by 5e-4)."""
+    data = tomllib.loads(CASE)
+    if through == "contact":
+        del data["convection"]
+        data["contact"] = [MOULD]
+    built, temps = run(data)
+    z = built.model.mesh.points[:, 1] / L
+    times = np.array([t for t, _ in temps])
+    for fo in (0.2, 0.5):
+        k = int(np.argmin(np.abs(times - fo * L**2 / ALPHA)))
+        exact = T_INF + (T0 - T_INF) * slab_series(z, times[k] * ALPHA / L**2, 2.0)
+        assert np.abs(temps[k][1] - exact).max() < 5e-3 * (T0 - T_INF)
+
+
+def test_the_history_monitors_a_temperature(tmp_path):
+    from axiform.cli import main
+
+    case = tmp_path / "slab.toml"
+    case.write_text(CASE.replace("steps = 100", "steps = 10"))
+    out = tmp_path / "out"
+    assert main(["run", str(case), "--out", str(out), "-q", "--set", "output.plots=false"]) == 0
+    rows = [line.split(",") for line in (out / "history.csv").read_text().splitlines()]
+    T_end = float(rows[-1][rows[0].index("T_bottom")])
+    assert T_INF + 10.0 < T_end < T0 - 10.0
+
+
+class Stop(Exception):
+    pass
+
+
+def test_a_checkpoint_carries_the_temperature(tmp_path):
+    """A run stopped after step 5 and resumed from its checkpoint (through the file format)
+    ends at the temperatures of the uninterrupted run."""
+    from axiform.io.checkpoint import load as load_checkpoint, save as save_checkpoint
+
+    data = tomllib.loads(CASE.replace("steps = 100", "steps = 10"))
+    data["contact"] = [MOULD]
+    built, full = run(data)
+    kept = []
+
+    def stop(step):
+        kept.append(step)
+        if step.number == 5:
+            raise Stop
+
+    with pytest.raises(Stop):
+        solve(built.model, built.control, built.options, on_step=stop)
+    save_checkpoint(tmp_path, kept[-1].checkpoint, {})
+    state, _ = load_checkpoint(tmp_path)
+    again = build(parse(data))
+    rest = solve(again.model, again.control, again.options, resume=state)
+    assert rest.status == "finished"
+    np.testing.assert_allclose(rest.last.state.temperature, full[-1][1], rtol=1e-12)
+
+
+@pytest.mark.parametrize("edit, message", [
+    (("conductivity = 0.2", "conductivity = -0.2"), r"thermal.conductivity: .*> 0"),
+    (("density = 1.0e-9", "density = [[100.0, 1.0e-9], [90.0, 1.1e-9]]"), r"thermal.density: .*increase"),
+    (("specific_heat = 1.9e9", "specific_heat = [[100.0, 1.9e9], [120.0]]"), r"thermal.specific_heat: .*holes"),
+    (("on = { z = 2.0 }", "on = { z = 1.0 }"), r"convection\[0\].on: .*no boundary edge"),
+    (("h = 0.2", "h = 0.0"), r"convection.0..h: must be > 0"),
+    (("[temperature]\ninitial = 150.0\n", ""), r"thermal: .*\[temperature\]"),
+    (("steps = 100", "steps = 100\ncontrol = \"arc-length\""), r"solver.control: .*heat conduction"),
+])
+def test_bad_thermal_input_is_refused_naming_the_key(tmp_path, capsys, edit, message):
+    from axiform.cli import main
+
+    assert edit[0] in CASE
+    case = tmp_path / "slab.toml"
+    case.write_text(CASE.replace(*edit))
+    assert main(["check", str(case)]) == 2
+    err = capsys.readouterr().err
+    assert re.search(message, err), err
+
+
+def test_a_conductance_needs_the_mould_temperature(tmp_path, capsys):
+    from axiform.cli import main
+
+    data = tomllib.loads(CASE)
+    data["contact"] = [{k: v for k, v in MOULD.items() if k != "temperature"}]
+    case = tmp_path / "slab.toml"
+    case.write_text(tomli_w.dumps(data))
+    assert main(["check", str(case)]) == 2
+    assert "contact[0]: temperature (the mould's) and conductance go together" in capsys.readouterr().err
