@@ -200,3 +200,22 @@ def test_a_table_needs_a_temperature(tmp_path, capsys):
     case.write_text(tomli_w.dumps(data))
     assert main(["check", str(case)]) == 2
     assert "material.C1: a table of the temperature needs the case's [temperature]" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("edits, warning", [
+    ([("viscoelastic = { g = [0.4, 0.3], tau = [0.05, 0.5] }\n", "")], "temperature.shift: .*changes nothing"),
+    ([("C1 = [[140.0, 0.6], [160.0, 0.4]]", "C1 = 0.5"), ("shift = { wlf = { C1 = 17.44, C2 = 51.6 } }", "")],
+     "temperature: no constant .* changes nothing"),
+    ([], None),
+])
+def test_a_temperature_that_changes_nothing_is_warned_before_the_run(edits, warning):
+    from axiform.case.preflight import idle_temperature
+
+    text = CASE
+    for edit in edits:
+        assert edit[0] in text
+        text = text.replace(*edit)
+    from axiform.case.schema import build, parse
+
+    lines = idle_temperature(build(parse(tomllib.loads(text))))
+    assert (lines == []) if warning is None else re.search(warning, lines[0])

@@ -1,6 +1,7 @@
 """`axiform run CASE.toml [--out DIR]`, `axiform check CASE.toml [--plot [PNG]]`, `axiform plot
-DIR`, `axiform fit DATA.csv --model MODEL` (app/fit.py), `axiform optimize CASE.toml --target
-T.csv --out DIR` (app/optimize.py), `axiform sweep SWEEP.toml --out DIR` (app/sweep.py).
+DIR`, `axiform fit DATA.csv --model MODEL` (app/fit.py; prony and wlf: app/fit_viscoelastic.py),
+`axiform optimize CASE.toml --target T.csv --out DIR` (app/optimize.py), `axiform sweep
+SWEEP.toml --out DIR` (app/sweep.py).
 
 Exit codes: 0 finished, 1 stopped (converged steps kept), 2 invalid case (refused before any
 work), 3 failed (an unexpected error), 130 / 143 interrupted by SIGINT / SIGTERM.
@@ -23,6 +24,7 @@ import sys
 from . import __version__
 
 
+VISCOELASTIC_FITS = ("prony", "wlf")  # `fit --model` beyond the hyperelastic laws (app/fit_viscoelastic.py)
 DESCRIPTION = ("Large-strain axisymmetric hyperelastic solids by finite elements: blow moulding, "
                "thermoforming and rubber parts, described in TOML case files.")
 
@@ -79,19 +81,27 @@ def _plot_and_fit(sub) -> argparse.ArgumentParser:
     p_plot.add_argument("--animate", action="store_true",
                         help="also write forming.gif: the deformed wall, moulds and thickness, one frame "
                              "per written step")
-    p_fit = sub.add_parser("fit", help="fit a hyperelastic law to uniaxial / equibiaxial / planar test data",
+    p_fit = sub.add_parser("fit", help="fit a hyperelastic law to test data, a Prony series to relaxation or "
+                                       "DMA data, WLF constants to shift factors",
                            description="Fit the constants of a hyperelastic law to uniaxial, equibiaxial and "
                                        "planar (pure shear) test data by least squares on the relative errors, "
-                                       "and check the law's Drucker stability at stretches 0.1 to 10. Writes "
-                                       "material.toml (a [material] table for a case), fit.json and one "
-                                       "fit_<mode>.png per mode.",
+                                       "and check the law's Drucker stability at stretches 0.1 to 10; or a "
+                                       "Prony series (--model prony) to a relaxation modulus or DMA data; or "
+                                       "the WLF constants (--model wlf) to shift factors. Writes material.toml "
+                                       "(the case-file table), fit.json and the plots fit_<mode>.png, "
+                                       "fit_prony.png or fit_wlf.png.",
                            epilog="exit codes: 0 fitted, 1 no admissible constants, 2 a bad data file or argument")
-    p_fit.add_argument("data", nargs="+", help="CSV files with the header mode,stretch,stress")
+    p_fit.add_argument("data", nargs="+", help="CSV files with the header mode,stretch,stress (one file with "
+                                               "time,modulus or frequency,storage,loss for prony, "
+                                               "temperature,log10_shift for wlf)")
     p_fit.add_argument("--model", required=True, help="the law: neo-hooke, mooney-rivlin, yeoh, ogden, gent, "
-                                                      "arruda-boyce")
-    p_fit.add_argument("--terms", type=int, help="Ogden: number of terms, 1 to 6 (default 3)")
+                                                      "arruda-boyce; or prony, wlf")
+    p_fit.add_argument("--terms", type=int, help="Ogden: number of terms, 1 to 6 (default 3); prony: 1 to 8 "
+                                                 "(default one per decade of the data)")
     p_fit.add_argument("--out", help="output folder (default: results/fit-<model>)")
     p_fit.add_argument("--kappa", type=float, help="bulk modulus written (default: 1000 x the initial shear modulus)")
+    p_fit.add_argument("--reference", type=float, help="wlf: the reference temperature T_ref (default: where the "
+                                                       "data's log10_shift is 0)")
     return p_fit
 
 
@@ -129,7 +139,14 @@ def _optimize_and_sweep(sub) -> None:
 
 def dispatch(args: argparse.Namespace) -> int:
     """Run the parsed command; returns its exit code."""
+    if args.command == "fit" and args.model in VISCOELASTIC_FITS:
+        from .app.fit_viscoelastic import run as fit_viscoelastic
+
+        return fit_viscoelastic(args.data, args.model, args.terms, args.out, args.kappa, args.reference)
     if args.command == "fit":
+        if args.reference is not None:
+            print("axiform fit: --reference is for --model wlf", file=sys.stderr)
+            return 2
         from .app.fit import run as fit
 
         return fit(args.data, args.model, args.terms, args.out, args.kappa)
@@ -166,8 +183,9 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "fit":
             from .case.material import KEYS
 
-            if args.model not in KEYS:
-                p_fit.error(f"argument --model: invalid choice: {args.model!r} (choose from {', '.join(KEYS)})")
+            if args.model not in (*KEYS, *VISCOELASTIC_FITS):
+                p_fit.error(f"argument --model: invalid choice: {args.model!r} "
+                            f"(choose from {', '.join((*KEYS, *VISCOELASTIC_FITS))})")
         import numpy as np
 
         try:

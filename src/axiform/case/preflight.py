@@ -46,7 +46,7 @@ def preflight(built: Built) -> list[str]:
     check that fails on an unforeseen case gives no warning rather than stopping the run it
     only advises (each check alone raises: the tests call them one by one)."""
     out = []
-    for check in (curves_past_target, mould_checks, inverting_loads):
+    for check in (curves_past_target, mould_checks, inverting_loads, idle_temperature):
         try:
             out += check(built)
         except Exception:  # noqa: BLE001 - advice only: never in the way of a valid case
@@ -307,3 +307,20 @@ def _internal_rate(model, u_p: np.ndarray) -> np.ndarray:
         return np.bincount(model.solid.dofs.ravel(), fe.ravel(), model.n_full)
 
     return (f_int(eps * u_p) - f_int(-eps * u_p)) / (2 * eps)
+
+
+def idle_temperature(built: Built) -> list[str]:
+    """A [temperature] that changes nothing: a shift without a Prony series (nothing
+    relaxes), or a temperature with neither tables of T in the law, a shift nor [thermal]."""
+    case = built.case
+    heat = case.temperature
+    if heat is None:
+        return []
+    viscous = case.material.viscoelastic is not None
+    if heat.shift is not None and not viscous:
+        return ["temperature.shift: the material has no Prony series ([material] viscoelastic): the shift of its "
+                "relaxation times changes nothing"]
+    if heat.shift is None and not case.material.tables() and case.thermal is None:
+        return ["temperature: no constant of [material] is a table of T, there is no shift and no [thermal]: the "
+                "temperature is written out but changes nothing"]
+    return []

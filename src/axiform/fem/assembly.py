@@ -10,6 +10,8 @@ import numpy as np
 
 from .elements import gauss_quad, gradient_operator
 from ..materials import InvertedElementError, deformation_gradient
+from ..materials.base import add_volumetric
+from ..materials.kinematics import from_rows, to_rows
 from ..materials.viscoelastic import Memory
 from .mesh import Mesh
 
@@ -103,11 +105,11 @@ class SolidAssembly:
             GdV_T = self._GdV[sl].transpose(0, 2, 1)
             law = self.law(sl, temperature)
             if memory is not None:  # the law's parts apart: the Prony series acts on the isochoric one
-                P, A = law.iso_stress_tangent(x)
-                P_vol, A_vol = law.volumetric_stress_tangent(x)
-                dP, dA = memory.add(sl, x, P, A if tangent else None)
-                P = P + P_vol + dP
-                A = A + A_vol + dA if tangent else None
+                xt, shape = to_rows(x)
+                P, A = law.stress_rows(xt, 0.0, tangent)
+                memory.add_rows(sl, xt, P, A)
+                add_volumetric(xt, law.kappa, P, A)
+                P, A = from_rows(P, A, shape)
             elif tangent:
                 P, A = law.stress_tangent(x)
             else:

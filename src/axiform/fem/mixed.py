@@ -133,12 +133,8 @@ class MixedAssembly(SolidAssembly):
             xt, shape = to_rows(x)
             p, dJ = self._pressure(xt, sl, temperature)
             P, A = self.law(sl, temperature).stress_rows(xt, 0.0, tangent)
-            if memory is not None:  # the Prony series on the isochoric part (rows viewed as points)
-                dP, dA = memory.add(sl, xt.T.reshape(shape + (5,)), P.T.reshape(shape + (5,)),
-                                    None if A is None else A.transpose(2, 0, 1).reshape(shape + (5, 5)))
-                P += dP.reshape(-1, 5).T
-                if A is not None:
-                    A += dA.reshape(-1, 5, 5).transpose(1, 2, 0)
+            if memory is not None:  # the Prony series on the isochoric part
+                memory.add_rows(sl, xt, P, A)
             P += p * dJ
             if tangent:
                 add_pressure_hessian(A, xt, p)

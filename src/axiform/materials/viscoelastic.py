@@ -65,14 +65,21 @@ class Prony:
 
 def second_piola(x: np.ndarray, P: np.ndarray) -> np.ndarray:
     """S = F^-1 P (..., 4) of a symmetric S from F and P (..., 5)."""
-    a, b, c, d, f = (x[..., k] for k in range(5))
+    return second_piola_rows(np.moveaxis(x, -1, 0), np.moveaxis(P, -1, 0)).T.reshape(x.shape[:-1] + (4,))
+
+
+def second_piola_rows(xt: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """S = F^-1 P as rows (4, n) (S_RR, S_RZ, S_ZZ, S_TT) from the rows of F and P (5, n)."""
+    a, b, c, d, f = xt.reshape(5, -1)
+    P = P.reshape(5, -1)
     det = a * d - b * c
     # inverse of the meridian block [[a, b], [c, d]] (rows r, z; columns R, Z)
-    S_RR = (d * P[..., 0] - b * P[..., 2]) / det
-    S_RZ = (d * P[..., 1] - b * P[..., 3]) / det
-    S_ZR = (-c * P[..., 0] + a * P[..., 2]) / det
-    S_ZZ = (-c * P[..., 1] + a * P[..., 3]) / det
-    return np.stack([S_RR, 0.5 * (S_RZ + S_ZR), S_ZZ, P[..., 4] / f], axis=-1)
+    S = np.empty((4, a.size))
+    S[0] = (d * P[0] - b * P[2]) / det
+    S[1] = 0.5 * ((d * P[1] - b * P[3]) + (-c * P[0] + a * P[2])) / det
+    S[2] = (-c * P[1] + a * P[3]) / det
+    S[3] = P[4] / f
+    return S
 
 
 def f_times(x: np.ndarray, H: np.ndarray) -> np.ndarray:
@@ -82,32 +89,38 @@ def f_times(x: np.ndarray, H: np.ndarray) -> np.ndarray:
                      x[..., 2] * RR + x[..., 3] * RZ, x[..., 2] * RZ + x[..., 3] * ZZ, x[..., 4] * TT], axis=-1)
 
 
-def d_f_times(H: np.ndarray) -> np.ndarray:
-    """d(F H)/dF (..., 5, 5) for a constant symmetric H (..., 4)."""
-    D = np.zeros(H.shape[:-1] + (5, 5))
-    RR, RZ, ZZ, TT = (H[..., k] for k in range(4))
-    for row, col in ((0, 0), (2, 2)):  # (F H)_iR = F_iR H_RR + F_iZ H_ZR
-        D[..., row, col], D[..., row, col + 1] = RR, RZ
-    for row, col in ((1, 0), (3, 2)):  # (F H)_iZ = F_iR H_RZ + F_iZ H_ZZ
-        D[..., row, col], D[..., row, col + 1] = RZ, ZZ
-    D[..., 4, 4] = TT
-    return D
+def viscous_rows(xt: np.ndarray, P: np.ndarray, A: np.ndarray | None, h: np.ndarray, S_n: np.ndarray,
+                 factors: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Add the Prony series to the law's isochoric P rows (5, n) and A rows (5, 5, n), in
+    place, at F rows xt (5, n) over a step (`factors` e, a, b: (m, 1) for every point or
+    (m, n) one set per point) from the committed history h (m, 4, n) and S_n (4, n); return
+    the trial h' (m, 4, n) and S' (4, n) (second_piola_rows of the law's P, taken first).
 
-
-def viscous_part(x: np.ndarray, P_iso: np.ndarray, A_iso: np.ndarray | None, history: dict[str, np.ndarray],
-                 factors: tuple[np.ndarray, np.ndarray, np.ndarray]):
-    """What the Prony series adds to the law's P (..., 5) and A (..., 5, 5) at F = x over a
-    step (its `factors`, Prony.factors: (m,) for all points or (..., m) one set per point)
-    from the committed history (h (..., m, 4), S (..., 4)), and the trial history at its end."""
+    P <- (1 - c) P - F H0, A <- (1 - c) A - d(F H0)/dF, H0 = sum_i e_i h_i + (sum_i a_i) S_n,
+    c = sum_i b_i (module docstring)."""
     e, a, b = factors
-    h, S_n = history["h"], history["S"]
-    S = second_piola(x, P_iso)
-    H0 = (e[..., None] * h).sum(-2) + a.sum(-1)[..., None] * S_n
-    c = b.sum(-1)
-    dP = -(f_times(x, H0) + c[..., None] * P_iso)
-    dA = None if A_iso is None else -(d_f_times(H0) + c[..., None, None] * A_iso)
-    trial = {"h": e[..., None] * h + a[..., None] * S_n[..., None, :] + b[..., None] * S[..., None, :], "S": S}
-    return dP, dA, trial
+    S = second_piola_rows(xt, P)
+    H0 = (e[:, None] * h).sum(0) + a.sum(0) * S_n  # (4, n)
+    keep = 1.0 - b.sum(0)  # (n,) or (1,)
+    trial = e[:, None] * h + a[:, None] * S_n + b[:, None] * S
+    RR, RZ, ZZ, TT = H0
+    x0, x1, x2, x3, x4 = xt
+    P *= keep
+    P[0] -= x0 * RR + x1 * RZ
+    P[1] -= x0 * RZ + x1 * ZZ
+    P[2] -= x2 * RR + x3 * RZ
+    P[3] -= x2 * RZ + x3 * ZZ
+    P[4] -= x4 * TT
+    if A is not None:
+        A *= keep
+        for row, col in ((0, 0), (2, 2)):  # (F H)_iR = F_iR H_RR + F_iZ H_ZR
+            A[row, col] -= RR
+            A[row, col + 1] -= RZ
+        for row, col in ((1, 0), (3, 2)):  # (F H)_iZ = F_iR H_RZ + F_iZ H_ZZ
+            A[row, col] -= RZ
+            A[row, col + 1] -= ZZ
+        A[4, 4] -= TT
+    return trial, S
 
 
 class Viscoelastic:
@@ -131,19 +144,27 @@ class Viscoelastic:
 
 class Memory:
     """One evaluation's use of the history of a law with memory: the committed history
-    (arrays (e, q, ...)), the step's factors (Prony.factors: (m,) for every point or (e, q, m)
-    one set per point), and the trial history filled chunk by chunk of elements (`add`)."""
+    (arrays (e, q, ...): h (e, q, m, 4), S (e, q, 4)), the step's factors (Prony.factors: (m,)
+    for every point or (e, q, m) one set per point), and the trial history filled chunk by
+    chunk of elements (`add_rows`)."""
 
     def __init__(self, committed: dict[str, np.ndarray], factors: tuple[np.ndarray, np.ndarray, np.ndarray]):
         self.committed = committed
         self.factors = factors
         self.trial = {k: np.empty_like(v) for k, v in committed.items()}
 
-    def add(self, sl: slice, x: np.ndarray, P_iso: np.ndarray, A_iso: np.ndarray | None):
-        """What the memory adds to P and A at the points x (m, q, 5) of the elements sl."""
-        history = {k: v[sl] for k, v in self.committed.items()}
-        factors = self.factors if self.factors[0].ndim == 1 else tuple(f[sl] for f in self.factors)
-        dP, dA, trial = viscous_part(x, P_iso, A_iso, history, factors)
-        for k, v in trial.items():
-            self.trial[k][sl] = v
-        return dP, dA
+    def add_rows(self, sl: slice, xt: np.ndarray, P: np.ndarray, A: np.ndarray | None) -> None:
+        """Add the memory to the law's isochoric P rows (5, n) and A rows (5, 5, n) of the
+        points of the elements sl (n = their number times q, element by element), in place."""
+        h = self.committed["h"][sl]  # (mc, q, m, 4)
+        mc, q, m, _ = h.shape
+        n = mc * q
+        h_rows = h.reshape(n, m, 4).transpose(1, 2, 0)  # (m, 4, n)
+        S_rows = self.committed["S"][sl].reshape(n, 4).T
+        if self.factors[0].ndim == 1:
+            factors = tuple(f[:, None] for f in self.factors)
+        else:
+            factors = tuple(f[sl].reshape(n, m).T for f in self.factors)
+        trial, S = viscous_rows(xt, P, A, h_rows, S_rows, factors)
+        self.trial["h"][sl] = trial.transpose(2, 0, 1).reshape(mc, q, m, 4)
+        self.trial["S"][sl] = S.T.reshape(mc, q, 4)

@@ -66,15 +66,21 @@ def _against_z(ax, t: dict[str, np.ndarray], length: str | None) -> None:
 
 def thickness_figure(thickness: Path, info: FolderInfo, history: dict[str, np.ndarray] | None = None):
     """Thickness against the reference arc length s and against the current z, the thickness
-    ratio, and the time of first contact where something touched; earlier steps from
+    ratio, the time of first contact where something touched and the mid-wall temperature
+    where the table has one that varies; earlier steps from
     thickness/step_NNNN.csv in light lines.  Axes start at 0, so that a 0.1 % variation
     stays a flat line.  None for an empty table."""
     t, step = _read_thickness(thickness)
     if not t:
         return None
     contact = "first_contact" in t and np.isfinite(t["first_contact"]).any()
-    fig = new_figure((10, 7.2) if contact else (13, 4))
-    axes = fig.subplots(2 if contact else 1, 2 if contact else 3, squeeze=False)
+    heat = "temperature" in t and np.ptp(t["temperature"]) > 0
+    panels = 3 + contact + heat
+    rows, cols = (1, 3) if panels == 3 else (2, 2) if panels == 4 else (2, 3)
+    fig = new_figure((13, 4) if rows == 1 else (10, 7.2) if cols == 2 else (14, 7.2))
+    axes = fig.subplots(rows, cols, squeeze=False)
+    for extra in axes.flat[panels:]:
+        extra.remove()
     a_s, a_z, a_ratio = axes.flat[:3]
     length = info.units.get("length")
     thick_label = with_unit("thickness", "length", info.units)
@@ -106,6 +112,13 @@ def thickness_figure(thickness: Path, info: FolderInfo, history: dict[str, np.nd
         ax.grid(True, alpha=0.3)
     if contact:
         _first_contact(axes.flat[3], t, info, arc, a_s.get_xlim())
+    if heat:
+        a_T = axes.flat[3 + contact]
+        a_T.plot(t["s"], t["temperature"], "o-", ms=2.5, color="C3")
+        a_T.set_xlabel(arc)
+        a_T.set_ylabel(with_unit("mid-wall temperature T", "temperature", info.units))
+        a_T.set_xlim(a_s.get_xlim())
+        a_T.grid(True, alpha=0.3)
     state = info.state(step, history) if history else f"step {step}"
     title(fig, (info.title + "\n" if info.title else "") + f"wall thickness, {state}")
     return fig
