@@ -3,7 +3,10 @@ along the load path (load control).
 
 At each converged step n the residual R_n(u_n; s, h_{n-1}) = 0 holds, h_{n-1} the history
 committed at the step before (contact stick points, sticky nodes and where they froze,
-positions for the crossing test), and h_n = H(u_n; s, h_{n-1}).  Differentiating,
+positions for the crossing test; the h_i of a viscoelastic law's Prony series and the
+isochoric stress they were updated with, per quadrature point; the nodes' temperature where
+heat conduction advances it after each step, Model.settle), and h_n = H(u_n; s, h_{n-1}).
+Differentiating,
 
     K_n du_n/ds = -( dR_n/ds |_u  +  dR_n/dh dh_{n-1}/ds )
 
@@ -23,8 +26,8 @@ residuals at the next step holds dR/dh dh/ds.  The linear solves reuse one facto
 K_n per step for all variables.
 
 Cost per converged step: one tangent evaluation and one factorization of K_n, 2 m residual
-evaluations for m variables (4 m with contact: the shadows' history), one back-substitution
-with m right-hand sides.
+evaluations for m variables (4 m with a history, has_history: the shadows' own, and a
+conduction step each with heat conduction), one back-substitution with m right-hand sides.
 """
 
 from __future__ import annotations
@@ -90,6 +93,13 @@ def _same_numbering(base: Model, other: Model, k: int) -> None:
                           "outer, ...) or by coordinates that do not move with the design")
 
 
+def has_history(model: Model) -> bool:
+    """Whether the residual of a step depends on the history committed before it: contact
+    pairs, a law with memory (materials.viscoelastic), or a temperature that heat conduction
+    advances step by step (Model.settle)."""
+    return bool(model.contacts) or bool(model.initial_state().solid) or model.conduction is not None
+
+
 def sensitivity(build: Callable[[np.ndarray], Model], design: np.ndarray, control: LoadControl,
                 options: NewtonOptions | None = None, keep_steps: bool = True,
                 on_step: Callable[[Step, np.ndarray], None] | None = None,
@@ -121,7 +131,7 @@ def sensitivity(build: Callable[[np.ndarray], Model], design: np.ndarray, contro
             _same_numbering(model, shadow, k)
         shadows.append(pair)
     dx_ds = np.stack([(p.mesh.points - q.mesh.points) / (2 * hk) for (p, q), hk in zip(shadows, h)], axis=-1)
-    history = bool(model.contacts)
+    history = has_history(model)
     dm = model.dofmap
     out = Sensitivity(SolveResult("running"), model, s, dx_ds)
 
@@ -132,7 +142,7 @@ def sensitivity(build: Callable[[np.ndarray], Model], design: np.ndarray, contro
         nonlocal lag_state
         u_f, lam = step.u_f, step.lam
         ev = model.evaluate(u_f, lam, lag_state)
-        lag_state = ev.trial
+        lag_state = step.state  # committed by the solver: h_n, the history of the next step's K
         dR = np.empty((model.n_free, m))
         for k, ((plus, minus), (s_plus, s_minus)) in enumerate(zip(shadows, shadow_states)):
             dR[:, k] = (plus.evaluate(u_f, lam, s_plus, tangent=False).r
@@ -141,7 +151,9 @@ def sensitivity(build: Callable[[np.ndarray], Model], design: np.ndarray, contro
         if history:
             for k, (pair, states) in enumerate(zip(shadows, shadow_states)):
                 for j, (shadow, sign) in enumerate(zip(pair, (1.0, -1.0))):
-                    states[j] = shadow.evaluate(u_f + sign * h[k] * du_f[:, k], lam, states[j], tangent=False).trial
+                    moved = u_f + sign * h[k] * du_f[:, k]
+                    trial = shadow.evaluate(moved, lam, states[j], tangent=False).trial
+                    states[j] = shadow.settle(states[j], trial, shadow.expand(moved, lam))
         du = np.concatenate([du_f[: dm.nf], np.zeros((dm.np, m))])[dm.eq]  # (n_full, m)
         if not keep_steps:
             out.du_ds.clear()
