@@ -14,8 +14,9 @@ initial 150, films h (T - 25) (the tube's bore: h (T - 80)), insulated elsewhere
 - scheme: a coarse slab (1 x 4 elements) in 2 steps of Fo 0.105 each: ccx against
   axiform's backward Euler and against Crank-Nicolson built from the same matrices, to see
   which time integration ccx uses;
-- slab: r 10..11, z 0..L = 2, Q8 1 x 24, film on z = L at Bi = h L / k = 0.5, 2, 10,
-  200 steps to Fo = 0.5, node temperatures at Fo = 0.2 and 0.5 against the series;
+- slab: r 10..11, z 0..L = 2, Q8 1 x 24, film on z = L at Bi = h L / k = 0.5, 2, 10
+  (and Q4 / CAX4 at Bi = 2), 200 steps to Fo = 0.5, node temperatures at Fo = 0.2 and 0.5
+  against the series;
 - tube wall: r 20..22, z 0..40, Q8 4 x 40; outside (r = 22) a film h = 0.4, 0.2, 0.1, 0.05
   on the bands z 0-10, 10-20, 20-30, 30-40 (four *FILM groups; four [[convection]] tables
   in axiform), inside (r = 20) h = 0.1 to 80; 300 steps of 0.2 s to t = 60 s.  axiform
@@ -143,18 +144,18 @@ def digits_check() -> dict:
     return {fo: np.abs(at(ax["T"], fo * L**2 / ALPHA) - at(cc["T"], fo * L**2 / ALPHA)).max() for fo in (0.2, 0.5)}
 
 
-def slab(bi: float) -> dict:
+def slab(bi: float, element: str = "q8") -> dict:
     """The slab at Biot number bi: both codes and the series at Fo = 0.2, 0.5."""
-    mesh = rectangle((10.0, 11.0), (0.0, L), (1, 24), "q8")
+    mesh = rectangle((10.0, 11.0), (0.0, L), (1, 24), element)
     film = Film(select_edges(mesh, {"z": L}), bi * K / L, lambda t: T_INF)
     conduction = Conduction(mesh, constant(K), constant(RHO), constant(C), [film])
     steps, every = 200, 40
     dt = 0.5 * L**2 / ALPHA / steps
-    repeat = REPEAT if bi == 2.0 else 1
+    repeat = REPEAT if (bi, element) == (2.0, "q8") else 1
     ax = run_axiform(conduction, dt, steps, every, repeat)
-    cc = run_ccx(f"slab_bi{bi:g}", mesh, [film], dt, steps, every, repeat)
+    cc = run_ccx(f"slab_bi{bi:g}_{element}", mesh, [film], dt, steps, every, repeat)
     z = mesh.points[:, 1] / L
-    out = {"bi": bi, "mesh": mesh, "dt": dt, "steps": steps, "ax": ax, "ccx": cc, "fo": {}}
+    out = {"bi": bi, "element": element, "mesh": mesh, "dt": dt, "steps": steps, "ax": ax, "ccx": cc, "fo": {}}
     for fo in (0.2, 0.5):
         t = fo * L**2 / ALPHA
         series = T_INF + (T0 - T_INF) * slab_series(z, fo, bi)
@@ -230,7 +231,7 @@ def main() -> int:
         return 1
     scheme = scheme_check()
     scheme["unit"] = digits_check()
-    slabs = [slab(bi) for bi in (0.5, 2.0, 10.0)]
+    slabs = [slab(bi) for bi in (0.5, 2.0, 10.0)] + [slab(2.0, "q4")]
     wall = tube()
     lines = report(scheme, slabs, wall)
     RESULTS.mkdir(exist_ok=True)
@@ -261,11 +262,11 @@ def report(scheme: dict, slabs: list[dict], wall: dict) -> list[str]:
             "(7 significant digits): the same slab at Bi = 2 cooled from 1 into 0, where ccx prints more digits "
             "after the point, differs by " + " and ".join(f"{d:.1e} at Fo {fo:g}" for fo, d in scheme["unit"].items())
             + " of T0 - T_inf."]
-    out += ["", "## Slab (r 10..11, z 0..2, Q8 1 x 24, film on z = 2), 200 steps to Fo = 0.5", "",
-            "| Bi | Fo | axiform - ccx | axiform - series | ccx - series |", "|---:|---:|---:|---:|---:|"]
+    out += ["", "## Slab (r 10..11, z 0..2, 1 x 24 elements, film on z = 2), 200 steps to Fo = 0.5", "",
+            "| element | Bi | Fo | axiform - ccx | axiform - series | ccx - series |", "|---|---:|---:|---:|---:|---:|"]
     for s in slabs:
         for fo, v in s["fo"].items():
-            out.append(f"| {s['bi']:g} | {fo:g} | {pct(v['ax'] - v['ccx'], span)} | "
+            out.append(f"| {s['element'].upper()} / CAX{s['mesh'].cells.shape[1]} | {s['bi']:g} | {fo:g} | {pct(v['ax'] - v['ccx'], span)} | "
                        f"{pct(v['ax'] - v['series'], span)} | {pct(v['ccx'] - v['series'], span)} |")
     out += ["", "The distance to the series is the discretisation error that both codes share, mostly backward "
             "Euler's: first order in dt (axiform alone, Bi = 10, Fo = 0.5: 0.117 %, 0.059 %, 0.029 % with 200, "
