@@ -159,8 +159,10 @@ class Memory:
         h = self.committed["h"][sl]  # (mc, q, m, 4)
         mc, q, m, _ = h.shape
         n = mc * q
-        h_rows = h.reshape(n, m, 4).transpose(1, 2, 0)  # (m, 4, n)
-        S_rows = self.committed["S"][sl].reshape(n, 4).T
+        # contiguous (m, 4, n) and (4, n) copies: every operation then runs over n numbers (on a
+        # strided view the sums ran loops of length 4 and cost the law's own stress and tangent)
+        h_rows = np.ascontiguousarray(h.reshape(n, m, 4).transpose(1, 2, 0))
+        S_rows = np.ascontiguousarray(self.committed["S"][sl].reshape(n, 4).T)
         if self.factors[0].ndim == 1:
             factors = tuple(f[:, None] for f in self.factors)
         else:

@@ -66,6 +66,7 @@ class SolidTerm:
         self.shift = shift  # of the relaxation times (materials.temperature.WLF, Arrhenius) or None
         self.blocks = (assembly.dofs,)
         self._scratch: dict[bool, tuple] = {}
+        self._factors: tuple = (None, None)  # (key, Prony factors): a step's, the same at every iteration
 
     def initial_state(self) -> dict:
         """The history per quadrature point before the first step: none for elastic laws; for
@@ -85,14 +86,25 @@ class SolidTerm:
         memory = None
         if state:  # a law with memory: the step from the committed state's time to t
             history = {k: v for k, v in state.items() if k != "t"}
-            dt = max(float(t) - float(state["t"]), 0.0)
-            dxi = dt if self.shift is None or T is None else dt / self.shift.shift(T)
-            memory = Memory(history, self.assembly.material.prony.factors(dxi))
+            memory = Memory(history, self.step_factors(float(t) - float(state["t"]), T))
         fe, Ke = self.assembly.evaluate(u, tangent, self._scratch[tangent], memory, T)
         dofs = self.assembly.dofs
         trial = {} if memory is None else memory.trial | {"t": np.asarray(float(t))}
         return Contribution(assemble(dofs, fe, self.n_full), K=(Ke,) if tangent else (),
                             magnitude=assemble(dofs, np.abs(fe), self.n_full), trial=trial)
+
+    def step_factors(self, dt: float, T: np.ndarray | None) -> tuple[np.ndarray, ...]:
+        """The Prony factors of a step dt at the points' temperatures T (e, q) (each point's
+        reduced time dt / a_T under a shift): computed once per step and temperature field
+        (an exp per point and term, a sixth of an elastic evaluation), then reused by the
+        step's iterations; a pure function of (dt, T), so the memo is no state."""
+        dt = max(dt, 0.0)
+        if self.shift is None or T is None:
+            return self.assembly.material.prony.factors(dt)
+        key = (dt, T.tobytes())
+        if self._factors[0] != key:
+            self._factors = (key, self.assembly.material.prony.factors(dt / self.shift.shift(T)))
+        return self._factors[1]
 
 
 class PressureTerm:
