@@ -125,6 +125,12 @@ def _optimize_and_sweep(sub) -> None:
                        help="stop when the max relative deviation from the target is below this (default 0.01)")
     p_opt.add_argument("--smoothness", type=float, default=1e-4,
                        help="weight of the smoothness term on the design (default 1e-4)")
+    p_opt.add_argument("--vary", choices=["thickness", "temperature"], default="thickness",
+                       help="thickness: the mesh.thickness table (parison programming, default); temperature: the "
+                            "[temperature] initial table (temperature programming)")
+    p_opt.add_argument("--bounds", metavar="LOW,HIGH", default=None,
+                       help="--vary temperature: the bounds of every temperature (default: the table's range "
+                            "+- 30 K)")
     p_opt.add_argument("-q", "--quiet", action="store_true", help="print only one line: the final status")
     p_sweep = sub.add_parser("sweep", help="run variants of a case on a Dask cluster: sweep.csv, sweep.png",
                              description="Run the cases of a sweep file ([vary]: full factorial, or [[cases]]) "
@@ -154,7 +160,7 @@ def dispatch(args: argparse.Namespace) -> int:
         from .app.optimize import run as optimize
 
         return optimize(args.case, args.target, args.out, args.max_iter, args.method, args.tolerance,
-                        args.smoothness, args.quiet)
+                        args.smoothness, args.quiet, args.vary, args.bounds)
     if args.command == "sweep":
         from .app.sweep import run_sweep
 

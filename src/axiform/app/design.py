@@ -75,6 +75,8 @@ class ThicknessDesign:
     initial: np.ndarray
     built: Built
 
+    name = "mesh.thickness"  # the table that holds the design
+
     @classmethod
     def from_case(cls, path: str | Path, overrides: list[str] = ()) -> "ThicknessDesign":
         """Read a case for optimization: a layered mesh with a thickness table, load control.
@@ -90,7 +92,7 @@ class ThicknessDesign:
                             f"\"{case.solver.control}\"")
         built = build(case, path.parent)
         table = np.asarray(case.mesh.thickness, float)
-        return cls(_absolute_paths(tree, path.parent), path.parent, table[:, 0], table[:, 1], built)
+        return cls(absolute_paths(tree, path.parent), path.parent, table[:, 0], table[:, 1], built)
 
     def case_tree(self, values: np.ndarray) -> dict[str, Any]:
         """The case tree with the thickness table's t replaced by `values`."""
@@ -109,8 +111,28 @@ class ThicknessDesign:
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         return BOUNDS[0] * self.initial, BOUNDS[1] * self.initial
 
+    @staticmethod
+    def to_y(x: np.ndarray) -> np.ndarray:
+        """The optimizer's variables y of the design x: y = ln t (a wall scales with its
+        parison, so that ln of the final wall is nearly linear in y)."""
+        return np.log(x)
 
-def _absolute_paths(tree: dict[str, Any], base: Path) -> dict[str, Any]:
+    @staticmethod
+    def from_y(y: np.ndarray) -> np.ndarray:
+        return np.exp(y)
+
+    @staticmethod
+    def dx_dy(x: np.ndarray) -> np.ndarray:
+        return np.asarray(x, float)
+
+    @staticmethod
+    def rule(x: np.ndarray, ratio: np.ndarray) -> np.ndarray:
+        """The fixed-point update of the design x with ratio = target / achieved at its
+        knots: each t_k scaled by it."""
+        return x * ratio
+
+
+def absolute_paths(tree: dict[str, Any], base: Path) -> dict[str, Any]:
     """The case tree with relative file names (mesh.file, contact surfaces' file and dxf)
     made absolute, so that the written case runs from any folder."""
     tree = copy.deepcopy(tree)

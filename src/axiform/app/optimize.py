@@ -1,8 +1,10 @@
 """Parison and preform programming: the initial wall thickness table of a
-layered case that gives a wanted final wall.
+layered case that gives a wanted final wall (`--vary thickness`), or the initial temperature
+table (`--vary temperature`, app.temperature_design: temperature programming).
 
 Design: the thicknesses t_k of the case's `mesh.thickness` table [[s_k, t_k], ...], bounded
-to 0.2 to 5 times their initial values.  Objective (`Objective`): the mean squared relative
+to 0.2 to 5 times their initial values (or the T_k of `[temperature] initial`, bounded to the
+table's range +- 30 K).  Objective (`Objective`): the mean squared relative
 misfit of the final thickness to the target over the reference arc length,
 int ln(t / T)^2 ds / L over the stations inside the target's range (ln(t / T) = (t - T) / T
 to first order; a wall scales with its parison, so that ln t is nearly linear in the
@@ -38,6 +40,10 @@ from ..post.optimize_plots import plot_optimization
 from ..solve.solver import solve
 from .design import SMOOTHNESS, Objective, TargetError, ThicknessDesign, read_target
 from .sensitivity import sensitivity
+from .temperature_design import TemperatureDesign
+
+Design = ThicknessDesign | TemperatureDesign
+VARY = {"thickness": ThicknessDesign, "temperature": TemperatureDesign}
 
 METHODS = ("gradient", "fixed-point")
 TOLERANCE = 0.01
@@ -80,7 +86,7 @@ class Forward:
     """The forward solves of one optimization, counted, and its iterations, recorded as rows
     of optimize.csv (`report(row)` is called with each as it comes)."""
 
-    def __init__(self, design: ThicknessDesign, objective: Objective, report: Callable[[Row], None] | None = None):
+    def __init__(self, design: Design, objective: Objective, report: Callable[[Row], None] | None = None):
         self.design = design
         self.objective = objective
         self.report = report
@@ -115,18 +121,30 @@ class Forward:
             self.report(row)
 
 
-def active_knots(design: ThicknessDesign, objective: Objective) -> np.ndarray:
+def active_knots(design: Design, objective: Objective) -> np.ndarray:
     """The knots whose interpolation reaches a station of the target (k,): the others keep
     their values."""
     k = design.knots
     left, right = np.concatenate([[-np.inf], k[:-1]]), np.concatenate([k[1:], [np.inf]])
-    s_in = design.built.model.mesh.fibre_s[objective.inside]
+    s_in = _stations(design, {"s": design.built.model.mesh.fibre_s})[objective.inside]
     return ((s_in[None, :] > left[:, None]) & (s_in[None, :] < right[:, None])).any(axis=1)
 
 
+def _stations(design, table: dict[str, np.ndarray]) -> np.ndarray:
+    """The positions of the wall's stations in the design table's coordinate (s, or the
+    reference r or z of a temperature table along them)."""
+    along = getattr(design, "along", "s")
+    if along == "s":
+        return table["s"]
+    mesh = design.built.model.mesh
+    f = mesh.fibres
+    return 0.5 * (mesh.points[f[:, 0], "rz".index(along)] + mesh.points[f[:, -1], "rz".index(along)])
+
+
 def fixed_point(forward: Forward, initial: Iterate, max_iter: int, tolerance: float) -> tuple[Iterate, str]:
-    """The plain rule, each t_k scaled by target / achieved at its station s_k, from the
-    last design, better or not; the best iterate and why it stopped ("" unless a solve did)."""
+    """The plain rule of the design (`design.rule`: each t_k scaled by target / achieved at
+    its knot; a temperature raised where the wall is too thick), from the last design, better
+    or not; the best iterate and why it stopped ("" unless a solve did)."""
     design, objective = forward.design, forward.objective
     active = active_knots(design, objective)
     lo, hi = design.bounds()
@@ -134,9 +152,10 @@ def fixed_point(forward: Forward, initial: Iterate, max_iter: int, tolerance: fl
     best = current = initial
     while current.deviation > tolerance and len(forward.rows) <= max_iter:
         t = current.thickness
-        ratio = np.interp(design.knots, t["s"][inside], objective.target[inside] / t["thickness"][inside])
+        ratio = np.interp(design.knots, _stations(design, t)[inside],
+                          objective.target[inside] / t["thickness"][inside])
         ratio[~active] = 1.0
-        current, _ = forward(np.clip(current.design * ratio, lo, hi), False)
+        current, _ = forward(np.clip(design.rule(current.design, ratio), lo, hi), False)
         if not current.finished:
             return best, f"the forward solve of iteration {len(forward.rows)} stopped: {current.message}"
         forward.record(current)
@@ -155,7 +174,7 @@ class LeastSquares:
         self.forward = forward
         self.active = active_knots(forward.design, forward.objective)
         self.x0 = initial.design
-        self.y0 = np.log(self.x0[self.active])
+        self.y0 = forward.design.to_y(self.x0[self.active])
         self.cache: dict[bytes, tuple[Iterate, Any]] = {self.y0.tobytes(): (initial, first)}
         self.best = self.last = initial
         self.max_iter = max_iter
@@ -167,7 +186,7 @@ class LeastSquares:
         key = y.tobytes()
         if key not in self.cache:
             x = self.x0.copy()
-            x[self.active] = np.exp(y)
+            x[self.active] = self.forward.design.from_y(y)
             self.cache[key] = self.forward(x, True)
             it = self.cache[key][0]
             if it.finished and it.objective < self.best.objective:
@@ -183,7 +202,7 @@ class LeastSquares:
 
     def jac(self, y) -> np.ndarray:
         it, rj = self.evaluate(y)
-        return rj[1][:, self.active] * it.design[self.active]  # dr/dy = dr/dt t
+        return rj[1][:, self.active] * self.forward.design.dx_dy(it.design[self.active])  # dr/dy = dr/dx dx/dy
 
     def callback(self, intermediate_result) -> None:
         """After each iteration of the optimizer: record the iterate it accepted (if new);
@@ -204,7 +223,7 @@ class LeastSquares:
         from scipy.optimize import least_squares
 
         lo, hi = self.forward.design.bounds()
-        bounds = (np.log(lo[self.active]), np.log(hi[self.active]))
+        bounds = (self.forward.design.to_y(lo[self.active]), self.forward.design.to_y(hi[self.active]))
         out = least_squares(self.fun, self.y0, jac=self.jac, bounds=bounds, method="trf",
                             max_nfev=4 * self.max_iter + 4, callback=self.callback)
         converged = out.status > 0
@@ -217,7 +236,7 @@ class LeastSquares:
         return self.best, converged, message
 
 
-def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], method: str = "gradient",
+def optimize(design: Design, target: tuple[np.ndarray, np.ndarray], method: str = "gradient",
              max_iter: int = 20, tolerance: float = TOLERANCE, smoothness: float = SMOOTHNESS,
              report: Callable[[Row], None] | None = None) -> OptimizeResult:
     """Find the thickness table whose final wall meets the target (module docstring).
@@ -248,14 +267,14 @@ def optimize(design: ThicknessDesign, target: tuple[np.ndarray, np.ndarray], met
                           time.perf_counter() - t0)
 
 
-def case_text(design: ThicknessDesign, values: np.ndarray) -> str:
+def case_text(design: Design, values: np.ndarray) -> str:
     """optimized.toml: the case with the thickness table's t = values, as TOML (tomli-w)."""
     import tomli_w
 
     return tomli_w.dumps(design.case_tree(values))
 
 
-def write_outputs(out: Path, design: ThicknessDesign, result: OptimizeResult,
+def write_outputs(out: Path, design: Design, result: OptimizeResult,
                   target: tuple[np.ndarray, np.ndarray], final: Path | None) -> None:
     """optimized.toml, optimize.csv, optimize.json and optimize.png in `out`."""
     import csv
@@ -274,11 +293,17 @@ def write_outputs(out: Path, design: ThicknessDesign, result: OptimizeResult,
                "objective": result.best.objective, "max_rel_deviation": result.best.deviation,
                "initial_objective": result.initial.objective,
                "initial_max_rel_deviation": result.initial.deviation,
-               "knots": design.knots.tolist(), "initial_thickness": design.initial.tolist(),
-               "optimized_thickness": result.best.design.tolist(),
+               "vary": design.name, "knots": design.knots.tolist(),
+               f"initial_{_quantity(design)}": design.initial.tolist(),
+               f"optimized_{_quantity(design)}": result.best.design.tolist(),
                "final": None if final is None else final.name}
     write_atomic(out / "optimize.json", json.dumps(summary, indent=2) + "\n")
     plot_optimization(out / "optimize.png", design, result, target)
+
+
+def _quantity(design: Design) -> str:
+    """"thickness" or "temperature": what the design's values are."""
+    return "temperature" if isinstance(design, TemperatureDesign) else "thickness"
 
 
 def _invalid_option(max_iter: int, tolerance: float, smoothness: float) -> str | None:
@@ -290,7 +315,7 @@ def _invalid_option(max_iter: int, tolerance: float, smoothness: float) -> str |
     return None
 
 
-def run_final(out_dir: Path, design: ThicknessDesign, result: OptimizeResult, quiet: bool) -> Path | None:
+def run_final(out_dir: Path, design: Design, result: OptimizeResult, quiet: bool) -> Path | None:
     """optimized.toml and its run in out_dir/final/ (as `axiform run`); the folder, None
     when no design finished.  A final run that does not finish makes the result "stopped"."""
     from ..io.files import write_atomic
@@ -310,15 +335,32 @@ def run_final(out_dir: Path, design: ThicknessDesign, result: OptimizeResult, qu
 
 
 def run(case_path: str, target_path: str, out: str, max_iter: int = 20, method: str = "gradient",
-        tolerance: float = TOLERANCE, smoothness: float = SMOOTHNESS, quiet: bool = False) -> int:
-    """`axiform optimize`: returns the exit code (0 finished, 1 stopped short, 2 invalid input)."""
+        tolerance: float = TOLERANCE, smoothness: float = SMOOTHNESS, quiet: bool = False, vary: str = "thickness",
+        bounds: str | None = None) -> int:
+    """`axiform optimize`: returns the exit code (0 finished, 1 stopped short, 2 invalid input).
+    vary: "thickness" (the mesh.thickness table) or "temperature" ([temperature] initial);
+    bounds: "LOW,HIGH" of every temperature (--vary temperature only)."""
     from ..case.schema import CaseError
     from .console import invalid, say
     from .run import prepare_folder
 
     case_file = Path(case_path)
+    limits = None
+    if bounds is not None:
+        try:
+            limits = tuple(float(v) for v in bounds.split(","))
+            if len(limits) != 2 or not all(np.isfinite(limits)):
+                raise ValueError
+        except ValueError:
+            say(f"axiform: invalid option:\n--bounds: {bounds!r} is not LOW,HIGH (two numbers)")
+            return 2
+        if vary != "temperature":
+            say("axiform: invalid option:\n--bounds: belongs to --vary temperature (a thickness is bounded to "
+                "0.2 to 5 times its initial value)")
+            return 2
     try:
-        design = ThicknessDesign.from_case(case_file)
+        design = (TemperatureDesign.from_case(case_file, bounds=limits) if vary == "temperature"
+                  else ThicknessDesign.from_case(case_file))
     except CaseError as exc:
         return invalid(case_file, exc)
     try:
@@ -337,7 +379,7 @@ def run(case_path: str, target_path: str, out: str, max_iter: int = 20, method: 
         say(f"axiform: invalid output folder:\n--out: {problem}")
         return 2
     if not quiet:
-        say(f"axiform optimize: {design.knots.size} design variables (mesh.thickness), method {method}, "
+        say(f"axiform optimize: {design.knots.size} design variables ({design.name}), method {method}, "
             f"tolerance {tolerance:g} -> {out_dir}")
 
     def report(row: Row) -> None:

@@ -32,7 +32,10 @@ def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResul
     fig = new_figure((13, 11))
     grid = fig.add_gridspec(3, 2, width_ratios=[1.0, 1.45])
     _section(fig.add_subplot(grid[:, 0]), design, result, runs, length)
-    _wall(fig.add_subplot(grid[0, 1]), design, runs, length)
+    if getattr(design, "along", None) is None:
+        _wall(fig.add_subplot(grid[0, 1]), design, runs, length)
+    else:
+        _temperature(fig.add_subplot(grid[0, 1]), design, runs, units)
     _final_thickness(fig.add_subplot(grid[1, 1]), design, result, runs, target, length)
     _convergence(fig.add_subplot(grid[2, 1]), result)
     save(fig, path)
@@ -41,14 +44,15 @@ def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResul
 def _section(ax, design, result, runs, length: str) -> None:
     """The parisons (initial filled, optimized outlined), their final mid-surfaces and the
     moulds at the end of the forming."""
+    same = getattr(design, "along", None) is not None  # a temperature design: one parison
     for values, it, colour, name in runs:
         model = design.model(values)
         f = model.mesh.fibres
         a, b = model.mesh.points[f[:, 0]], model.mesh.points[f[:, -1]]
         ring = np.vstack([a, b[::-1], a[:1]])
         if it is result.initial:
-            ax.fill(ring[:, 0], ring[:, 1], color=colour, alpha=0.5, lw=0, label=f"{name} parison")
-        else:
+            ax.fill(ring[:, 0], ring[:, 1], color=colour, alpha=0.5, lw=0, label="parison" if same else f"{name} parison")
+        elif not same:
             ax.plot(ring[:, 0], ring[:, 1], "-", color=colour, lw=0.9, label=f"{name} parison")
         if it.thickness is not None:
             ax.plot(it.thickness["r"], it.thickness["z"], "-", color=colour, lw=1.2, label=f"{name}: final wall")
@@ -79,6 +83,20 @@ def _wall(ax, design, runs, length: str) -> None:
     ax.set_xlabel("reference arc length s" + length)
     ax.set_ylabel("faces at ±t/2 about the mid-surface" + length)
     ax.set_title("the wall straightened (dots: the thickness table)")
+    ax.legend(fontsize=8)
+
+
+def _temperature(ax, design, runs, units) -> None:
+    """The initial and optimized temperature tables against their positions (s, r or z)."""
+    x_unit = f" ({units.length})" if units.length else ""
+    T_unit = f" ({units.temperature})" if units.temperature else ""
+    for values, _, colour, name in runs:
+        ax.plot(design.knots, values, "o-", color=colour, lw=1.2, ms=4, label=f"{name} temperature")
+    lo, hi = design.limits
+    ax.set_xlabel({"s": "reference arc length s", "r": "reference r", "z": "reference z"}[design.along] + x_unit)
+    ax.set_ylabel("initial temperature" + T_unit)
+    ax.set_title(f"the initial temperature table (dots: its knots; bounds {lo:g} to {hi:g})")
+    ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
 
 
