@@ -82,7 +82,7 @@ def test_cup_conserves_the_material_volume_and_lies_on_the_mould_bottom():
     mixed): int J dV from the model's gradient within 0.5 % of the reference volume; the
     sheet's centre frozen on the cup's bottom (z = -50, from 0.5: 50.5 down, within the
     penalty's sink); the plug clear of the sheet at the end."""
-    model, res = run_case("cup_thermoforming", 2.0, "mesh.divisions=[20,1]", "mesh.element=q8")
+    model, res = run_case("cup_thermoforming", 1.5, "mesh.divisions=[20,1]", "mesh.element=q8")
     assert res.status == "finished"
     u = res.last.u
     assert abs(volume_ratio(model, u) - 1.0) < 5e-3
@@ -96,11 +96,11 @@ def test_cup_conserves_the_material_volume_and_lies_on_the_mould_bottom():
 
 def test_preform_follows_the_stretch_rod():
     """The preform (Q8, 4 + 15 along, 1 through the wall) stretched by the rod alone
-    (t = 0.3, before the pre-blow): the inner tip on the axis 98 t - 0.25 down (the rod's
-    travel less the initial gap) less the penetration the penalty leaves, the deepest there,
+    (t = 0.06 s, before the pre-blow): the inner tip on the axis 98 t / 0.2 - 0.25 down (the
+    rod's travel less the initial gap) less the penetration the penalty leaves, the deepest there,
     within the design's 5 % of the wall (3.5); the gas still at its initial content, so
     almost no pressure."""
-    model, res = run_case("stretch_blow_moulding", 0.3, "mesh.layers=1",
+    model, res = run_case("stretch_blow_moulding", 0.06, "mesh.layers=1",
                           "mesh.profile=[{arc={center=[0.0,115.0],to=[9.0,115.0],divisions=4}},"
                           "{line={to=[9.0,200.0],divisions=15}}]")
     assert res.status == "finished"
@@ -109,34 +109,37 @@ def test_preform_follows_the_stretch_rod():
                              & (np.abs(model.mesh.points[:, 1] - 107.75) < 1e-9))[0])
     rod = model.contacts[0].report(res.last.state.contacts[0])
     assert rod["gap"][model.contacts[0].nodes == tip][0] == pytest.approx(-rod["penetration"], rel=1e-12)
-    assert u[tip * model.dpn + 1] == pytest.approx(-(98.0 * 0.3 - 0.25) + rod["penetration"], abs=1e-6)
+    assert u[tip * model.dpn + 1] == pytest.approx(-(98.0 * 0.06 / 0.2 - 0.25) + rod["penetration"], abs=1e-6)
     assert rod["penetration"] < 0.05 * 3.5
     assert abs(res.last.state.cavities[0].pressure) < 0.02  # the ambient gas, stretched a little
 
 
 def test_preform_blown_into_the_mould():
     """The whole stretch blow moulding on the coarse preform: the gas law p_abs V = content
-    at the end, the wall frozen on the mould at more than 90 % of its slave nodes."""
-    model, res = run_case("stretch_blow_moulding", 2.0, "mesh.layers=1",
+    at the end, the 3 MPa blow; the wall frozen on the mould at every slave node but the
+    neck's clamped one (the heel of the base included, which the 0.8 MPa of the elastic
+    version of this case left open)."""
+    model, res = run_case("stretch_blow_moulding", 0.4, "mesh.layers=1",
                           "mesh.profile=[{arc={center=[0.0,115.0],to=[9.0,115.0],divisions=4}},"
                           "{line={to=[9.0,200.0],divisions=15}}]")
     assert res.status == "finished"
     cavity = res.last.state.cavities[0]
-    assert (cavity.pressure + 0.1) * cavity.volume == pytest.approx(500000.0, rel=1e-6)
-    assert 0.7 < cavity.pressure < 0.9
+    assert (cavity.pressure + 0.1) * cavity.volume == pytest.approx(1700000.0, rel=1e-6)
+    assert 2.9 < cavity.pressure < 3.1
     status = model.contacts[1].report(res.last.state.contacts[1])["status"]
-    assert (status == 3).mean() > 0.9
+    assert (status == 3).sum() == status.size - 1
 
 
 @pytest.mark.parametrize("element", ["q4", "sfr"])
 def test_coarse_straight_edged_preform_passes_the_pre_blow(element):
-    """The coarse preform in Q4 and SFR (4 + 15 elements, one through the wall) to t = 0.4,
-    past the start of the pre-blow (0.3), where the wall slid round the rod's tip, the chord
-    of the tip's element cut into the rod until the element inverted (t = 0.31): the
+    """The coarse preform in Q4 and SFR (4 + 15 elements, one through the wall) to t = 0.07 s,
+    past the start of the pre-blow (0.06 s), where the wall slides round the rod's tip (in
+    the elastic case of the same geometry the chord of the tip's element cut into the rod
+    until the element inverted, 0.5 % of the process after the pre-blow's start): the
     mid-point guard of the straight edges holds the edge's mid-point (eq. 3 for SFR) less
     than half the preform's wall (3.5) inside the rod's tip (radius 5, centre at
-    z = 113 - 98 t)."""
-    model, res = run_case("stretch_blow_moulding", 0.4, "mesh.layers=1", f"mesh.element={element}",
+    z = 113 - 98 t / 0.2); measured 0.44 (Q4) and 0.76 (SFR)."""
+    model, res = run_case("stretch_blow_moulding", 0.07, "mesh.layers=1", f"mesh.element={element}",
                           "mesh.profile=[{arc={center=[0.0,115.0],to=[9.0,115.0],divisions=4}},"
                           "{line={to=[9.0,200.0],divisions=15}}]")
     assert res.status == "finished"
@@ -148,7 +151,7 @@ def test_coarse_straight_edged_preform_passes_the_pre_blow(element):
     if element == "sfr":
         dX = rod.X[b] - rod.X[a]
         mid += 0.25 * (u[a, 2] - u[b, 2])[:, None] * np.column_stack([-dX[:, 1], dX[:, 0]])
-    centre = np.array([0.0, 113.0 - 98.0 * 0.4])
+    centre = np.array([0.0, 113.0 - 98.0 * 0.07 / 0.2])
     on_tip = mid[:, 1] < centre[1]
     depth = 5.0 - np.linalg.norm(mid[on_tip] - centre, axis=1)
     assert on_tip.sum() >= 1 and depth.max() < 0.5 * 3.5
