@@ -69,7 +69,8 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
                 break
             continue
         path.accept(u_new, lam_new, trial)
-        path.history = model.settle(path.history, ev.trial, model.expand(u_new, lam_new))  # of the accepted u only
+        u_full = model.expand(u_new, lam_new)
+        path.history = model.settle(path.history, ev.trial, u_full)  # the trial of the accepted u only
         result.newton_iterations += its
         if its <= opts.easy_iterations:
             size *= opts.growth
@@ -78,7 +79,7 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
         number = first + result.n_steps - 1
         checkpoint = {"path": path.state(), "model": path.history.to_dict(), "size": size, "step": number,
                       "newton_iterations": result.newton_iterations}
-        step = Step(number, lam_new, its, res, u_new, model.expand(u_new, lam_new), ev.r_full, checkpoint,
+        step = Step(number, lam_new, its, res, u_new, u_full, ev.r_full, checkpoint,
                     path.history)
         del ev  # the tangent goes now, not at the next step
         result.steps.append(step)
