@@ -219,3 +219,34 @@ def test_a_temperature_that_changes_nothing_is_warned_before_the_run(edits, warn
 
     lines = idle_temperature(build(parse(tomllib.loads(text))))
     assert (lines == []) if warning is None else re.search(warning, lines[0])
+
+
+
+@pytest.mark.parametrize("element, formulation", [("q4", "mixed"), ("q8", "displacement"), ("sfr", "mixed")])
+def test_the_tangent_of_a_blown_tube_with_memory_tables_and_a_shift_matches_differences(element, formulation):
+    """A tube under volume control (the bordered system) with a Prony series, C1 a table of
+    T, a WLF shift and a temperature graded along it: the whole tangent, from a committed
+    state with history, against central differences of the residual (measured 2e-10)."""
+    import copy
+
+    from conftest import difference_tangent
+    from test_temperature_programming import TUBE
+
+    from axiform.case.schema import build, parse
+
+    tree = copy.deepcopy(TUBE)
+    tree["mesh"].update(element=element, formulation=formulation)
+    tree["temperature"]["initial"]["table"] = [[0.0, 146.0], [4.0, 153.0], [8.0, 148.0], [12.0, 151.0]]
+    built = build(parse(tree))
+    model = built.model
+    res = solve(model, LoadControl(0.5, 4), built.options)
+    held = res.last.state
+    assert np.abs(held.solid["h"]).max() > 0
+    u_f = res.last.u_f + 1e-3 * np.random.default_rng(1).standard_normal(model.n_free)
+    t = res.last.lam + 0.1
+    K = model.evaluate(u_f, t, held).K.toarray()
+    num, _ = difference_tangent(model, u_f, t, 1e-6, held)
+    n = model.dofmap.nf  # the displacement block, and the cavity's row and column
+    assert np.abs(K[:n, :n] - num[:n, :n]).max() < 1e-7 * np.abs(K[:n, :n]).max()
+    assert np.abs(K[n:] - num[n:]).max() < 1e-7 * np.abs(K[n:]).max()
+    assert np.abs(K[:, n:] - num[:, n:]).max() < 1e-7 * np.abs(K[:, n:]).max()
