@@ -82,6 +82,23 @@ def test_a_slab_cools_through_a_film_or_a_mould_as_the_series(through):
         assert np.abs(temps[k][1] - exact).max() < 5e-3 * (T0 - T_INF)
 
 
+def test_heat_crosses_a_thin_gap_in_proportion():
+    """A mould 0.05 from the top face, never touched, conductance_gap = 0.1: half the
+    conductance flows (h_c (1 - g / gap)), the slab cools as with Bi = 1 (the series)."""
+    data = tomllib.loads(CASE)
+    del data["convection"]
+    mould = {k: v for k, v in MOULD.items() if k != "motion"}
+    data["contact"] = [mould | {"surface": {"polyline": [[12.0, 2.05], [9.0, 2.05]]}, "conductance_gap": 0.1,
+                                "depth": 0.1}]
+    built, temps = run(data)
+    z = built.model.mesh.points[:, 1] / L
+    times = np.array([t for t, _ in temps])
+    for fo in (0.2, 0.5):
+        k = int(np.argmin(np.abs(times - fo * L**2 / ALPHA)))
+        exact = T_INF + (T0 - T_INF) * slab_series(z, times[k] * ALPHA / L**2, 1.0)
+        assert np.abs(temps[k][1] - exact).max() < 5e-3 * (T0 - T_INF)
+
+
 def test_the_history_monitors_a_temperature(tmp_path):
     from axiform.cli import main
 
@@ -131,6 +148,9 @@ def test_a_checkpoint_carries_the_temperature(tmp_path):
     (("h = 0.2", "h = 0.0"), r"convection.0..h: must be > 0"),
     (("[temperature]\ninitial = 150.0\n", ""), r"thermal: .*\[temperature\]"),
     (("steps = 100", "steps = 100\ncontrol = \"arc-length\""), r"solver.control: .*heat conduction"),
+    (("[[convection]]", "[[contact]]\nsurface = { polyline = [[12.0, 2.0], [9.0, 2.0]] }\nslaves = { z = 2.0 }\n"
+                        "temperature = 25.0\nconductance = 0.2\nconductance_gap = 5.0\n[[convection]]"),
+     r"contact\[0\].conductance_gap: 5 is beyond the contact search depth"),
 ])
 def test_bad_thermal_input_is_refused_naming_the_key(tmp_path, capsys, edit, message):
     from axiform.cli import main

@@ -112,6 +112,7 @@ class ContactSpec(Strict):
     temperature: float | None = None
     temperature_curve: CurveKnots | None = None
     conductance: Annotated[float, Field(gt=0)] | None = None
+    conductance_gap: Annotated[float, Field(ge=0)] = 0.0  # heat across gaps below this, fading linearly
 
     @model_validator(mode="after")
     def _law(self):

@@ -104,9 +104,14 @@ def build_conduction(model: Model, mesh: Mesh, thermal: ThermalSpec | None, conv
     conductances = []
     for k, c in enumerate(contacts):
         if c.conductance is not None:
+            depth = model.contacts[k].depth
+            if c.conductance_gap > depth:
+                raise CaseError(f"contact[{k}].conductance_gap: {c.conductance_gap:g} is beyond the contact search "
+                                f"depth {depth:g} (the nodes farther from the surface are not seen): give depth = "
+                                f"{c.conductance_gap:g} or more, or a smaller gap")
             curve = None if c.temperature_curve is None else Curve(c.temperature_curve)
             mould = (lambda t, v=c.temperature: v) if curve is None else \
                 (lambda t, v=c.temperature, f=curve: v * f(t))
-            conductances.append(Conductance(c.conductance, mould, contact_conductance(k)))
+            conductances.append(Conductance(c.conductance, mould, contact_conductance(k, c.conductance_gap)))
     model.conduct(Conduction(mesh, *(_as_property(getattr(thermal, key))
                                      for key in ("conductivity", "density", "specific_heat")), films, conductances))

@@ -450,13 +450,20 @@ def _tabled(material) -> bool:
     return bool(getattr(law, "tables", None))
 
 
-def contact_conductance(k: int):
-    """The nodes in contact of the model's contact pair k at a model state and their current
-    ring areas: (nodes (m,), areas (m,)) for fem.heat.Conductance."""
+def contact_conductance(k: int, gap: float = 0.0):
+    """The slave nodes of the model's contact pair k through which heat flows at a model
+    state, and their current ring areas weighted by the share of the conductance they get:
+    (nodes (m,), weighted areas (m,)) for fem.heat.Conductance.  The nodes in contact take it
+    whole; with gap > 0 a node at a gap g < gap from the surface takes (1 - g / gap) of it
+    (heat across a thin layer of air: the wall cools as it comes, not only once it touches)."""
     def in_contact(state: ModelState) -> tuple[np.ndarray, np.ndarray]:
         held = state.contacts[k]
         if held.seen is None:
             return np.zeros(0, np.int64), np.zeros(0)
-        touching = held.seen.status > 0
-        return held.nodes[touching], held.seen.a[touching]
+        share = (held.seen.status > 0).astype(float)
+        if gap > 0:
+            g = np.where(held.seen.proj.active, held.seen.proj.g, np.inf)
+            share = np.maximum(share, np.clip(1.0 - g / gap, 0.0, 1.0))
+        flowing = share > 0
+        return held.nodes[flowing], held.seen.a[flowing] * share[flowing]
     return in_contact
