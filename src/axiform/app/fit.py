@@ -79,16 +79,21 @@ class Data:
         return x
 
 
+def read_text(path: Path) -> str:
+    """The text of a data file; FitDataError names the file where it cannot be read."""
+    try:
+        return path.read_text()
+    except UnicodeDecodeError as exc:
+        raise FitDataError(f"{path}: not UTF-8 text (byte {exc.start})") from None
+    except OSError as exc:
+        raise FitDataError(f"{path}: cannot read ({exc.strerror or exc})") from None
+
+
 def read_data(paths: list[str | Path]) -> Data:
     """Read CSV files with the header mode,stretch,stress; FitDataError names the line."""
     modes, stretches, stresses, notes = [], [], [], []
     for path in map(Path, paths):
-        try:
-            text = path.read_text()
-        except UnicodeDecodeError as exc:
-            raise FitDataError(f"{path}: not UTF-8 text (byte {exc.start})") from None
-        except OSError as exc:
-            raise FitDataError(f"{path}: cannot read ({exc.strerror or exc})") from None
+        text = read_text(path)
         header, rows = None, len(modes)
         for number, row in enumerate(csv.reader(text.splitlines()), start=1):
             cells = [c.strip() for c in row]

@@ -29,7 +29,7 @@ from ..materials.viscoelastic import MAX_TERMS
 from ..materials.viscoelastic_fit import (PronyFit, WLFFit, decades, fit_dynamic, fit_relaxation, fit_wlf,
                                           zero_crossing)
 from ..post.fit_viscoelastic_plots import plot_dynamic, plot_relaxation, plot_wlf
-from .fit import FitDataError
+from .fit import FitDataError, read_text
 from .run import prepare_folder
 
 HEADERS = {"relaxation": ("time", "modulus"), "dynamic": ("frequency", "storage", "loss"),
@@ -52,12 +52,7 @@ class Table:
 def read_table(path: str | Path, kinds: tuple[str, ...]) -> Table:
     """Read a CSV file whose header is one of HEADERS[kinds]; FitDataError names the line."""
     path = Path(path)
-    try:
-        text = path.read_text()
-    except UnicodeDecodeError as exc:
-        raise FitDataError(f"{path}: not UTF-8 text (byte {exc.start})") from None
-    except OSError as exc:
-        raise FitDataError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    text = read_text(path)
     header, kind, rows, lines = None, None, [], []
     wanted = " or ".join(",".join(HEADERS[k]) for k in kinds)
     for number, row in enumerate(csv.reader(text.splitlines()), start=1):
