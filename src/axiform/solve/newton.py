@@ -41,10 +41,7 @@ def converged(ev: Evaluation, lam: float, opts: NewtonOptions, floor: float, res
         raise StepFailed("the residual is not finite")
     residuals.append(norm)
     ref = reference_force(ev, lam, floor)
-    # diverging: 1e10 times the reference force or the step's first residual, whichever is
-    # larger (a sheet at rest that a tool starts to press has no element forces to compare
-    # with: its first residual, the tool's force, is not a divergence)
-    if norm > 1e10 * max(ref, residuals[0]):
+    if norm > 1e10 * ref:
         raise StepFailed("Newton diverges")
     # the round-off level (a row sum over K) is computed only where the tolerance is not met
     return (norm <= opts.tolerance * ref or norm <= ev.noise) and ev.constraint_error <= opts.tolerance
