@@ -204,7 +204,8 @@ def section_process(trees: dict[str, Path], repeat: int, tmp: Path) -> str:
     names = list(trees)
     rows = []
     for ex in EXAMPLES:
-        row = [ex, ", ".join(s.strip() for s in steps[(ex, names[0])]).replace("axiform: finished after ", "")]
+        row = [ex, " → ".join(", ".join(s.strip() for s in steps[(ex, n)]).replace("axiform: finished after ", "")
+                             for n in names)]
         for n in names:
             row.append(f"{min(times[(ex, n)]):.1f} / {statistics.median(times[(ex, n)]):.1f} s")
         row.append(f"{statistics.median(times[(ex, names[0])]) / statistics.median(times[(ex, names[1])]):.2f}")
