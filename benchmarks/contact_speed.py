@@ -200,7 +200,8 @@ def section_process(trees: dict[str, Path], repeat: int, tmp: Path) -> str:
                 if proc.returncode:
                     raise RuntimeError(proc.stdout[-2000:] + proc.stderr[-2000:])
                 times.setdefault((ex, name), []).append(wall)
-                steps[(ex, name)] = (proc.stdout + proc.stderr).strip().splitlines()[-1].split(",")[0:2]
+                status = [s for s in (proc.stdout + proc.stderr).splitlines() if s.startswith("axiform:")]
+                steps[(ex, name)] = status[-1].split(",")[0:2]
     names = list(trees)
     rows = []
     for ex in EXAMPLES:
