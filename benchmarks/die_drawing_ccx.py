@@ -304,7 +304,7 @@ def timing(repeat: int) -> int:
         ta.append(ax["wall"])
         deck = ccx_deck(ax["built"], False, penalty, 0.01)
         start = time.perf_counter()
-        cc = run_ccx(deck, "die_q4_timing")
+        cc = run_ccx(deck, "die_q4_frictionless")  # the deck of the comparison run (the same)
         tc.append(time.perf_counter() - start)
     fa, fc = -ax["fz"][-1], -factor * cc["fz"][-1]
     print(f"source: {SRC}")
