@@ -200,11 +200,13 @@ def section_process(trees: dict[str, Path], repeat: int, tmp: Path) -> str:
                 if proc.returncode:
                     raise RuntimeError(proc.stdout[-2000:] + proc.stderr[-2000:])
                 times.setdefault((ex, name), []).append(wall)
-                steps[(ex, name)] = (proc.stdout + proc.stderr).strip().splitlines()[-1].split(",")[0:2]
+                status = [s for s in (proc.stdout + proc.stderr).splitlines() if s.startswith("axiform:")]
+                steps[(ex, name)] = status[-1].split(",")[0:2]
     names = list(trees)
     rows = []
     for ex in EXAMPLES:
-        row = [ex, ", ".join(s.strip() for s in steps[(ex, names[0])]).replace("axiform: finished after ", "")]
+        row = [ex, " → ".join(", ".join(s.strip() for s in steps[(ex, n)]).replace("axiform: finished after ", "")
+                             for n in names)]
         for n in names:
             row.append(f"{min(times[(ex, n)]):.1f} / {statistics.median(times[(ex, n)]):.1f} s")
         row.append(f"{statistics.median(times[(ex, names[0])]) / statistics.median(times[(ex, names[1])]):.2f}")

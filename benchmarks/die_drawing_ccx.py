@@ -4,6 +4,7 @@ contact), on the same mesh: punch force and the gap between the sheet's centre a
 face against the punch travel, with and without friction, and the final shapes.
 
     python benchmarks/die_drawing_ccx.py [--quick]
+    python benchmarks/die_drawing_ccx.py --timing [--src OLD/src] [--repeat 3]
 
 Writes benchmarks/results/die_drawing.md, die_drawing.png and the CalculiX decks under
 benchmarks/results/die_drawing_ccx/ (apt-get install calculix-ccx).
@@ -23,6 +24,11 @@ Same problem in both codes:
   control (30 nominal steps, cut back as needed).
 ccx prints the forces of axisymmetric models for a segment of the ring: the factor to the whole
 ring is measured on a pressurised annulus resting on a rigid tool (`ring_factor`).
+
+--timing: the frictionless case only, axiform in the displacement formulation with no outputs
+(the solve through the API) against ccx on one thread, each run `--repeat` times in turn; wall
+times min / median, their ratio and the punch forces at a travel of 3.  --src: the source tree
+of axiform to time (another checkout's src/, for a before / after comparison).
 """
 
 from __future__ import annotations
@@ -33,13 +39,15 @@ import re
 import shutil
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
-sys.path.insert(0, str(ROOT / "src"))
+SRC = Path(sys.argv[sys.argv.index("--src") + 1]) if "--src" in sys.argv[:-1] else ROOT / "src"
+sys.path.insert(0, str(SRC.resolve()))
 
 from axiform.case.schema import build, load, youngs_modulus  # noqa: E402 (after the sys.path line)
 from axiform.solve.solver import solve  # noqa: E402
@@ -224,8 +232,10 @@ class _Line:
         self.L = np.linalg.norm(self.b - self.a, axis=1)
 
 
-def run_axiform(friction: bool, penalty: float, element: str) -> dict:
+def run_axiform(friction: bool, penalty: float, element: str, formulation: str | None = None) -> dict:
     sets = [f"contact[{k}].penalty={penalty!r}" for k in range(2)] + [f"mesh.element={element}"]
+    if formulation is not None:
+        sets.append(f'mesh.formulation="{formulation}"')
     if not friction:
         sets += ["contact[0].friction=0.0", "contact[1].friction=0.0"]
     built = build(load(CASE, sets), CASE.parent)
@@ -239,23 +249,30 @@ def run_axiform(friction: bool, penalty: float, element: str) -> dict:
         uz.append(step.u[centre])
         fz.append(punch.report(step.state.contacts[0])["force_z"])
 
+    start = time.perf_counter()
     res = solve(built.model, built.control, built.options, on_step=record)
+    wall = time.perf_counter() - start
     top = np.flatnonzero(np.abs(built.model.mesh.points[:, 1] - 0.3) < 1e-9)
     x = built.model.mesh.points[top] + res.last.u.reshape(-1, built.model.dpn)[top, :2]
     rep = punch.report(res.last.state.contacts[0])
     return {"t": np.array(t), "uz": np.array(uz), "fz": np.array(fz), "x_top": x[np.argsort(x[:, 0])],
             "status": res.status, "steps": len(res.steps), "iterations": res.newton_iterations,
-            "open": int((rep["status"] == 0).sum()), "slaves": len(rep["status"]), "built": built}
+            "open": int((rep["status"] == 0).sum()), "slaves": len(rep["status"]), "built": built, "wall": wall}
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="only the case with friction, coarser ccx increments")
     ap.add_argument("--q8", action="store_true", help="Q8 / CAX8 instead of Q4 / CAX4")
+    ap.add_argument("--timing", action="store_true", help="time the frictionless case in both codes")
+    ap.add_argument("--src", type=Path, default=SRC, help="the axiform source tree to time (default: this one)")
+    ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args(argv)
     if shutil.which("ccx") is None:
         print("ccx not found (apt-get install calculix-ccx)")
         return 1
+    if args.timing:
+        return timing(args.repeat)
     element = "q8" if args.q8 else "q4"
     base = build(load(CASE, [f"mesh.element={element}"]), CASE.parent)
     penalty = 10.0 * youngs_modulus(base.model.material) / 0.15
@@ -272,6 +289,31 @@ def main(argv=None) -> int:
         print(f"{name}: axiform {ax['status']} {ax['steps']} steps; ccx {'finished' if cc['ok'] else 'stopped'} "
               f"{len(cc['t'])} increments; end gap axiform {-TRAVEL - ax['uz'][-1] * 1 + 0:.4f}")
     report(runs, element, penalty, factor)
+    return 0
+
+
+def timing(repeat: int) -> int:
+    """Wall times of the frictionless die drawing, Q4 / CAX4: axiform (displacement formulation,
+    no outputs) and ccx (one thread), `repeat` runs each in turn; printed as a table."""
+    base = build(load(CASE, ["mesh.element=q4"]), CASE.parent)
+    penalty = 10.0 * youngs_modulus(base.model.material) / 0.15
+    factor = ring_factor(penalty)
+    ta, tc = [], []
+    for _ in range(repeat):
+        ax = run_axiform(False, penalty, "q4", "displacement")
+        ta.append(ax["wall"])
+        deck = ccx_deck(ax["built"], False, penalty, 0.01)
+        start = time.perf_counter()
+        cc = run_ccx(deck, "die_q4_frictionless")  # the deck of the comparison run (the same)
+        tc.append(time.perf_counter() - start)
+    fa, fc = -ax["fz"][-1], -factor * cc["fz"][-1]
+    print(f"source: {SRC}")
+    print("| | wall min / median | steps, iterations | punch force at travel 3 |\n|---|---:|---:|---:|")
+    print(f"| axiform Q4, displacement | {min(ta):.2f} / {np.median(ta):.2f} s | {ax['steps']}, {ax['iterations']} | "
+          f"{fa:.4f} |")
+    print(f"| CalculiX CAX4 | {min(tc):.2f} / {np.median(tc):.2f} s | {len(cc['t'])} increments | {fc:.4f} "
+          f"({100 * (fa / fc - 1):+.2f} %) |")
+    print(f"| ratio axiform / CalculiX | {min(ta) / min(tc):.3f} / {np.median(ta) / np.median(tc):.3f} | | |")
     return 0
 
 

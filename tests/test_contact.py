@@ -310,3 +310,24 @@ def test_no_node_ends_a_step_deeper_than_the_reported_penetration(element, tmp_p
     assert res.status == "finished"
     assert max(p for _, p in worst) > 0  # it did touch
     assert max(p for _, p in worst) < 0.02 * 0.5  # and the default penalty keeps it small
+
+
+@pytest.mark.parametrize("element", ["q4", "sfr"])
+def test_the_nodes_projected_with_the_guards_are_the_nodes_projected_alone(element):
+    """`guard` projects the slave nodes with the mid-points in one pass and hands them to the
+    `evaluate` that follows at the same u and state: the very forces, tangents and state of
+    an `evaluate` on its own (and none are handed on to another u)."""
+    punch = Circle(motion=(0.02, 0.1), center=(1.0, -0.03), radius=0.15)
+    model, pair = _contact_model(element, punch, friction=0.05)
+    history = model.evaluate(np.zeros(model.n_free), 0.3).trial.contacts[0]
+    rng = np.random.default_rng(5)
+    u, v = (0.01 * rng.standard_normal((model.mesh.n_nodes, model.dpn)) for _ in range(2))
+    alone = pair.evaluate(u[:, :2], 0.5, history)
+    pair.guard(u, 0.5, punch.velocity(0.5), history)
+    after_guard = pair.evaluate(u[:, :2], 0.5, history)
+    pair.guard(v, 0.5, punch.velocity(0.5), history)
+    other = pair.evaluate(u[:, :2], 0.5, history)
+    for trial in (after_guard, other):
+        for name in ("f", "K", "coupling"):
+            assert np.array_equal(getattr(trial, name), getattr(alone, name)), name
+        assert np.array_equal(trial.state.seen.proj.g, alone.state.seen.proj.g)

@@ -88,6 +88,24 @@ def test_dense_and_searched_candidates_agree(seed, monkeypatch):
         same(surf.local(x, x_prev, 0.1, method), dense)
 
 
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("dense", [True, False])
+def test_one_pass_over_several_sets_is_one_call_per_set(seed, dense, monkeypatch):
+    """`local_sets` (the slave nodes and their edges' mid-points in one pass) gives each set
+    the very projection of its own `local` call: its own depth and motion."""
+    if not dense:
+        monkeypatch.setattr(surfaces, "DENSE_PAIRS", 0)
+    rng = np.random.default_rng(200 + seed)
+    surf = random_polyline(rng, int(rng.integers(2, 9)))
+    sets = []
+    for n, spread, depth in ((int(rng.integers(1, 300)), 0.3, 0.05), (int(rng.integers(1, 300)), 0.1, 0.4), (0, 0.1, 0.1)):
+        x_prev = near_points(rng, surf, n, spread) if n else np.zeros((0, 2))
+        sets.append((x_prev + rng.normal(0, rng.choice([0.01, 0.2]), (n, 2)), x_prev, depth))
+    for method in ("buckets", "binary"):
+        for p, (x, x_prev, depth) in zip(surf.local_sets(sets, method), sets):
+            same(p, surf.local(x, x_prev, depth, method))
+
+
 def test_piece_local_is_the_reference_on_every_pair():
     rng = np.random.default_rng(7)
     surf = random_polyline(rng, 8)

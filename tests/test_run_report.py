@@ -88,9 +88,13 @@ def test_the_run_maxima_and_the_stabilization(ring_run):
     assert stab["work"] == pytest.approx(work) and stab["strain_energy"] == pytest.approx(
         model.strain_energy(result.last.u))
     assert 0 < stab["ratio"] < 0.01  # no warning
-    # the thinnest wall: the ring's height through z (a rectangle's wall), squeezed to about 70 %
+    # the thinnest wall: the ring's height through z (a rectangle's wall), squeezed to about 70 %,
+    # the same at every r (frictionless plates squeeze the ring homogeneously): the thinnest is
+    # then one of equal walls, where round-off puts it, somewhere on the squeezed ring
     t = summary["thickness"]
-    assert 0.6 * H < t["min"] <= t["max"] < 0.8 * H and A - 1 < t["r_min"] < B + 2
+    assert 0.6 * H < t["min"] <= t["max"] < 0.8 * H and t["max"] - t["min"] < 1e-9 * H
+    r = model.mesh.points[:, 0] + result.last.u.reshape(-1, model.dpn)[:, 0]
+    assert r.min() <= t["r_min"] <= r.max()
 
 
 def test_contact_csv_leaves_a_gap_without_surface_empty(ring_run):

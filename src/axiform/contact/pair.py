@@ -176,6 +176,9 @@ class ContactPair:
         self.search = search
         self.stabilization = stabilization  # None: decided by the model (Model.finalize)
         self.name: str | None = None  # a label for plots and summary.json (case file: [[contact]] name)
+        # the nodes' projection found by `guard` with the mid-points' (one pass over the pieces),
+        # for the `evaluate` of the same u and state that follows it: (x, x_prev, projection)
+        self._projected = None
 
     def initial_state(self) -> ContactState:
         """The history before the first step: no node touched, positions at the reference."""
@@ -283,11 +286,15 @@ class ContactPair:
         dpn = u.shape[1]
         un = u[self.nodes]
         xa = self.X + un[:, :2]
-        mid = 0.5 * (xa[e[:, 0]] + xa[e[:, 1]]) - self.surface.offset(lam)
+        offset = self.surface.offset(lam)
+        mid = 0.5 * (xa[e[:, 0]] + xa[e[:, 1]]) - offset
         if dpn == 3:
             mid += (un[e[:, 0], 2] - un[e[:, 1], 2])[:, None] * self.guard_arm
         mid_prev = 0.5 * (state.x_prev[e[:, 0]] + state.x_prev[e[:, 1]])
-        proj = self.surface.local(mid, mid_prev, self.depth + self.guard_allowance.max(), self.search)
+        x = xa - offset  # the nodes, projected in the same pass for `evaluate`
+        nodes, proj = self.surface.local_sets([(x, state.x_prev, self.depth),
+                                               (mid, mid_prev, self.depth + self.guard_allowance.max())], self.search)
+        self._projected = (x, state.x_prev, nodes)
         fn, dfn = _normal_law(proj.g + self.guard_allowance, proj.active, self.guard_kn, self.smoothing)
         w = self.guard_weight
         force = (w * fn)[:, None] * proj.n  # on the mid-point (m, 2)
@@ -318,7 +325,11 @@ class ContactPair:
         """The contact law per unit of w (pressure per unit gap kn0, kt0): traction t (n, 2),
         dt/dx (n, 2, 2), status, the projection, x, and the slip state (friction: contact,
         s0, z, limit; else None), at positions x relative to the surface."""
-        proj = self.surface.local(x, state.x_prev, self.depth, self.search)
+        held, self._projected = self._projected, None
+        if held is not None and held[1] is state.x_prev and np.array_equal(held[0], x):
+            proj = held[2]  # found by `guard` at these very positions
+        else:
+            proj = self.surface.local(x, state.x_prev, self.depth, self.search)
         n = len(x)
         f = np.zeros((n, 2))
         K = np.zeros((n, 2, 2))  # d f / d x

@@ -11,7 +11,7 @@ and the surface's curvature terms: dn/dx = kappa t t^T, dt/dx = -kappa n t^T, ds
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -48,6 +48,10 @@ class Projection:
         return cls(np.zeros(n, bool), z.copy(), np.zeros((n, 2)), np.zeros((n, 2)), z.copy(), z.copy(),
                    np.ones(n), np.zeros((n, 2)), z.copy(), np.zeros(n, np.int8))
 
+    def rows(self, sl: slice) -> Projection:
+        """The projections of the rows sl (views)."""
+        return Projection(*(getattr(self, f.name)[sl] for f in fields(self)))
+
 
 def _best_per_node(i: np.ndarray, score: np.ndarray, rank: np.ndarray) -> np.ndarray:
     """For pairs sorted by node i: the index of the last pair of each node among those with
@@ -81,6 +85,10 @@ class RigidSurface:
     def velocity(self, t: float) -> np.ndarray:
         """d offset / dt."""
         return self.curve.slope(t) * np.asarray(self.motion, float)
+
+    def local_sets(self, sets: list, method: str = "buckets") -> list[Projection]:
+        """`local` of each set of points (x (n, 2), x_prev (n, 2), depth)."""
+        return [self.local(x, x_prev, depth, method) for x, x_prev, depth in sets]
 
 
 @dataclass
@@ -325,12 +333,36 @@ class Polyline(RigidSurface):
            the vertex is its contact point, with the mean of the two normals.
         Every pair of every node is evaluated at once (arrays over the pairs, no loop over
         pieces or nodes)."""
+        return self.local_sets([(x, x_prev, depth)], method)[0]
+
+    def local_sets(self, sets: list, method: str = "buckets") -> list[Projection]:
+        """`local` of several sets of points, (x (n, 2), x_prev (n, 2), depth) each, in one
+        pass over the pairs: the very projections of one `local` per set (each set's
+        candidates from its own depth and motion), the fixed cost of a call paid once (the
+        slave nodes and the mid-points of their edges)."""
         if method not in ("buckets", "binary", "brute"):
             raise KeyError(method)
+        ii, kk, dd, start = [], [], [], 0
+        for xs, xps, ds in sets:
+            dxp = xs - xps
+            moved = float(np.sqrt(dxp[:, 0] * dxp[:, 0] + dxp[:, 1] * dxp[:, 1]).max()) if len(xs) else 0.0
+            i, k = self._candidates(xs, xps, ds, moved, method)
+            ii.append(i + start)
+            kk.append(k)
+            dd.append(np.full(len(i), float(ds)))
+            start += len(xs)
+        x = np.concatenate([xs for xs, _, _ in sets]) if len(sets) > 1 else sets[0][0]
+        x_prev = np.concatenate([xps for _, xps, _ in sets]) if len(sets) > 1 else sets[0][1]
+        i, k, depth = np.concatenate(ii), np.concatenate(kk), np.concatenate(dd)
+        out = self._local_pairs(x, x_prev, i, k, depth)
+        bounds = np.cumsum([0] + [len(xs) for xs, _, _ in sets])
+        return [out] if len(sets) == 1 else [out.rows(slice(a, b)) for a, b in zip(bounds[:-1], bounds[1:])]
+
+    def _local_pairs(self, x: np.ndarray, x_prev: np.ndarray, i: np.ndarray, k: np.ndarray,
+                     depth: np.ndarray) -> Projection:
+        """Steps 1-3 of `local` over the candidate pairs (node i, piece k) sorted by node, with
+        the depth of each pair's node."""
         nn = len(x)
-        dxp = x - x_prev
-        moved = float(np.sqrt(dxp[:, 0] * dxp[:, 0] + dxp[:, 1] * dxp[:, 1]).max()) if nn else 0.0
-        i, k = self._candidates(x, x_prev, depth, moved, method)
         out = Projection.empty(nn)
         if len(i) == 0:
             return out

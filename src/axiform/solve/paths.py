@@ -112,7 +112,7 @@ class PathFollowing:
 class LoadPath(PathFollowing):
     """lambda = t from 0 to the target; every knot of every curve is a step's end."""
 
-    _state_keys = ("u_f", "lam", "previous")
+    _state_keys = ("u_f", "lam", "rate", "previous")
 
     def __init__(self, model, control: LoadControl, opts):
         super().__init__(model, opts)
@@ -123,7 +123,9 @@ class LoadPath(PathFollowing):
         k = model.knots()
         lo, hi = sorted((0.0, self.target))
         self.stops = np.append(k[(k > lo) & (k < hi)][:: 1 if self.target > 0 else -1], self.target)
-        self.previous = None  # the last converged increment (du, dlambda)
+        self.rate = None  # du_f/dlambda at the last converged state (None: not yet computed)
+        self.previous = None  # the last converged increment (du_f, dlambda), within the curves' pieces
+        self.converged = None  # the converged evaluation of the last attempt, until it is accepted
 
     def done(self):
         return abs(self.target - self.lam) <= 1e-12 * abs(self.target)
@@ -139,17 +141,43 @@ class LoadPath(PathFollowing):
     def attempt(self, size):
         stop = self._next_stop()
         lam = stop if abs(stop - self.lam - size) <= 1e-12 * abs(self.target) else self.lam + size
-        guess = None
-        if self.previous is not None:
-            # secant predictor: the last increment scaled to this step; Newton from the last
-            # converged state instead needs many iterations where the response is far from
-            # linear (a flat sheet under pressure stiffens as it stretches)
-            du, dlam = self.previous
-            guess = self.u_f + ((lam - self.lam) / dlam) * du
-        return newton_load(self.model, self.history, self.u_f, lam, self.opts, self.floor, guess)
+        if self.rate is None:  # the first step (or a restart): the tangent at the converged state
+            self.rate = self._tangent_rate(None)
+        # predictor of second order: the parabola through the last two converged states with
+        # the tangent's rate du/dlambda at the last one (only that rate at the first step and
+        # after a knot).  A predictor of first order (the last increment scaled, or the rate
+        # alone) misses the volume of a nearly incompressible sheet by a term of second order in
+        # the step, and kappa times that is a pressure error of the order of the stresses
+        # themselves (kappa / mu = 1210 in the cup example: p 0.21 -> 0.007 under the plug, 0.27
+        # -> 0.84 at its nose, for mu = 0.33); the tangent at such a guess was indefinite and the
+        # first correction drove the sheet through the plug.  docs: benchmarks/CONTACT.md § 6
+        dlam = lam - self.lam
+        guess = self.u_f + dlam * self.rate if self.rate.any() else None
+        if guess is not None and self.previous is not None:
+            du, h = self.previous
+            guess += (dlam * dlam / (h * h)) * (h * self.rate - du)
+        out = newton_load(self.model, self.history, self.u_f, lam, self.opts, self.floor, guess)
+        self.converged = out[4]
+        return out
+
+    def _tangent_rate(self, ev) -> np.ndarray:
+        """du_f/dlambda = -K^-1 dR/dlambda (n_free,) at the evaluation ev (None: evaluated at the
+        last converged state); zeros where that fails (the predictor is then that state)."""
+        try:
+            if ev is None:
+                ev = evaluate_checked(self.model, self.history, self.u_f, self.lam)
+            return -factorize_checked(ev.K)(ev.dr_dlam)
+        except StepFailed:
+            return np.zeros_like(self.u_f)
 
     def accept(self, u_f, lam, size):
-        self.previous = (u_f - self.u_f, lam - self.lam)
+        # the last increment, none across a knot (the rate jumps there); the rate at the new state
+        # from the tangent of the step's converged evaluation (whose history is that of the step's
+        # start: a node that stuck in the step is not yet tied in it)
+        knot = np.abs(self.stops - lam).min() <= 1e-12 * abs(self.target)
+        self.previous = None if knot else (u_f - self.u_f, lam - self.lam)
+        self.rate = self._tangent_rate(self.converged)
+        self.converged = None
         super().accept(u_f, lam, size)
 
     def diagnosis(self):
