@@ -221,7 +221,7 @@ def test_bottle_example_is_a_design_case():
 def test_bottle_whole_wall_within_5_percent_in_fewer_forward_solves_than_the_rule(tmp_path):
     """The bottle example on a coarser mesh (16 Q8 elements, 10 steps, a knot every 8 mm and at
     s = 68): the whole wall but the pinch-off's element, neck included, within 5 % of a uniform
-    target; the gradient method needs 3 forward solves, the fixed-point rule 5."""
+    target; the gradient method needs 3 forward solves, the fixed-point rule 6."""
     from axiform.app.optimize import ThicknessDesign, optimize
 
     tree = tomllib.loads((EXAMPLES / "parison_bottle.toml").read_text())
@@ -241,4 +241,4 @@ def test_bottle_whole_wall_within_5_percent_in_fewer_forward_solves_than_the_rul
         wall = result.best.thickness["thickness"][1:]
         assert np.abs(wall / 1.15 - 1).max() == pytest.approx(result.best.deviation, rel=1e-12)
         assert result.best.deviation <= 0.05
-    assert (grad.forward_solves, rule.forward_solves) == (3, 5)
+    assert (grad.forward_solves, rule.forward_solves) == (3, 6)
