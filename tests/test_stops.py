@@ -40,6 +40,23 @@ def test_a_body_at_the_open_end_of_its_mould_is_said_to_slide_off_it():
     assert diagnosis_after_the_run(30.0) == ""
 
 
+def test_an_end_of_a_mould_on_the_axis_is_no_end_to_slide_off():
+    """A disc (r 0..4) pressed onto a plate whose outline ends on the axis: the centre node
+    rests on that end, which the outline would continue mirrored; nothing to say."""
+    case = ring_on_a_short_plate(30.0)
+    case["mesh"]["r"] = [0.0, 4.0]
+    case["contact"][0]["surface"]["polyline"] = [[0.0, 0.0], [10.0, 0.0]]
+    case["contact"][1]["surface"]["polyline"] = [[10.0, 4.0], [0.0, 4.0]]
+    case["fix"] = [{"at": {"r": 0.0}, "dofs": ["ur"]}]
+    built = build(parse(case))
+    res = solve(built.model, built.control, built.options)
+    assert res.status == "finished", res.message
+    assert (built.model.contacts[0].report(res.last.state.contacts[0])["status"] > 0).all()
+    path = LoadPath(built.model, LoadControl(1.0, 2), NewtonOptions())
+    path.u_f, path.lam, path.history = res.last.u_f, res.last.lam, res.last.state
+    assert path.diagnosis() == ""
+
+
 def test_the_cause_comes_before_the_failure(monkeypatch):
     from axiform.solve import solver
 

@@ -63,6 +63,8 @@ class PathFollowing:
         u = self.model.expand(self.u_f, self.lam).reshape(-1, self.model.dpn)
         for k, (pair, held) in enumerate(zip(self.model.contacts, self.history.contacts)):
             ends = _open_ends(pair.surface)
+            # an end on the axis is no end a body slides off: the outline goes on mirrored
+            ends = ends[np.abs(ends[:, 0] + pair.surface.offset(self.lam)[0]) > 1e-9 * size]
             if held.seen is None or not len(ends):
                 continue
             touching = held.seen.status > 0
