@@ -350,6 +350,20 @@ class Model:
         """Full displacement vector (n_full,) from the unknowns and the time t."""
         return self.dofmap.expand(u_f, self.prescribed(t)[0])
 
+    def relaxation_rate(self, u_f: np.ndarray, t: float, state: ModelState, h: float) -> np.ndarray:
+        """dR/dt of the solid at fixed u (n_free,) from the committed `state`: a law with memory
+        relaxes (its stress moves with t), which Evaluation.dr_dlam (the loads') leaves out;
+        a forward difference over h.  Zeros for a law without memory."""
+        out = np.zeros(self.n_free)
+        if getattr(self.material, "prony", None) is None or h <= 0:
+            return out
+        u = self.expand(u_f, t)
+        term = self.loads[0]
+        r0 = term.evaluate(u, t, state.solid, False, state.temperature).r
+        r1 = term.evaluate(u, t + h, state.solid, False, state.temperature).r
+        out[: self.dofmap.nf] = self.dofmap.gather((r1 - r0) / h)[: self.dofmap.nf]
+        return out
+
     def strain_energy(self, u_full: np.ndarray, state: ModelState | None = None) -> float:
         """The strain energy stored in the body at the displacements u_full (n_full,) (at the
         temperatures of `state`, default the initial ones): the law's W at every quadrature
