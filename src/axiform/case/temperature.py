@@ -22,7 +22,7 @@ from pydantic import ValidationError, field_validator, model_validator
 
 from ..fem.mesh import Mesh
 from ..materials.temperature import WLF, Arrhenius, Shift, Table
-from .base import CaseError, Strict
+from .base import CaseError, PositiveFloat, Strict
 
 
 def _increasing_table(rows: list[tuple[float, float]], what: str) -> list[tuple[float, float]]:
@@ -51,28 +51,14 @@ class InitialTable(Strict):
 class WLFSpec(Strict):
     """log10 a_T = -C1 (T - T_ref) / (C2 + T - T_ref)."""
 
-    C1: float
-    C2: float
-
-    @field_validator("C1", "C2")
-    @classmethod
-    def _positive(cls, value: float) -> float:
-        if not value > 0:
-            raise ValueError(f"must be > 0, got {value}")
-        return value
+    C1: PositiveFloat
+    C2: PositiveFloat
 
 
 class ArrheniusSpec(Strict):
     """ln a_T = activation (1/T - 1/T_ref), T in kelvin; activation = E/R in kelvin."""
 
-    activation: float
-
-    @field_validator("activation")
-    @classmethod
-    def _positive(cls, value: float) -> float:
-        if not value > 0:
-            raise ValueError(f"must be > 0 (E/R in kelvin), got {value}")
-        return value
+    activation: PositiveFloat
 
 
 class ShiftSpec(Strict):

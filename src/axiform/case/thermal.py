@@ -28,7 +28,7 @@ from ..fem.mesh import Mesh
 from ..fem.selectors import select_edges
 from ..materials.temperature import Table
 from ..model.model import Model, contact_conductance
-from .base import CaseError, CurveMixin, Selector, Strict
+from .base import CaseError, CurveMixin, PositiveFloat, Selector, Strict
 
 
 def _property(value: Any) -> Any:
@@ -70,15 +70,8 @@ class ConvectionSpec(CurveMixin):
     """A [[convection]] table: a film h (T - ambient x f(t)) on boundary edges."""
 
     on: Selector
-    h: float
+    h: PositiveFloat
     ambient: float
-
-    @field_validator("h")
-    @classmethod
-    def _h(cls, value: float) -> float:
-        if not value > 0:
-            raise ValueError(f"must be > 0, got {value}")
-        return value
 
     def ambient_of_time(self):
         """ambient x f(t), f = 1 without a curve."""
