@@ -15,7 +15,7 @@ FIELD_NAMES = {"von_mises": ("von Mises stress", "stress"), "J": ("J = det F", "
                "cauchy_stress": ("Cauchy stress", "stress"), "principal_stretches": ("principal stretch", ""),
                "displacement": ("displacement", "length"), "thickness": ("thickness", "length"),
                "contact_pressure": ("contact pressure", "pressure"), "fibre_rotation": ("fibre rotation", "rotation"),
-               "first_contact": ("time of first contact", "time"),
+               "first_contact": ("time of first contact", "time"), "temperature": ("temperature", "temperature"),
                "pressure": ("hydrostatic pressure −tr σ / 3", "stress"),
                "hydrostatic_pressure": ("hydrostatic pressure −tr σ / 3", "stress"),
                # the components the VTU files hold besides as scalars (fields.with_components)
