@@ -63,11 +63,6 @@ class Prony:
         return {"h": np.zeros(points + (len(self.g), 4)), "S": np.zeros(points + (4,))}
 
 
-def second_piola(x: np.ndarray, P: np.ndarray) -> np.ndarray:
-    """S = F^-1 P (..., 4) of a symmetric S from F and P (..., 5)."""
-    return second_piola_rows(np.moveaxis(x, -1, 0), np.moveaxis(P, -1, 0)).T.reshape(x.shape[:-1] + (4,))
-
-
 def second_piola_rows(xt: np.ndarray, P: np.ndarray) -> np.ndarray:
     """S = F^-1 P as rows (4, n) (S_RR, S_RZ, S_ZZ, S_TT) from the rows of F and P (5, n)."""
     a, b, c, d, f = xt.reshape(5, -1)
