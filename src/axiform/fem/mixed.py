@@ -96,26 +96,29 @@ class MixedAssembly(SolidAssembly):
         self.NpdV = NpdV
         self._NpdV_T = np.ascontiguousarray(NpdV.transpose(0, 2, 1))  # (e, np, q)
 
-    def _pressure(self, xt: np.ndarray, sl: slice, temperature=None) -> tuple[np.ndarray, np.ndarray]:
-        """p = kappa (J_bar - 1) (n,) and dJ (5, n) at the rows xt (5, n) of the elements sl."""
+    def _pressure(self, xt: np.ndarray, sl: slice, kappa: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """p = kappa (J_bar - 1) (n,) and dJ (5, n) at the rows xt (5, n) of the elements sl,
+        kappa (m,) theirs (bulk_modulus)."""
         J, dJ = volumetric_rows(xt)
         m, q = self.Np[sl].shape[:2]
         h = np.matmul(self._NpdV_T[sl], J.reshape(m, q, 1))  # int N_p J dV (m, np, 1)
         Jbar = np.matmul(self.Np[sl], np.matmul(self.Minv[sl], h))  # (m, q, 1)
-        return (self.bulk_modulus(sl, temperature)[:, None] * (Jbar[..., 0] - 1.0)).reshape(-1), dJ
+        return (kappa[:, None] * (Jbar[..., 0] - 1.0)).reshape(-1), dJ
 
-    def bulk_modulus(self, sl: slice, temperature: np.ndarray | None = None) -> np.ndarray:
-        """kappa (m,) of the elements sl: the law's, or where it is a table of T the mean of
-        the element's points (one pressure field per element needs one kappa)."""
-        m = len(range(*sl.indices(self.dV.shape[0])))
-        kappa = np.asarray(self.law(sl, temperature).kappa, float)
+    @staticmethod
+    def bulk_modulus(law, m: int) -> np.ndarray:
+        """kappa (m,) of m elements from their law (SolidAssembly.law): the law's, or where it
+        is a table of T the mean of each element's points (one pressure field per element
+        needs one kappa)."""
+        kappa = np.asarray(law.kappa, float)
         return np.broadcast_to(kappa, (m,)) if kappa.ndim == 0 else kappa.reshape(m, -1).mean(1)
 
     def stress(self, x: np.ndarray, sl: slice = slice(None), temperature: np.ndarray | None = None) -> np.ndarray:
         """P = P_iso + p dJ/dF (e, q, 5) with the element pressure p."""
         xt, shape = to_rows(x)
-        p, dJ = self._pressure(xt, sl, temperature)
-        P = self.law(sl, temperature).stress_rows(xt, 0.0, False)[0]
+        law = self.law(sl, temperature)
+        p, dJ = self._pressure(xt, sl, self.bulk_modulus(law, shape[0]))
+        P = law.stress_rows(xt, 0.0, False)[0]
         P += p * dJ
         return from_rows(P, None, shape)[0]
 
@@ -131,8 +134,10 @@ class MixedAssembly(SolidAssembly):
         for sl, x in self.chunks(u_full):
             m = sl.stop - sl.start
             xt, shape = to_rows(x)
-            p, dJ = self._pressure(xt, sl, temperature)
-            P, A = self.law(sl, temperature).stress_rows(xt, 0.0, tangent)
+            law = self.law(sl, temperature)  # built once per chunk (a tabled law: one value per point)
+            kappa = self.bulk_modulus(law, m)
+            p, dJ = self._pressure(xt, sl, kappa)
+            P, A = law.stress_rows(xt, 0.0, tangent)
             if memory is not None:  # the Prony series on the isochoric part
                 memory.add_rows(sl, xt, P, A)
             P += p * dJ
@@ -148,6 +153,5 @@ class MixedAssembly(SolidAssembly):
                 # K += kappa B^T M^-1 B
                 W = self._NpdV_T[sl][:, :, :, None] * dJ.T.reshape(m, 1, q, 5)  # (m, np, q, 5)
                 B = np.matmul(W.reshape(m, -1, q * 5), self._G2[sl])
-                kappa = self.bulk_modulus(sl, temperature)[:, None, None]
-                Ke[sl] += np.matmul(B.transpose(0, 2, 1), kappa * np.matmul(self.Minv[sl], B))
+                Ke[sl] += np.matmul(B.transpose(0, 2, 1), kappa[:, None, None] * np.matmul(self.Minv[sl], B))
         return fe, Ke
