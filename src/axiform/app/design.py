@@ -11,6 +11,7 @@ stations inside the target's range, plus a small smoothness term on the design.
 from __future__ import annotations
 
 import copy
+from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -62,8 +63,30 @@ def read_target(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     return np.array(s), np.array(t)
 
 
+class CaseDesign(ABC):
+    """What the designs of a case share (ThicknessDesign, temperature_design.TemperatureDesign):
+    the model and the control of the case tree with the design's values (`case_tree`), the
+    case read from `tree`, its relative files from `base`, built once as `built`."""
+
+    tree: dict[str, Any]
+    base: Path
+    built: Built
+
+    @abstractmethod
+    def case_tree(self, values: np.ndarray) -> dict[str, Any]:
+        """The case tree with the design's values in it."""
+
+    def model(self, values: np.ndarray) -> Model:
+        """The finalized model of the case with the design's values."""
+        return build(parse(self.case_tree(values)), self.base).model
+
+    @property
+    def control(self) -> LoadControl:
+        return self.built.control
+
+
 @dataclass
-class ThicknessDesign:
+class ThicknessDesign(CaseDesign):
     """The design variables of a layered case: the t of its `mesh.thickness` table.
 
     tree: the case tree (validated); base: the folder its relative paths start from;
@@ -99,14 +122,6 @@ class ThicknessDesign:
         tree = copy.deepcopy(self.tree)
         tree["mesh"]["thickness"] = [[float(s), float(t)] for s, t in zip(self.knots, values)]
         return tree
-
-    def model(self, values: np.ndarray) -> Model:
-        """The finalized model of the case with the thickness table's t = values."""
-        return build(parse(self.case_tree(values)), self.base).model
-
-    @property
-    def control(self) -> LoadControl:
-        return self.built.control
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         return BOUNDS[0] * self.initial, BOUNDS[1] * self.initial

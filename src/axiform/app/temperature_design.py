@@ -20,16 +20,14 @@ from typing import Any
 import numpy as np
 
 from ..case.schema import Built, CaseError, build, parse, read
-from ..model.model import Model
-from ..solve.solver import LoadControl
-from .design import absolute_paths
+from .design import CaseDesign, absolute_paths
 
 MARGIN = 30.0  # K: the default bounds, the table's range widened by this much
 RULE_GAIN = 15.0  # K per unit of ln(achieved / target) (the fixed-point rule)
 
 
 @dataclass
-class TemperatureDesign:
+class TemperatureDesign(CaseDesign):
     """The design variables of a case whose [temperature] initial is a table: its T_k.
 
     tree: the case tree; base: the folder its relative paths start from; along: "s", "r" or
@@ -79,14 +77,6 @@ class TemperatureDesign:
         tree["temperature"]["initial"] = {"along": self.along,
                                           "table": [[float(x), float(T)] for x, T in zip(self.knots, values)]}
         return tree
-
-    def model(self, values: np.ndarray) -> Model:
-        """The finalized model of the case with the temperature table's T = values."""
-        return build(parse(self.case_tree(values)), self.base).model
-
-    @property
-    def control(self) -> LoadControl:
-        return self.built.control
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         k = self.knots.size
