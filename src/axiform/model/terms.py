@@ -66,7 +66,11 @@ class SolidTerm:
         self.shift = shift  # of the relaxation times (materials.temperature.WLF, Arrhenius) or None
         self.blocks = (assembly.dofs,)
         self._scratch: dict[bool, tuple] = {}
-        self._factors: tuple = (None, None)  # (key, Prony factors): a step's, the same at every iteration
+        # memos of pure functions of the step's inputs (the same at every iteration of a step):
+        # the nodes' temperature -> the points' T (e, q) and dxi/dt = 1 / a_T; (dt, T) -> the
+        # Prony factors (an exp per point and term, a sixth of an elastic evaluation)
+        self._points: tuple = (None, None, None)
+        self._factors: tuple = (None, None)
 
     def initial_state(self) -> dict:
         """The history per quadrature point before the first step: none for elastic laws; for
@@ -82,28 +86,31 @@ class SolidTerm:
         """state: the solid's history per point (or None); temperature: the nodes' T (n,) or None."""
         if tangent not in self._scratch:
             self._scratch[tangent] = self.assembly.buffers(tangent)
-        T = None if temperature is None else self.assembly.point_values(temperature)
+        key = None if temperature is None else temperature.tobytes()
+        if key is not None and self._points[0] != key:
+            T = self.assembly.point_values(temperature)
+            self._points = (key, T, None if self.shift is None else 1.0 / self.shift.shift(T))
+        T = None if key is None else self._points[1]
         memory = None
         if state:  # a law with memory: the step from the committed state's time to t
             history = {k: v for k, v in state.items() if k != "t"}
-            memory = Memory(history, self.step_factors(float(t) - float(state["t"]), T))
+            memory = Memory(history, self.step_factors(float(t) - float(state["t"]), key))
         fe, Ke = self.assembly.evaluate(u, tangent, self._scratch[tangent], memory, T)
         dofs = self.assembly.dofs
         trial = {} if memory is None else memory.trial | {"t": np.asarray(float(t))}
         return Contribution(assemble(dofs, fe, self.n_full), K=(Ke,) if tangent else (),
                             magnitude=assemble(dofs, np.abs(fe), self.n_full), trial=trial)
 
-    def step_factors(self, dt: float, T: np.ndarray | None) -> tuple[np.ndarray, ...]:
-        """The Prony factors of a step dt at the points' temperatures T (e, q) (each point's
-        reduced time dt / a_T under a shift): computed once per step and temperature field
-        (an exp per point and term, a sixth of an elastic evaluation), then reused by the
-        step's iterations; a pure function of (dt, T), so the memo is no state."""
+    def step_factors(self, dt: float, temperature_key: bytes | None) -> tuple[np.ndarray, ...]:
+        """The Prony factors of a step dt (each point's reduced time dt / a_T under a shift, at
+        the temperature field of `temperature_key`, the memo's): computed once per step, then
+        reused by the step's iterations."""
         dt = max(dt, 0.0)
-        if self.shift is None or T is None:
+        if self.shift is None or temperature_key is None:
             return self.assembly.material.prony.factors(dt)
-        key = (dt, T.tobytes())
+        key = (dt, temperature_key)
         if self._factors[0] != key:
-            self._factors = (key, self.assembly.material.prony.factors(dt / self.shift.shift(T)))
+            self._factors = (key, self.assembly.material.prony.factors(dt * self._points[2]))
         return self._factors[1]
 
 
