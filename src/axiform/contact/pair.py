@@ -234,7 +234,7 @@ class ContactPair:
         c = self.stabilization * self.kn0
         d = self.smoothing
         free = proj.active & ~state.stuck
-        xi = np.clip(-proj.g / d, 0.0, 1.0)  # 0 at the surface, 1 at the depth of the rounding
+        xi = np.minimum(np.maximum(-proj.g / d, 0.0), 1.0)  # 0 at the surface, 1 at the depth of the rounding
         s = np.where(free, 1.0 - xi * xi * (3.0 - 2.0 * xi), 0.0)
         ds = np.where(free, 6.0 * xi * (1.0 - xi) / d, 0.0)  # ds/dg
         step = x - state.x_prev  # the motion relative to the surface since the last converged step
@@ -295,18 +295,25 @@ class ContactPair:
         nodes, proj = self.surface.local_sets([(x, state.x_prev, self.depth),
                                                (mid, mid_prev, self.depth + self.guard_allowance.max())], self.search)
         self._projected = (x, state.x_prev, nodes)
-        fn, dfn = _normal_law(proj.g + self.guard_allowance, proj.active, self.guard_kn, self.smoothing)
+        m = len(e)
+        g = proj.g + self.guard_allowance
+        if not (proj.active & (g < 0.0)).any():  # no mid-point behind its allowance: no force
+            return np.zeros((m, 2 * dpn)), np.zeros((m, 2 * dpn, 2 * dpn)), np.zeros((m, 2 * dpn)), np.zeros((m, 2))
+        fn, dfn = _normal_law(g, proj.active, self.guard_kn, self.smoothing)
         w = self.guard_weight
         force = (w * fn)[:, None] * proj.n  # on the mid-point (m, 2)
         Kx = (w * dfn)[:, None, None] * outer(proj.n, proj.n)
         Kx += (w * fn * proj.kappa)[:, None, None] * outer(proj.t, proj.t)
         Kv = Kx @ velocity
         if dpn == 2:  # P = [I I] / 2: the products are copies of force, Kx and Kx v
-            return np.tile(0.5 * force, 2), np.tile(0.25 * Kx, (1, 2, 2)), np.tile(0.5 * Kv, 2), force
-        P = np.zeros((len(e), 2, 2, dpn))  # d x_m / d (node, dof)
+            half, quarter = 0.5 * force, 0.25 * Kx
+            return (np.concatenate((half, half), axis=1),
+                    np.broadcast_to(quarter[:, None, :, None, :], (m, 2, 2, 2, 2)).reshape(m, 4, 4),
+                    np.concatenate((0.5 * Kv,) * 2, axis=1), force)
+        P = np.zeros((m, 2, 2, dpn))  # d x_m / d (node, dof)
         P[:, 0, :, 0] = P[:, 1, :, 1] = 0.5
         P[:, :, 0, 2], P[:, :, 1, 2] = self.guard_arm, -self.guard_arm
-        P = P.reshape(len(e), 2, 2 * dpn)
+        P = P.reshape(m, 2, 2 * dpn)
         PT = P.transpose(0, 2, 1)  # (m, 2 dpn, 2): stacked matrix products, not einsums on tiny operands
         return (PT @ force[..., None])[..., 0], PT @ (Kx @ P), (PT @ Kv[..., None])[..., 0], force
 
@@ -396,7 +403,7 @@ class ContactPair:
             # saturated to 1e-10, reversing nodes had next to no tangential stiffness and a
             # frictional tube took twice the iterations and a cut)
             contact, s0, z, limit = slip_state
-            zc = np.clip(z, -Z_SATURATED, Z_SATURATED)
+            zc = np.minimum(np.maximum(z, -Z_SATURATED), Z_SATURATED)
             s_new = np.where(z != zc, proj.s - zc * limit / np.maximum(self.kt0, 1e-300), s0)
             s_stick = np.where(contact, s_new, np.nan)
         if self.sticky:

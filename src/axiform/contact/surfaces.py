@@ -80,11 +80,22 @@ class RigidSurface:
     curve: Curve = PROPORTIONAL
 
     def offset(self, t: float) -> np.ndarray:
-        return self.curve(t) * np.asarray(self.motion, float)
+        """The translation at time t (2,) (read-only: the last one is kept for the next call)."""
+        held = self.__dict__.get("_offset")
+        if held is None or held[0] != t or held[1] is not self.curve or held[2] is not self.motion:
+            value = self.curve(t) * np.asarray(self.motion, float)
+            value.flags.writeable = False
+            held = self.__dict__["_offset"] = (t, self.curve, self.motion, value)
+        return held[3]
 
     def velocity(self, t: float) -> np.ndarray:
-        """d offset / dt."""
-        return self.curve.slope(t) * np.asarray(self.motion, float)
+        """d offset / dt (2,) (read-only: the last one is kept for the next call)."""
+        held = self.__dict__.get("_velocity")
+        if held is None or held[0] != t or held[1] is not self.curve or held[2] is not self.motion:
+            value = self.curve.slope(t) * np.asarray(self.motion, float)
+            value.flags.writeable = False
+            held = self.__dict__["_velocity"] = (t, self.curve, self.motion, value)
+        return held[3]
 
     def local_sets(self, sets: list, method: str = "buckets") -> list[Projection]:
         """`local` of each set of points (x (n, 2), x_prev (n, 2), depth)."""
@@ -196,6 +207,7 @@ class Polyline(RigidSurface):
                                      np.where(arc & (self.sweep > 0), self.sweep, 1.0), self.dir,
                                      -self.tan_a[:, 1], self.tan_a[:, 0]])
         self._pair_cache = search.PairCache()  # `_candidates`: the pairs of a step reused
+        self._previous_table = None  # `_previous`: x_prev against every piece, for a step's iterations
         self._cavity = np.zeros(m, bool)
         self._vertex_n = np.zeros((m, 2))
         for k in range(1, m):
@@ -267,7 +279,7 @@ class Polyline(RigidSurface):
             g = np.where(arc, ga, g)
         if not full:
             return xi, g
-        xic = np.clip(xi, 0.0, 1.0)
+        xic = np.minimum(np.maximum(xi, 0.0), 1.0)
         t, n = P[:, 2:4], P[:, 11:13]  # the line's tangent and normal
         point = P[:, 0:2] + (xic * L)[:, None] * t
         if self._any_arc:
@@ -296,12 +308,26 @@ class Polyline(RigidSurface):
         xi[ia], g[ia] = sub[0], sub[1]
         if not full:
             return xi, g
-        xic = np.clip(xi, 0.0, 1.0)
+        xic = np.minimum(np.maximum(xi, 0.0), 1.0)
         t, n = P[:, 2:4].copy(), P[:, 11:13].copy()
         point = P[:, 0:2] + (xic * P[:, 4])[:, None] * t
         kappa, m = np.zeros(len(k)), np.ones(len(k))
         n[ia], t[ia], kappa[ia], m[ia], point[ia] = sub[2:]
         return xi, g, n, t, kappa, m, point
+
+    def _previous(self, x_prev: np.ndarray, i: np.ndarray, k: np.ndarray):
+        """xi and g of the last converged positions x_prev (n, 2) on the pairs (node i, piece
+        k), from `_project`.  For few pairs in all (n M <= DENSE_PAIRS) out of a table of every
+        node against every piece, built once for an x_prev: the iterations of a step share it."""
+        M = len(self.a)
+        if len(x_prev) * M > DENSE_PAIRS:
+            return self._project(k, x_prev[i], full=False)
+        held = self._previous_table
+        if held is None or held[0].shape != x_prev.shape or not np.array_equal(held[0], x_prev):
+            xi0, g0 = self._project(np.tile(np.arange(M), len(x_prev)), np.repeat(x_prev, M, axis=0), full=False)
+            held = self._previous_table = (x_prev.copy(), xi0, g0)
+        flat = i * M + k
+        return held[1][flat], held[2][flat]
 
     def _candidates(self, x: np.ndarray, x_prev: np.ndarray, depth: float, moved: float, method: str):
         """The (node, piece) pairs of the global search (boxes widened by depth + moved),
@@ -367,7 +393,7 @@ class Polyline(RigidSurface):
         if len(i) == 0:
             return out
         xi, g, n, t, kappa, m, point = self._project(k, x[i])
-        xi0, g0 = self._project(k, x_prev[i], full=False)
+        xi0, g0 = self._previous(x_prev, i, k)
         tol = 1e-9
         dg = g0 - g
         tau = np.divide(g0, dg, out=np.full(len(g), np.inf), where=dg > 0)  # where along the path it crosses
@@ -401,8 +427,8 @@ class Polyline(RigidSurface):
         out.active[bi] = True
         out.g[bi], out.n[bi], out.t[bi] = g[best], n[best], t[best]
         out.kappa[bi], out.m[bi], out.point[bi] = kappa[best], m[best], point[best]
-        out.s[bi] = self.s0[bk] + np.clip(xi[best], 0.0, 1.0) * self.L[bk]
-        out.s_prev[bi] = self.s0[bk] + np.clip(xi0[best], 0.0, 1.0) * self.L[bk]
+        out.s[bi] = self.s0[bk] + np.minimum(np.maximum(xi[best], 0.0), 1.0) * self.L[bk]
+        out.s_prev[bi] = self.s0[bk] + np.minimum(np.maximum(xi0[best], 0.0), 1.0) * self.L[bk]
         out.kind[bi] = np.where(crossed[best], 3, 1)
         if len(self.a) > 1 and len(bi) < nn:
             self._cavity_corners(out, x, i, k, g, xi, depth, tol)
