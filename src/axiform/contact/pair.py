@@ -385,10 +385,11 @@ class ContactPair:
             status[sliding] = 2
             slip_state = (contact, s0, z, limit)
         if self.sticky:
-            tied = stuck
-            f[tied] -= kn[tied, None] * (x[tied] - state.stuck_point[tied])
-            K[tied] -= kn[tied, None, None] * np.eye(2)
-            status[tied] = 3
+            tie = stuck * kn  # the penalty of the tied nodes, 0 elsewhere (whose stuck point is 0)
+            f -= tie[:, None] * (x - state.stuck_point)
+            K[:, 0, 0] -= tie
+            K[:, 1, 1] -= tie
+            status[stuck] = 3
         return f, K, status, proj, x, slip_state
 
     def _next(self, state: ContactState, seen: ContactSeen, slip_state, lam: float, work: float) -> ContactState:

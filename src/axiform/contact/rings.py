@@ -47,6 +47,8 @@ def ring_areas(x: np.ndarray, edges: np.ndarray, derivative: bool = False):
     da[m, i, j, :] = d a_i / d x_j (m, k, k, 2) with respect to the positions of the edge's
     nodes; a node's area is the sum of its parts over its edges."""
     m, k = edges.shape
+    if k == 2:
+        return _straight_ring_areas(x, edges, derivative)
     _, _, N, dN = edge_rule(k, 3)  # (p, k): built once
     wN, wNN, wNdN = _ring_weights(k)
     X = x[edges]  # (m, k, 2)
@@ -60,6 +62,28 @@ def ring_areas(x: np.ndarray, edges: np.ndarray, derivative: bool = False):
     da = np.swapaxes((r / L)[..., None] * t, 1, 2) @ wNdN
     da[:, 0] += L @ wNN
     return a, da.reshape(m, 2, k, k).transpose(0, 2, 3, 1)
+
+
+# a_i = (pi / 3) l (2 r_i + r_j) on a straight edge of length l: the linear N_i integrated
+_STRAIGHT = (np.pi / 3.0) * np.array([[2.0, 1.0], [1.0, 2.0]])
+
+
+def _straight_ring_areas(x: np.ndarray, edges: np.ndarray, derivative: bool):
+    """`ring_areas` of straight two-node edges in closed form (the rule is exact there):
+    a_i = (pi / 3) l (2 r_i + r_j), d a_i / d x_j = (pi / 3) (1 + delta_ij) l e_r
+    + (pi / 3) (2 r_i + r_j) dl/dx_j, dl/dx_1 = -dl/dx_0 = (x_1 - x_0) / l."""
+    X = x[edges]  # (m, 2, 2)
+    d = X[:, 1] - X[:, 0]
+    length = np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1])
+    s = X[..., 0] @ _STRAIGHT  # (pi / 3) (2 r_i + r_j), (m, 2)
+    a = s * length[:, None]
+    if not derivative:
+        return a
+    da = np.empty((len(edges), 2, 2, 2))
+    np.multiply(s[:, :, None], (d / length[:, None])[:, None, :], out=da[:, :, 1])
+    np.negative(da[:, :, 1], out=da[:, :, 0])
+    da[..., 0] += length[:, None, None] * _STRAIGHT
+    return a, da
 
 
 def pole_rows(x: np.ndarray, edges: np.ndarray, corner: np.ndarray, derivative: bool = False):

@@ -253,7 +253,7 @@ class Polyline(RigidSurface):
     def _project(self, k: np.ndarray, x: np.ndarray, full: bool = True, subset: bool = True):
         """`_piece_local` on arrays, every pair at once: the pieces' data gathered by k and
         both the straight and the circular formula evaluated for every pair (the arc's only
-        where the polyline has arcs), the right one picked by np.where.  full=False: xi and g
+        where a pair lies on an arc), the right one picked by np.where.  full=False: xi and g
         only (the last converged positions need no more)."""
         P = self._par[k]  # (p, 13): one gather of every piece's constants
         ar, az, tr, tz, L, cr, cz, R, phi0, sweep, sgn = P.T[:11]
@@ -261,8 +261,9 @@ class Polyline(RigidSurface):
         dx, dz = xr - ar, xz - az
         xi = (dx * tr + dz * tz) / L
         g = dx * -tz + dz * tr  # (x - a) . nor, nor = (-t_z, t_r)
-        if self._any_arc:
-            arc = self.is_arc[k]
+        arc = self.is_arc[k] if self._any_arc else None
+        arcs = arc is not None and bool(arc.any())  # the arc formulas only where a pair is on an arc
+        if arcs:
             if subset and len(k) > ARC_SUBSET:
                 return self._project_subset(k, x, full, arc, xi, g, P)
             dr, dh = xr - cr, xz - cz
@@ -282,7 +283,7 @@ class Polyline(RigidSurface):
         xic = np.minimum(np.maximum(xi, 0.0), 1.0)
         t, n = P[:, 2:4], P[:, 11:13]  # the line's tangent and normal
         point = P[:, 0:2] + (xic * L)[:, None] * t
-        if self._any_arc:
+        if arcs:
             isarc = arc[:, None]
             sc = np.empty((len(k), 2))
             np.negative(sin, out=sc[:, 0])
@@ -329,6 +330,15 @@ class Polyline(RigidSurface):
         flat = i * M + k
         return held[1][flat], held[2][flat]
 
+    def _dense_candidates(self, x: np.ndarray, widen):
+        """The (node, piece) pairs, sorted by node then piece, of the nodes x (n, 2) inside the
+        pieces' boxes widened by `widen` (a number, or one per node (n, 1)): every node
+        against every box at once."""
+        xr, xz = x[:, 0, None], x[:, 1, None]
+        inside = (xr >= self.lo[:, 0] - widen) & (xr <= self.hi[:, 0] + widen)
+        inside &= (xz >= self.lo[:, 1] - widen) & (xz <= self.hi[:, 1] + widen)
+        return np.nonzero(inside)
+
     def _candidates(self, x: np.ndarray, x_prev: np.ndarray, depth: float, moved: float, method: str):
         """The (node, piece) pairs of the global search (boxes widened by depth + moved),
         sorted by node then piece.  For a few pairs in all (N M <= DENSE_PAIRS) every node
@@ -336,11 +346,7 @@ class Polyline(RigidSurface):
         returns, without its set-up.  Else the search, its pairs of x_prev reused while the
         nodes stay near x_prev (`search.PairCache`: the same pairs)."""
         if len(x) * len(self.a) <= DENSE_PAIRS:
-            widen = depth + moved
-            lo, hi = self.lo - widen, self.hi + widen
-            xr, xz = x[:, 0, None], x[:, 1, None]
-            inside = (xr >= lo[:, 0]) & (xr <= hi[:, 0]) & (xz >= lo[:, 1]) & (xz <= hi[:, 1])
-            return np.nonzero(inside)
+            return self._dense_candidates(x, depth + moved)
         finder = {"buckets": search.buckets, "binary": search.binary_sort, "brute": search.brute_force}[method]
         pairs = self._pair_cache.pairs(finder, x, x_prev, self.lo, self.hi, depth, moved)
         return pairs[:, 0], pairs[:, 1]
@@ -368,20 +374,27 @@ class Polyline(RigidSurface):
         slave nodes and the mid-points of their edges)."""
         if method not in ("buckets", "binary", "brute"):
             raise KeyError(method)
-        ii, kk, dd, start = [], [], [], 0
-        for xs, xps, ds in sets:
+        sizes = [len(xs) for xs, _, _ in sets]
+        moved = []
+        for xs, xps, _ in sets:
             dxp = xs - xps
-            moved = float(np.sqrt(dxp[:, 0] * dxp[:, 0] + dxp[:, 1] * dxp[:, 1]).max()) if len(xs) else 0.0
-            i, k = self._candidates(xs, xps, ds, moved, method)
-            ii.append(i + start)
-            kk.append(k)
-            dd.append(np.full(len(i), float(ds)))
-            start += len(xs)
+            moved.append(float(np.sqrt(dxp[:, 0] * dxp[:, 0] + dxp[:, 1] * dxp[:, 1]).max()) if len(xs) else 0.0)
         x = np.concatenate([xs for xs, _, _ in sets]) if len(sets) > 1 else sets[0][0]
         x_prev = np.concatenate([xps for _, xps, _ in sets]) if len(sets) > 1 else sets[0][1]
-        i, k, depth = np.concatenate(ii), np.concatenate(kk), np.concatenate(dd)
-        out = self._local_pairs(x, x_prev, i, k, depth)
-        bounds = np.cumsum([0] + [len(xs) for xs, _, _ in sets])
+        depth = np.repeat([float(ds) for _, _, ds in sets], sizes)  # per point
+        if len(x) * len(self.a) <= DENSE_PAIRS:  # every point against every widened box at once
+            widen = np.repeat([float(ds) + mv for (_, _, ds), mv in zip(sets, moved)], sizes)[:, None]
+            i, k = self._dense_candidates(x, widen)
+        else:
+            ii, kk, start = [], [], 0
+            for (xs, xps, ds), mv in zip(sets, moved):
+                i, k = self._candidates(xs, xps, ds, mv, method)
+                ii.append(i + start)
+                kk.append(k)
+                start += len(xs)
+            i, k = np.concatenate(ii), np.concatenate(kk)
+        out = self._local_pairs(x, x_prev, i, k, depth[i])
+        bounds = np.cumsum([0] + sizes)
         return [out] if len(sets) == 1 else [out.rows(slice(a, b)) for a, b in zip(bounds[:-1], bounds[1:])]
 
     def _local_pairs(self, x: np.ndarray, x_prev: np.ndarray, i: np.ndarray, k: np.ndarray,
