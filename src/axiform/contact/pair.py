@@ -203,12 +203,22 @@ class ContactPair:
         the surface get the penalty in it, see the class).  guard_force: the mid-point guards'
         forces (m, 2) of the same state (`guard`), for the report."""
         xa = self.X + u[self.nodes]
+        x = xa - self.surface.offset(lam)
+        held, self._projected = self._projected, None
+        if held is not None and held[1] is state.x_prev and np.array_equal(held[0], x):
+            proj = held[2]  # found by `guard` at these very positions
+        else:
+            proj = self.surface.local(x, state.x_prev, self.depth, self.search)
+        if guard_force is None:
+            guard_force = np.zeros((len(self.edges) if self.guarded else 1, 2))
+        if self._idle(proj, state, predicting):
+            return self._untouching(xa, x, proj, state, guard_force)
         parts, dparts = ring_areas(xa, self.edges, derivative=True)
         a = np.bincount(self.edges.ravel(), parts.ravel(), len(self.nodes))
         # f = w(a) t: w = a (a / a0)^thinning, the area times the thinning of the penalty
         ratio = np.where(self.on_axis, 1.0, a / np.where(self.on_axis, 1.0, self.area0)) ** self.thinning
         w, dw = a * ratio, np.where(self.on_axis, 1.0, (1.0 + self.thinning) * ratio)
-        t, dt, status, proj, x, slip = self._traction(xa - self.surface.offset(lam), state, predicting)
+        t, dt, status, slip = self._traction(x, proj, state, predicting)
         work = state.damping_work
         if self.stabilization:
             ts, dts, energy = self._damping(x, state, proj)
@@ -222,10 +232,33 @@ class ContactPair:
         # d f_i / d x_j through a_i: dw_i t_i (x) da_i/dx_j (m, k, 2, k, 2)
         C = (dw[e][:, :, None] * t[e])[:, :, :, None, None] * dparts[:, :, None]
         pole_rate = self._poles(xa, t, dt, f, C) if self.pole_edge.size else None
-        if guard_force is None:
-            guard_force = np.zeros((len(e) if self.guarded else 1, 2))
         seen = ContactSeen(x, proj, f, status, a, ratio[:, None] * t, guard_force)
         return ContactTrial(f, K, C.reshape(m, 2 * k, 2 * k), pole_rate, self._next(state, seen, slip, lam, work))
+
+    def _idle(self, proj, state: ContactState, predicting: bool) -> bool:
+        """Whether the law gives no force and no stiffness at the projection `proj`: no node
+        behind the surface (nor resting on it, where the predicting tangent holds it), none
+        tied, no stabilization."""
+        if self.stabilization or state.stuck.any():
+            return False
+        below = self.smoothing if predicting and self.mu == 0 and not self.sticky else 0.0
+        return not (proj.active & (proj.g < below)).any()
+
+    def _untouching(self, xa: np.ndarray, x: np.ndarray, proj, state: ContactState,
+                    guard_force: np.ndarray) -> ContactTrial:
+        """`evaluate` where the pair is idle (`_idle`): no force, no derivative; the trial
+        state that of `_next` with no node in contact (stick points released)."""
+        n = len(self.nodes)
+        e = self.edges
+        m, k = e.shape
+        a = np.bincount(e.ravel(), ring_areas(xa, e).ravel(), n)
+        zero = np.zeros((n, 2))
+        seen = ContactSeen(x, proj, zero, np.zeros(n, np.int8), a, zero, guard_force)
+        s_stick = np.full(n, np.nan) if self.mu > 0 and not self.sticky else state.s_stick
+        after = ContactState(self.nodes, x.copy(), s_stick, state.stuck, state.stuck_point, state.first_contact,
+                             seen, state.damping_work)
+        pole_rate = np.zeros((self.pole_edge.size, k, 2, 2)) if self.pole_edge.size else None
+        return ContactTrial(zero, np.zeros((n, 2, 2)), np.zeros((m, 2 * k, 2 * k)), pole_rate, after)
 
     def _damping(self, x: np.ndarray, state: ContactState, proj):
         """The stabilization's traction per unit of w (n, 2), its derivative d/dx (n, 2, 2)
@@ -328,15 +361,10 @@ class ContactPair:
                       (trial.pole_rate @ velocity).sum(axis=1))
         return out
 
-    def _traction(self, x: np.ndarray, state: ContactState, predicting: bool):
+    def _traction(self, x: np.ndarray, proj, state: ContactState, predicting: bool):
         """The contact law per unit of w (pressure per unit gap kn0, kt0): traction t (n, 2),
-        dt/dx (n, 2, 2), status, the projection, x, and the slip state (friction: contact,
-        s0, z, limit; else None), at positions x relative to the surface."""
-        held, self._projected = self._projected, None
-        if held is not None and held[1] is state.x_prev and np.array_equal(held[0], x):
-            proj = held[2]  # found by `guard` at these very positions
-        else:
-            proj = self.surface.local(x, state.x_prev, self.depth, self.search)
+        dt/dx (n, 2, 2), status and the slip state (friction: contact, s0, z, limit; else
+        None), at positions x relative to the surface and their projection `proj`."""
         n = len(x)
         f = np.zeros((n, 2))
         K = np.zeros((n, 2, 2))  # d f / d x
@@ -390,7 +418,7 @@ class ContactPair:
             K[:, 0, 0] -= tie
             K[:, 1, 1] -= tie
             status[stuck] = 3
-        return f, K, status, proj, x, slip_state
+        return f, K, status, slip_state
 
     def _next(self, state: ContactState, seen: ContactSeen, slip_state, lam: float, work: float) -> ContactState:
         """The history after a step that ends at the evaluation `seen` from `state`: positions
