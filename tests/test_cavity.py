@@ -241,3 +241,36 @@ def test_invalid_cavity_tables(tmp_path, capsys, edit, message):
     case.write_text(text)
     assert main(["check", str(case)]) == 2
     assert message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("zero", [False, True])
+def test_the_bordered_pattern_gives_the_block_matrix(element, zero):
+    """BorderedPattern.matrix (values placed in a pattern built once) is scipy's block matrix
+    [[K, -G], [c_u G^T, diag(c_p)]] entry for entry, stored entries included: a gas and a
+    volume cavity (no dC/dp entry), and a zero in G (a wall node on the axis), which block
+    assembly leaves out."""
+    import scipy.sparse as sp
+
+    from axiform.fem.constraints import BorderedPattern
+
+    mesh, model = bore(element)
+    model.finalize()
+    K = model.evaluate(0.03 * np.random.default_rng(2).standard_normal(model.n_free), 0.5).K
+    nf = model.dofmap.nf
+    wall = model.dofmap.eq[model.mesh.element.dofs_per_node * select_nodes(mesh, {"r": 1.0})[:, None]
+                           + np.arange(2)].ravel()
+    wall = np.unique(wall[wall < nf])
+    border = BorderedPattern(model.pattern, [wall, wall[::2]], [True, False])
+    G = np.zeros((nf, 2))
+    rng = np.random.default_rng(3)
+    for j, rows in enumerate(border.supports):
+        G[rows, j] = rng.uniform(0.5, 1.5, len(rows))
+    if zero:
+        G[border.supports[0][0], 0] = 0.0
+    c_u, c_p = np.array([6.2, 1.0]), np.array([2.5, 0.0])
+    got = border.matrix(K, G, c_u, c_p)
+    want = sp.bmat([[K, sp.csr_matrix(-G)], [sp.csr_matrix(c_u[:, None] * G.T), sp.csr_matrix(np.diag(c_p))]],
+                   format="csr")
+    want.sort_indices()
+    for name in ("indptr", "indices", "data"):
+        assert np.array_equal(getattr(got, name), getattr(want, name)), name

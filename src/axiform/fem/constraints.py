@@ -125,3 +125,43 @@ class SparsePattern:
         i, p, s = self._fp_csr
         K_fp = sp.csr_matrix((data[self.n_ff: self.n_ff + self.n_fp], i, p), shape=s)
         return self.free_block(data), K_fp
+
+
+class BorderedPattern:
+    """The CSR pattern of K_ff (nf, nf) bordered by m constraint rows and columns,
+    [[K, -G], [Cu, Cp]]: G (nf, m) and Cu (m, nf) = c_u G^T nonzero only on the rows
+    `supports[j]` (the equations of cavity j's wall), Cp (m, m) diagonal, its entry j
+    present where diagonal[j] (a gas cavity: dC/dp = V; a volume constraint has none).
+    Built once from K_ff's pattern; `matrix` places the values of an iteration with one
+    gather (scipy's block assembly rebuilt the whole matrix at every iteration)."""
+
+    def __init__(self, pattern: SparsePattern, supports: list[np.ndarray], diagonal: list[bool]):
+        indices, indptr, (nf, _) = pattern._ff_csr
+        self.supports = [np.asarray(s, np.int64) for s in supports]
+        self.diagonal = np.flatnonzero(diagonal)
+        m = len(supports)
+        k_rows = np.repeat(np.arange(nf), np.diff(indptr))
+        col = np.concatenate([np.full(len(s), nf + j) for j, s in enumerate(self.supports)] + [np.zeros(0, int)])
+        row = np.concatenate(self.supports + [np.zeros(0, int)])
+        rows = np.concatenate([k_rows, row, col, nf + self.diagonal])
+        cols = np.concatenate([indices, col, row, nf + self.diagonal])
+        source = np.arange(1, len(rows) + 1, dtype=float)  # where each entry comes from, + 1
+        B = sp.csr_matrix((source, (rows, cols)), shape=(nf + m, nf + m))
+        B.sort_indices()
+        self._source = B.data.astype(np.int64) - 1  # the CSR slot -> the entry of the values
+        self._indices, self._indptr, self.shape = B.indices, B.indptr, B.shape
+
+    def matrix(self, K: sp.csr_matrix, G: np.ndarray, c_u: np.ndarray, c_p: np.ndarray) -> sp.csr_matrix:
+        """The bordered matrix of K_ff (on this pattern), G (nf, m), c_u (m,) and c_p (m,),
+        with no stored zero in the border (a wall node on the axis, dV/du_r = 0; a volume
+        constraint's dC/dp), as block assembly leaves them out: the same matrix."""
+        g = [G[s, j] for j, s in enumerate(self.supports)]
+        border = np.concatenate(g + [c * v for c, v in zip(c_u, g)] + [c_p[self.diagonal]])
+        if not border.all() or not np.array_equal(np.flatnonzero(c_p), self.diagonal):  # zeros: another pattern
+            Cu = c_u[:, None] * G.T
+            return sp.bmat([[K, sp.csr_matrix(-G)], [sp.csr_matrix(Cu), sp.csr_matrix(np.diag(c_p))]], format="csr")
+        n_g = sum(len(v) for v in g)
+        values = np.concatenate([K.data, -border[:n_g], border[n_g:]])
+        out = sp.csr_matrix((values[self._source], self._indices, self._indptr), shape=self.shape)
+        out.has_sorted_indices = True
+        return out

@@ -14,7 +14,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..fem.assembly import SolidAssembly
-from ..fem.constraints import DofMap, SparsePattern
+from ..fem.constraints import BorderedPattern, DofMap, SparsePattern
 from ..fem.cavity import Cavity
 from ..fem.curves import PROPORTIONAL, Curve
 from ..fem.graphs import connected_components
@@ -277,6 +277,9 @@ class Model:
         index = {c: i for i, c in enumerate(self._presc_curves)}
         self._presc_curve = np.array([index[curve_of_eq[k]] for k in range(dm.np)], dtype=np.int64)
         self._unknown = [c for c in self.cavities if c.unknown]  # cavities whose pressure is solved for
+        walls = [dm.eq[c.dofs].ravel() for c in self._unknown]  # their constraints' support
+        self._border = BorderedPattern(self.pattern, [np.unique(eq[eq < dm.nf]) for eq in walls],
+                                       [c.control == "gas" for c in self._unknown])
         # round-off floor of the residual from the model's own force scale 2 pi k L R, which
         # is not zero at u = 0 (a state in equilibrium converges whatever the load); k the
         # larger of the shear and bulk moduli: the stresses carry kappa (J - 1), J to round-off
@@ -452,9 +455,7 @@ class Model:
         # prescribed displacements move the wall: dC/dt += dC/du_p du_p/dt
         dC_dt = np.array([c.rate + c.c_u * (g[nf:] @ dpresc) for c, g in zip(constraints, g_eq)])
         if K is not None:
-            Cu = np.array([c.c_u for c in constraints])[:, None] * G.T
-            Cp = np.diag([c.c_p for c in constraints])
-            K = sp.bmat([[K, sp.csr_matrix(-G)], [sp.csr_matrix(Cu), sp.csr_matrix(Cp)]], format="csr")
+            K = self._border.matrix(K, G, np.array([c.c_u for c in constraints]), np.array([c.c_p for c in constraints]))
         return np.concatenate([r, C]), np.concatenate([dr_dt, dC_dt]), K
 
 
