@@ -246,19 +246,17 @@ class ContactPair:
 
     def _untouching(self, xa: np.ndarray, x: np.ndarray, proj, state: ContactState,
                     guard_force: np.ndarray) -> ContactTrial:
-        """`evaluate` where the pair is idle (`_idle`): no force, no derivative; the trial
-        state that of `_next` with no node in contact (stick points released)."""
+        """`evaluate` where the pair is idle (`_idle`): no force, no derivative (None); the
+        trial state that of `_next` with no node in contact (stick points released)."""
         n = len(self.nodes)
         e = self.edges
-        m, k = e.shape
         a = np.bincount(e.ravel(), ring_areas(xa, e).ravel(), n)
         zero = np.zeros((n, 2))
         seen = ContactSeen(x, proj, zero, np.zeros(n, np.int8), a, zero, guard_force)
         s_stick = np.full(n, np.nan) if self.mu > 0 and not self.sticky else state.s_stick
         after = ContactState(self.nodes, x.copy(), s_stick, state.stuck, state.stuck_point, state.first_contact,
                              seen, state.damping_work)
-        pole_rate = np.zeros((self.pole_edge.size, k, 2, 2)) if self.pole_edge.size else None
-        return ContactTrial(zero, np.zeros((n, 2, 2)), np.zeros((m, 2 * k, 2 * k)), pole_rate, after)
+        return ContactTrial(zero, None, None, None, after)
 
     def _damping(self, x: np.ndarray, state: ContactState, proj):
         """The stabilization's traction per unit of w (n, 2), its derivative d/dx (n, 2, 2)
@@ -314,7 +312,7 @@ class ContactPair:
         Returns per edge over `guard_dofs` the force on the body F (m, 2 dpn), its derivative
         K = dF/du (m, 2 dpn, 2 dpn), the rate K_x velocity (m, 2 dpn) of a surface moving
         with velocity (2,) (the force depends on x_m - offset(lam)), and the force on each
-        mid-point (m, 2)."""
+        mid-point (m, 2); F, K and the rate are None where no guard acts."""
         e = self.edges
         dpn = u.shape[1]
         un = u[self.nodes]
@@ -331,7 +329,7 @@ class ContactPair:
         m = len(e)
         g = proj.g + self.guard_allowance
         if not (proj.active & (g < 0.0)).any():  # no mid-point behind its allowance: no force
-            return np.zeros((m, 2 * dpn)), np.zeros((m, 2 * dpn, 2 * dpn)), np.zeros((m, 2 * dpn)), np.zeros((m, 2))
+            return None, None, None, np.zeros((m, 2))
         fn, dfn = _normal_law(g, proj.active, self.guard_kn, self.smoothing)
         w = self.guard_weight
         force = (w * fn)[:, None] * proj.n  # on the mid-point (m, 2)
@@ -354,6 +352,8 @@ class ContactPair:
         """d f / d lambda at fixed u of the evaluation `trial` divided by -1, per slave node
         (n, 2), for a surface moving with `velocity` (2,): the forces depend on the positions
         relative to the surface, x - offset(lambda)."""
+        if trial.K is None:  # an idle pair
+            return np.zeros((len(self.nodes), 2))
         out = trial.K @ velocity
         if trial.pole_rate is not None:
             q = np.arange(self.pole_edge.size)

@@ -65,11 +65,12 @@ class ContactState:
 class ContactTrial:
     """One evaluation of a pair: its forces on the slave nodes f (n, 2), their derivative K
     (n, 2, 2) with respect to the positions relative to the surface, the coupling through the
-    current ring areas (m, 2k, 2k), the poles' rate blocks (or None), and the state the pair
-    would have if this evaluation were accepted (`state`)."""
+    current ring areas (m, 2k, 2k) (both None for a pair that touches nowhere), the poles'
+    rate blocks (or None), and the state the pair would have if this evaluation were
+    accepted (`state`)."""
 
     f: np.ndarray
-    K: np.ndarray
-    coupling: np.ndarray
+    K: np.ndarray | None
+    coupling: np.ndarray | None
     pole_rate: np.ndarray | None
     state: ContactState

@@ -426,7 +426,12 @@ class Polyline(RigidSurface):
         gap_rank = np.where(crossed | ~inrange, 0.0, g)
         # per node the largest score, then among those the largest gap_rank, then the last such
         # pair: the last pair of each node in a stable sort by (node, score, gap_rank)
-        if len(i) <= ARC_SUBSET:
+        single = np.empty(len(i), bool)  # whether each pair is the only one of its node
+        np.not_equal(i[1:], i[:-1], out=single[1:])
+        single[0] = True
+        if single.all():  # one pair per node (the common case): nothing to choose
+            best = np.arange(len(i))
+        elif len(i) <= ARC_SUBSET:
             order = np.lexsort((gap_rank, score, i))
             io = i[order]
             last = np.empty(len(io), bool)

@@ -428,7 +428,8 @@ class Model:
             data = None
             for term, part in parts:
                 for pos, Ke in zip(self._positions[id(term)], part.K):
-                    data = self.pattern.accumulate(pos, Ke, data)
+                    if Ke is not None:
+                        data = self.pattern.accumulate(pos, Ke, data)
             K = self.pattern.free_block(data)
             if dm.np and dpresc.any():
                 dr_dt = dr_dt + self.pattern.fp_product(data, dpresc)

@@ -32,7 +32,7 @@ from .state import CavityState
 class Contribution:
     """One term at one state: its part r (n_full,) of the residual R, of dR/dt at fixed u
     (n_full,) or None, of the tangent dR/du as element matrices K (one (m, k, k) array per
-    block of the term, empty when not asked), the applied external load it holds (n_full,)
+    block of the term, or None for a block that adds nothing; empty when not asked), the applied external load it holds (n_full,)
     or None, the assembled magnitudes of its element forces (n_full,) or None (the scale
     of the residual), and its trial state."""
 
@@ -175,10 +175,10 @@ class ContactTerm:
         u_nodes = u.reshape(-1, self.dpn)
         n = self.n_full
         dr = None
-        guard_force, guard_K = None, ()
+        fg, guard_force, guard_K = None, None, ()
         if pair.guarded:  # the mid-points of straight edges (ContactPair.guard)
             fg, Kg, rate, guard_force = pair.guard(u_nodes, t, velocity, state)
-            guard_K = (-Kg,)
+            guard_K = (None if Kg is None else -Kg,)
         trial = pair.evaluate(u_nodes[:, :2], t, state, predicting, guard_force)
         # the slave nodes' dofs are distinct: their forces are placed, not summed
         r = np.zeros(n)
@@ -186,11 +186,11 @@ class ContactTerm:
         if moving:
             dr = np.zeros(n)
             dr[self.node_dofs.ravel()] = pair.rate(trial, velocity).ravel()
-        if pair.guarded:  # edges share nodes: summed (np.bincount, not the slower np.add.at)
+        if fg is not None:  # edges share nodes: summed (np.bincount, not the slower np.add.at)
             r -= np.bincount(self.guard_dofs.ravel(), fg.ravel(), n)
             if moving:
                 dr += np.bincount(self.guard_dofs.ravel(), rate.ravel(), n)
-        K = (-trial.K, -trial.coupling) + guard_K if tangent else ()
+        K = tuple(None if Ke is None else -Ke for Ke in (trial.K, trial.coupling)) + guard_K if tangent else ()
         return Contribution(r, dr, K, trial=trial.state)
 
 
