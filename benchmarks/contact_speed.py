@@ -17,8 +17,16 @@ Sections (each can be run alone with --only):
             the case files; before and after in turn, `--repeat` times; min and median.
 * profile   cProfile of the cup example in each tree: cumulative time of the contact
             functions and of the solid's evaluation.
+* share     the share of contact in the solver's time: wall time inside the contact terms'
+            evaluations (and nothing else of contact runs outside them) against the time
+            inside the load path's steps (every evaluation, factorization, solve and
+            predictor), over whole runs of the cup (its mesh, 2 and 4 times finer), the die
+            drawing, the bottle and the stretch blow moulding, plots off.
 
-Run:    python benchmarks/contact_speed.py --before /work/main/src [--after src] [--repeat 3]
+`--examples DIR` takes the three process examples (and the share's cases) from DIR: the case
+files of an older tree, which it can run, against which the whole process is measured.
+
+Run:    python benchmarks/contact_speed.py --before OLD/src [--after src] [--repeat 3] [--examples DIR]
 Writes: benchmarks/results/contact_speed.md
 """
 
@@ -144,6 +152,37 @@ print("PROFILE " + json.dumps(res))
 '''
 
 
+SHARE_CHILD = r'''
+import json, sys, time
+from axiform.model import terms
+from axiform.solve import paths
+acc = {"contact": 0.0, "solve": 0.0}
+def timed(f, key):
+    def wrapper(*a, **k):
+        t = time.perf_counter()
+        try:
+            return f(*a, **k)
+        finally:
+            acc[key] += time.perf_counter() - t
+    return wrapper
+terms.ContactTerm.evaluate = timed(terms.ContactTerm.evaluate, "contact")
+for cls in (paths.LoadPath, paths.DisplacementPath):
+    for name in ("attempt", "accept"):
+        setattr(cls, name, timed(getattr(cls, name), "solve"))
+from axiform.cli import main
+case, out, sets = sys.argv[1], sys.argv[2], json.loads(sys.argv[3])
+main(["run", case, "--out", out, "-q", "--set", "output.plots=false"] + [a for v in sets for a in ("--set", v)])
+print("SHARE " + json.dumps(acc))
+'''
+# the share's cases: (example, --set overrides, label)
+SHARE_CASES = (("cup_thermoforming", [], "cup (100 x 2, 101 slaves a tool)"),
+               ("cup_thermoforming", ["mesh.divisions=[200,2]"], "cup 200 x 2"),
+               ("cup_thermoforming", ["mesh.divisions=[400,4]"], "cup 400 x 4"),
+               ("die_drawing", [], "die drawing"),
+               ("bottle_blow_moulding", [], "bottle"),
+               ("stretch_blow_moulding", [], "stretch blow moulding"))
+
+
 def env_for(src: Path) -> dict:
     env = dict(os.environ, PYTHONPATH=str(src))
     env.pop("PYTHONDONTWRITEBYTECODE", None)
@@ -185,7 +224,30 @@ def section_scaling(trees: dict[str, Path], repeat: int, tmp: Path) -> str:
                      f"new step {names[0]}", f"new step {names[1]}", "speed-up", "max |diff|"], rows))
 
 
-def section_process(trees: dict[str, Path], repeat: int, tmp: Path) -> str:
+def section_share(trees: dict[str, Path], repeat: int, tmp: Path, examples: Path) -> str:
+    got: dict[tuple[str, str], list[dict]] = {}
+    for _ in range(repeat):
+        for example, sets, label in SHARE_CASES:
+            for name, src in trees.items():
+                proc = subprocess.run([sys.executable, "-c", SHARE_CHILD, str(examples / f"{example}.toml"),
+                                       str(tmp / f"share_{name}"), json.dumps(sets)], env=env_for(src),
+                                      capture_output=True, text=True, cwd=ROOT, check=True)
+                line = next(s for s in proc.stdout.splitlines() if s.startswith("SHARE "))
+                got.setdefault((label, name), []).append(json.loads(line[len("SHARE "):]))
+    names = list(trees)
+    rows = []
+    for _, _, label in SHARE_CASES:
+        row = [label]
+        for n in names:
+            best = min(got[(label, n)], key=lambda a: a["solve"])
+            row.append(f"{best['contact']:.2f} / {best['solve']:.2f} s = {best['contact'] / best['solve']:.0%}")
+        rows.append(row)
+    return ("### The share of contact in the solver's time\n\n"
+            f"Contact evaluations / the load path's steps, wall time, the run with the shortest solve of {repeat}, "
+            "plots off, the trees in turn.\n\n" + table(["case"] + names, rows))
+
+
+def section_process(trees: dict[str, Path], repeat: int, tmp: Path, examples: Path) -> str:
     times: dict[tuple[str, str], list[float]] = {}
     steps = {}
     for r in range(repeat):
@@ -193,7 +255,7 @@ def section_process(trees: dict[str, Path], repeat: int, tmp: Path) -> str:
             for name, src in trees.items():
                 out = tmp / f"{ex}_{name}"
                 t = time.perf_counter()
-                proc = subprocess.run([sys.executable, "-m", "axiform.cli", "run", str(ROOT / "examples" / f"{ex}.toml"),
+                proc = subprocess.run([sys.executable, "-m", "axiform.cli", "run", str(examples / f"{ex}.toml"),
                                        "--out", str(out), "-q"], env=env_for(src), capture_output=True, text=True,
                                       cwd=ROOT)
                 wall = time.perf_counter() - t
@@ -212,7 +274,7 @@ def section_process(trees: dict[str, Path], repeat: int, tmp: Path) -> str:
         row.append(f"{statistics.median(times[(ex, names[0])]) / statistics.median(times[(ex, names[1])]):.2f}")
         rows.append(row)
     return ("### Whole process, the three process examples\n\n"
-            f"`axiform run examples/NAME.toml --out DIR -q` (outputs as in the case files, plots included), "
+            f"`axiform run {examples}/NAME.toml --out DIR -q` (outputs as in the case files, plots included), "
             f"wall time min / median of {repeat} runs, the trees in turn.\n\n"
             + table(["example", "steps, iterations", names[0], names[1], "speed-up (median)"], rows))
 
@@ -238,10 +300,13 @@ def main() -> None:
     ap.add_argument("--before", type=Path, required=True, help="src/ of the tree before (e.g. the branch point)")
     ap.add_argument("--after", type=Path, default=ROOT / "src", help="src/ of the tree after (default: this tree)")
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--only", choices=["scaling", "process", "profile"], action="append")
+    ap.add_argument("--only", choices=["scaling", "process", "profile", "share"], action="append")
+    ap.add_argument("--examples", type=Path, default=ROOT / "examples",
+                    help="the folder of the case files run by 'process' and 'share' (default: this tree's)")
     args = ap.parse_args()
     trees = {"before": args.before.resolve(), "after": args.after.resolve()}
-    only = args.only or ["scaling", "process", "profile"]
+    only = args.only or ["scaling", "process", "profile", "share"]
+    examples = args.examples.resolve()
     parts = [f"## Contact speed, before / after ({datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC)\n",
              f"Machine: {machine()}; load average at the start {load_average()}.\n",
              f"before: `{trees['before']}`, after: `{trees['after']}`.\n"]
@@ -250,13 +315,15 @@ def main() -> None:
         if "scaling" in only:
             parts.append(section_scaling(trees, args.repeat, tmp))
         if "process" in only:
-            parts.append(section_process(trees, args.repeat, tmp))
+            parts.append(section_process(trees, args.repeat, tmp, examples))
+        if "share" in only:
+            parts.append(section_share(trees, args.repeat, tmp, examples))
         if "profile" in only:
             parts.append(section_profile(trees, tmp))
     parts.append(f"Load average at the end: {load_average()}.\n")
     text = "\n".join(parts)
     RESULTS.mkdir(exist_ok=True)
-    name = "contact_speed" + ("" if len(only) == 3 else "_" + "_".join(only))
+    name = "contact_speed" + ("" if len(only) == 4 else "_" + "_".join(only))
     (RESULTS / f"{name}.md").write_text(text)
     print(text)
 
