@@ -207,7 +207,7 @@ class Polyline(RigidSurface):
                                      np.where(arc & (self.sweep > 0), self.sweep, 1.0), self.dir,
                                      -self.tan_a[:, 1], self.tan_a[:, 0]])
         self._pair_cache = search.PairCache()  # `_candidates`: the pairs of a step reused
-        self._previous_table = None  # `_previous`: x_prev against every piece, for a step's iterations
+        self._previous_held = None  # `_previous`: the last converged positions' projections, for the next call
         self._cavity = np.zeros(m, bool)
         self._vertex_n = np.zeros((m, 2))
         for k in range(1, m):
@@ -318,17 +318,13 @@ class Polyline(RigidSurface):
 
     def _previous(self, x_prev: np.ndarray, i: np.ndarray, k: np.ndarray):
         """xi and g of the last converged positions x_prev (n, 2) on the pairs (node i, piece
-        k), from `_project`.  For few pairs in all (n M <= DENSE_PAIRS) out of a table of every
-        node against every piece, built once for an x_prev: the iterations of a step share it."""
-        M = len(self.a)
-        if len(x_prev) * M > DENSE_PAIRS:
-            return self._project(k, x_prev[i], full=False)
-        held = self._previous_table
-        if held is None or held[0].shape != x_prev.shape or not np.array_equal(held[0], x_prev):
-            xi0, g0 = self._project(np.tile(np.arange(M), len(x_prev)), np.repeat(x_prev, M, axis=0), full=False)
-            held = self._previous_table = (x_prev.copy(), xi0, g0)
-        flat = i * M + k
-        return held[1][flat], held[2][flat]
+        k), from `_project`; kept for the next call, which the iterations of a step make with
+        the same x_prev and, mostly, the same pairs."""
+        held = self._previous_held
+        if (held is None or len(held[1]) != len(i) or held[0].shape != x_prev.shape or not np.array_equal(held[1], i)
+                or not np.array_equal(held[2], k) or not np.array_equal(held[0], x_prev)):
+            held = self._previous_held = (x_prev.copy(), i, k) + self._project(k, x_prev[i], full=False)
+        return held[3], held[4]
 
     def _dense_candidates(self, x: np.ndarray, widen):
         """The (node, piece) pairs, sorted by node then piece, of the nodes x (n, 2) inside the
