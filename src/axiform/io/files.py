@@ -1,5 +1,6 @@
 """Files of a results folder written whole or not at all: an atomic replace, a VTU file of the
-mesh with point data, the ParaView series of the VTU files, the mould outlines as CSV text."""
+mesh with point data, the ParaView series of the VTU files, the mould outlines and the contact
+table as CSV text."""
 
 from __future__ import annotations
 
@@ -74,3 +75,23 @@ def mould_outlines(pairs, lam: float) -> str:
         pts = pair.surface.polyline() + pair.surface.offset(lam)
         table.writerows([k, f"{r:.10g}", f"{z:.10g}"] for r, z in pts)
     return text.getvalue()
+
+
+CONTACT_COLUMNS = ("pair", "node", "r", "z", "gap", "pressure", "status", "first_contact")
+
+
+def contact_table(reports: list[dict], x: np.ndarray, status_names: dict[int, str]) -> str:
+    """contact.csv as text: a row per slave node of every pair's report (ContactPair.report:
+    node, gap, pressure, status, first_contact, each (m,)) at the current nodes x (n, 2); gap
+    and first_contact empty where NaN.  Formatted column by column (no cell needs quotes)."""
+    lines = [",".join(CONTACT_COLUMNS)]
+    for k, rep in enumerate(reports):
+        node = np.asarray(rep["node"], dtype=np.int64)
+        r, z = x[node, 0].tolist(), x[node, 1].tolist()
+        gap = ["" if g != g else f"{g:.6g}" for g in np.asarray(rep["gap"], float).tolist()]
+        pressure = [f"{p:.6g}" for p in np.asarray(rep["pressure"], float).tolist()]
+        status = [status_names[s] for s in np.asarray(rep["status"]).astype(int).tolist()]
+        first = ["" if t != t else repr(t) for t in np.asarray(rep["first_contact"], float).tolist()]
+        lines += [f"{k},{n},{a:.10g},{b:.10g},{g},{p},{s},{t}"
+                  for n, a, b, g, p, s, t in zip(node.tolist(), r, z, gap, pressure, status, first)]
+    return "\n".join(lines) + "\n"

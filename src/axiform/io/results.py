@@ -30,7 +30,7 @@ from . import gid
 from ..post.fields import point_fields, with_components
 from ..post.results_folder import HISTORY_COLUMNS
 from ..post.thickness import thickness_table, write_thickness_csv
-from .files import atomic, mould_outlines, write_atomic, write_pvd, write_vtu
+from .files import atomic, contact_table, mould_outlines, write_atomic, write_pvd, write_vtu
 from .run_report import RunRecord, column_units, thickness_summary
 
 
@@ -116,7 +116,7 @@ class ResultsWriter:
         with restart_meta beside it.  resume: the checkpoint a resumed run starts from: the
         folder's rows and files up to its step are kept, later ones dropped.  plots: draw the
         PNG plots at the end (plots.plot_folder, in this process).  flush_every_s: history.csv, summary.json,
-        thickness.csv and fields.pvd are rewritten after a step when that long has passed
+        thickness.csv, fields.pvd, contact.csv and surfaces.csv are rewritten after a step when that long has passed
         since they last were (0: after every step), before every checkpoint and by `finish`,
         whatever ended the run: a run that never reaches `finish` (kill -9) loses at most
         that long of rows.  warnings: the pre-run warnings (one line each) for summary.json's
@@ -133,6 +133,7 @@ class ResultsWriter:
         self.flush_every_s = flush_every_s
         self._flushed = -np.inf  # time of the last flush: the first step is written at once
         self._thickness = None  # the table of the last field step, not yet in thickness.csv
+        self._contact = None  # the reports, nodes and load factor of the last step, not yet in contact.csv
         self._pvd_written = 0  # entries of self._pvd in fields.pvd
         self.thickness_every = thickness_every
         self.t0 = time.perf_counter()
@@ -218,11 +219,12 @@ class ResultsWriter:
                 raise NonFiniteResult(f"step {step.number}: monitor {name} is {v}: not written")
 
     def _flush(self) -> None:
-        """Rewrite history.csv, thickness.csv and fields.pvd if they changed, then
-        summary.json (whose `steps` the others then hold).  The VTU files submitted are
-        written first: fields.pvd lists written files only."""
+        """Rewrite history.csv, contact.csv, surfaces.csv, thickness.csv and fields.pvd if
+        they changed, then summary.json (whose `steps` the others then hold).  The VTU files
+        submitted are written first: fields.pvd lists written files only."""
         self._wait_for_vtu()
         write_atomic(self.out / "history.csv", self._history.getvalue())
+        self._write_contact()
         if self._thickness is not None:
             with atomic(self.out / "thickness.csv") as tmp:
                 write_thickness_csv(tmp, self._thickness)
@@ -244,7 +246,7 @@ class ResultsWriter:
         self._csv.writerow([step.number, repr(float(step.lam)), repr(float(step.lam)), step.iterations]
                            + [repr(v) for v in values.values()])
         if self.model.contacts:
-            self._write_contact(step)
+            self._record_contact(step)
         self.steps = step.number
         self.newton_iterations += step.iterations
         self.summary.update(steps=self.steps, newton_iterations=self.newton_iterations,
@@ -266,32 +268,32 @@ class ResultsWriter:
             self._flush()
         return values
 
-    def _write_contact(self, step):
-        """contact.csv: every slave node of every pair at this step (gap left empty where the
-        node sees no surface); the totals, and the run's largest force and penetration against
-        the wall (RunRecord), in the summary."""
-        from ..contact.pair import STATUS
-
-        text = io.StringIO()
-        table = csv.writer(text, lineterminator="\n")
-        table.writerow(["pair", "node", "r", "z", "gap", "pressure", "status", "first_contact"])  # header first
+    def _record_contact(self, step):
+        """The contact pairs at this step: the totals, and the run's largest force and
+        penetration against the wall (RunRecord), in the summary; contact.csv (every slave
+        node of every pair, gap left empty where the node sees no surface) and surfaces.csv
+        are written by the next `_flush`."""
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
         x = self.model.mesh.points + u
         reports = [pair.report(held) for pair, held in zip(self.model.contacts, step.state.contacts)]
-        for k, rep in enumerate(reports):
-            for node, g, p, st, t in zip(rep["node"], rep["gap"], rep["pressure"], rep["status"], rep["first_contact"]):
-                r, z = x[node]
-                gap = "" if np.isnan(g) else f"{g:.6g}"
-                first = "" if np.isnan(t) else repr(float(t))
-                table.writerow([k, node, f"{r:.10g}", f"{z:.10g}", gap, f"{p:.6g}", STATUS[int(st)], first])
-        write_atomic(self.out / "contact.csv", text.getvalue())
-        write_atomic(self.out / "surfaces.csv", mould_outlines(self.model.contacts, float(step.lam)))
+        self._contact = (reports, x, float(step.lam))
         self.record.contact_step(step, reports, x, thickness_table(self.model.mesh, u) if self.model.mesh.fibres
                                  is not None else None)
         self.summary["contact"] = [{"name": rec.name} | {q: rep[q] for q in ("force_r", "force_z", "contact_area",
                                                                            "penetration")}
                                    | rec.summary() | {"touched": rec.touched}
                                    for rec, rep in zip(self.record.pairs, reports)]
+
+    def _write_contact(self) -> None:
+        """contact.csv and surfaces.csv of the last recorded step, if not yet written."""
+        from ..contact.pair import STATUS
+
+        if self._contact is None:
+            return
+        reports, x, lam = self._contact
+        write_atomic(self.out / "contact.csv", contact_table(reports, x, STATUS))
+        write_atomic(self.out / "surfaces.csv", mould_outlines(self.model.contacts, lam))
+        self._contact = None
 
     def _write_fields(self, step):
         """Field output of one step: VTU (+ .pvd), GiD results, thickness.csv."""
