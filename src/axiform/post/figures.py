@@ -32,10 +32,17 @@ def save(fig, path: str | Path, dpi: float = DPI, **savefig: Any) -> Path | None
     0.37 s instead of 0.40 s, the files 13 % larger (benchmarks/README.md § 3.9).  The
     figure holds no global state: it is freed with its last reference.  Written whole to a
     temporary name beside `path`, then renamed over it: a reader sees the old picture or the
-    new one, never a part."""
+    new one, never a part.  A figure's layout (constrained) is done here at `dpi`, then the
+    engine taken off: savefig would otherwise draw the whole figure once, unseen, to lay it
+    out before it draws it (the same pixels; the cup's three pictures 0.77 s instead of 0.88)."""
     if fig is None:
         return None
     path = Path(path)
+    engine = fig.get_layout_engine()
+    if engine is not None and "bbox_inches" not in savefig:
+        fig.set_dpi(dpi)
+        engine.execute(fig)
+        fig.set_layout_engine(None)
     savefig.setdefault("format", path.suffix.lstrip(".").lower() or "png")
     if savefig["format"].lower() == "png":
         savefig.setdefault("pil_kwargs", {"compress_level": 1})
