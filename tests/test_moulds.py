@@ -3,6 +3,7 @@ the penalty on the current area, the time of first contact, DXF moulds, moulds o
 pieces."""
 
 import csv
+import os
 import re
 from pathlib import Path
 
@@ -21,7 +22,7 @@ from axiform import (
     solve,
 )
 from axiform.cli import main
-from axiform.contact.dxf import DxfError, read_dxf
+from axiform.contact.dxf import DxfError, close_pairs, read_dxf
 from axiform.contact.pair import ContactPair, ring_areas, slave_edges
 from axiform.contact.surfaces import Polyline
 from axiform.solve.solver import ArcLengthControl
@@ -231,6 +232,37 @@ def test_example_drawing_is_what_its_script_writes(tmp_path):
         a, b = read_dxf(target, layer), read_dxf(EXAMPLES / "cup_mould.dxf", layer)
         assert np.array_equal(a.points, b.points) and np.array_equal(a.is_arc, b.is_arc)
     _check_cup(read_dxf(EXAMPLES / "cup_mould.dxf", "MOULD"))
+
+
+def test_a_drawing_is_parsed_once_per_version_of_its_file(tmp_path, monkeypatch):
+    """Two layers of one file: one parse; the file rewritten (a new time): parsed again."""
+    calls = []
+    readfile = ezdxf.readfile
+    monkeypatch.setattr(ezdxf, "readfile", lambda path: calls.append(path) or readfile(path))
+    doc = ezdxf.new()
+    _cup(doc.modelspace())
+    doc.modelspace().add_line((0.0, 5.0), (9.0, 5.0), dxfattribs={"layer": "PLUG"})
+    doc.saveas(tmp_path / "m.dxf")
+    _check_cup(read_dxf(tmp_path / "m.dxf", "MOULD"))
+    assert np.array_equal(read_dxf(tmp_path / "m.dxf", "PLUG").points, [[0.0, 5.0], [9.0, 5.0]])
+    assert len(calls) == 1
+    doc.modelspace().query('LINE[layer=="PLUG"]')[0].dxf.end = (7.0, 5.0)
+    doc.saveas(tmp_path / "m.dxf")
+    held = (tmp_path / "m.dxf").stat()
+    os.utime(tmp_path / "m.dxf", ns=(held.st_atime_ns, held.st_mtime_ns + 1))
+    assert np.array_equal(read_dxf(tmp_path / "m.dxf", "PLUG").points, [[0.0, 5.0], [7.0, 5.0]])
+    assert len(calls) == 2
+
+
+def test_close_pairs_are_those_of_all_pairs():
+    """Points on a grid of 0.01 (equal x, repeated points, distances 0.01 and 0.0141 in
+    and 0.02 out of 0.015) against all pairs compared."""
+    points = np.round(np.random.default_rng(3).uniform(0.0, 0.3, (400, 2)), 2)
+    tol = 0.015
+    near = np.hypot(*(points[:, None] - points[None]).transpose(2, 0, 1)) <= tol
+    expected = np.column_stack(np.nonzero(np.triu(near, 1)))
+    assert len(expected) > 400 and np.array_equal(close_pairs(points, tol), expected)
+    assert close_pairs(points[:1], tol).shape == close_pairs(points[:0], tol).shape == (0, 2)
 
 
 def _bad_drawings(tmp_path):

@@ -10,11 +10,13 @@ the body lies to its left, as for polylines (`reverse` flips it).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 import scipy.sparse as sp
 
+from ..fem.graphs import connected_components
 from .surfaces import Polyline
 
 
@@ -145,7 +147,8 @@ def _read_dxf(path: Path, layer: str | None, reverse: bool, tolerance: float | N
     import ezdxf
 
     try:
-        doc = ezdxf.readfile(path)
+        held = path.resolve().stat()
+        doc = _drawing(path.resolve(), held.st_ino, held.st_mtime_ns, held.st_size)
     except (OSError, ezdxf.DXFError, UnicodeDecodeError, ValueError) as exc:
         raise DxfError(f"cannot read {path} as a DXF drawing ({exc})") from None
     msp = doc.modelspace()
@@ -177,6 +180,15 @@ def _read_dxf(path: Path, layer: str | None, reverse: bool, tolerance: float | N
     return _chain(pieces, tol, reverse, motion)
 
 
+@lru_cache(maxsize=8)
+def _drawing(path: Path, inode: int, mtime_ns: int, size: int):
+    """The DXF document of a file, parsed once per file version (its inode, time and size):
+    the [[contact]] tables that take layers of one drawing share it (read only)."""
+    import ezdxf
+
+    return ezdxf.readfile(path)
+
+
 def _extent_points(entity):
     """A few points of the entity, for the drawing's size."""
     kind = entity.dxftype()
@@ -191,14 +203,28 @@ def _extent_points(entity):
     return []
 
 
+def close_pairs(points: np.ndarray, tol: float) -> np.ndarray:
+    """(p, 2) the pairs i < j of the points (m, 2) at most tol apart, in increasing order:
+    the points sorted by x, each compared with the next ones until x is more than tol
+    further (in NumPy: a KD-tree's import costs more than this search on a drawing)."""
+    order = np.argsort(points[:, 0], kind="stable")
+    x = points[order]
+    found = []
+    for k in range(1, len(x)):
+        near = np.flatnonzero(x[k:, 0] - x[:-k, 0] <= tol)
+        if not near.size:
+            break
+        hit = near[np.hypot(*(x[near + k] - x[near]).T) <= tol]
+        found.append(np.column_stack([order[hit], order[hit + k]]))
+    pairs = np.sort(np.concatenate(found or [np.zeros((0, 2), np.int64)]).astype(np.int64), axis=1)
+    return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
+
+
 def _chain(pieces: list[Piece], tol: float, reverse: bool, motion) -> Polyline:
     """Join the pieces end to end into one path (see read_dxf)."""
-    from scipy.sparse.csgraph import connected_components  # imported when needed (0.3 s with cKDTree)
-    from scipy.spatial import cKDTree
-
     n = len(pieces)
     ends = np.array([[p.a, p.b] for p in pieces]).reshape(-1, 2)  # end 2k: start of k, 2k+1: its end
-    pairs = np.array(sorted(cKDTree(ends).query_pairs(tol)), dtype=np.int64).reshape(-1, 2)
+    pairs = close_pairs(ends, tol)
     graph = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(2 * n, 2 * n))
     _, node = connected_components(graph, directed=False)  # a joint of the path per end
     count = np.bincount(node)
