@@ -444,7 +444,7 @@ class Polyline(RigidSurface):
         out.s[bi] = self.s0[bk] + np.minimum(np.maximum(xi[best], 0.0), 1.0) * self.L[bk]
         out.s_prev[bi] = self.s0[bk] + np.minimum(np.maximum(xi0[best], 0.0), 1.0) * self.L[bk]
         out.kind[bi] = np.where(crossed[best], 3, 1)
-        if len(self.a) > 1 and len(bi) < nn:
+        if self._cavity.any() and len(bi) < nn:  # a node without a point, and a corner to find it
             self._cavity_corners(out, x, i, k, g, xi, depth, tol)
         return out
 
