@@ -241,8 +241,13 @@ class ContactPair:
         tied, no stabilization."""
         if self.stabilization or state.stuck.any():
             return False
-        below = self.smoothing if predicting and self.mu == 0 and not self.sticky else 0.0
+        below = self.smoothing if self._holds_resting(predicting) else 0.0
         return not (proj.active & (proj.g < below)).any()
+
+    def _holds_resting(self, predicting: bool) -> bool:
+        """Whether the tangent holds the nodes resting on the surface (see the class): in a
+        step's first iteration, frictionless and not sticky pairs only."""
+        return predicting and self.mu == 0 and not self.sticky
 
     def _untouching(self, xa: np.ndarray, x: np.ndarray, proj, state: ContactState,
                     guard_force: np.ndarray) -> ContactTrial:
@@ -379,7 +384,7 @@ class ContactPair:
         fn, dfn = _normal_law(g, contact, kn, d)
         nv, tv = proj.n, proj.t
         nn, tt = outer(nv, nv), outer(tv, tv)
-        if predicting and self.mu == 0 and not self.sticky:
+        if self._holds_resting(predicting):
             # nodes resting on the surface (0 <= g < d) get the penalty in the tangent only
             resting = proj.active & (g >= 0.0) & (g < d) & ~stuck
             K -= (resting * kn)[:, None, None] * nn

@@ -78,23 +78,25 @@ class RigidSurface:
 
     motion: tuple[float, float] = (0.0, 0.0)
     curve: Curve = PROPORTIONAL
+    # the last offset and velocity asked for, by name: (t, curve, motion, value (2,))
+    _held: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def offset(self, t: float) -> np.ndarray:
-        """The translation at time t (2,) (read-only: the last one is kept for the next call)."""
-        held = self.__dict__.get("_offset")
-        if held is None or held[0] != t or held[1] is not self.curve or held[2] is not self.motion:
-            value = self.curve(t) * np.asarray(self.motion, float)
-            value.flags.writeable = False
-            held = self.__dict__["_offset"] = (t, self.curve, self.motion, value)
-        return held[3]
+        """The translation at time t (2,) (read-only: kept for the next call at the same t)."""
+        return self._kept("offset", t, self.curve)
 
     def velocity(self, t: float) -> np.ndarray:
-        """d offset / dt (2,) (read-only: the last one is kept for the next call)."""
-        held = self.__dict__.get("_velocity")
+        """d offset / dt (2,) (read-only: kept for the next call at the same t)."""
+        return self._kept("velocity", t, self.curve.slope)
+
+    def _kept(self, name: str, t: float, factor) -> np.ndarray:
+        """motion * factor(t), from the last call of `name` where t, the curve and the motion
+        are the same (every evaluation of a pair asks for them twice or more at one t)."""
+        held = self._held.get(name)
         if held is None or held[0] != t or held[1] is not self.curve or held[2] is not self.motion:
-            value = self.curve.slope(t) * np.asarray(self.motion, float)
+            value = factor(t) * np.asarray(self.motion, float)
             value.flags.writeable = False
-            held = self.__dict__["_velocity"] = (t, self.curve, self.motion, value)
+            held = self._held[name] = (t, self.curve, self.motion, value)
         return held[3]
 
     def local_sets(self, sets: list, method: str = "buckets") -> list[Projection]:
