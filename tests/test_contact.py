@@ -331,3 +331,30 @@ def test_the_nodes_projected_with_the_guards_are_the_nodes_projected_alone(eleme
         for name in ("f", "K", "coupling"):
             assert np.array_equal(getattr(trial, name), getattr(alone, name)), name
         assert np.array_equal(trial.state.seen.proj.g, alone.state.seen.proj.g)
+
+
+@pytest.mark.parametrize("law", [{}, {"friction": 0.3}, {"sticky": True}], ids=["frictionless", "friction", "sticky"])
+@pytest.mark.parametrize("predicting", [False, True])
+def test_an_idle_pair_gives_what_its_law_gives(element, law, predicting):
+    """A pair whose nodes are all in front of the surface (some in its search range) skips its
+    law (`ContactPair._idle`): no force, no tangent blocks, and the very trial state the law
+    would give (stick points released, the same positions, areas and projections)."""
+    surface = Polyline(points=[[0.0, -0.05], [2.0, -0.02]])  # 0.02 to 0.05 below the slave face
+    model, pair = _contact_model(element, surface, depth=0.5, **law)
+    history = pair.initial_state()
+    u = np.zeros((model.mesh.n_nodes, 2))
+    if not pair.sticky:  # a step that pressed the nodes in: stick points to release
+        u[:, 1] = -0.1
+        history = pair.evaluate(u, 0.3, history).state
+        assert (history.seen.status > 0).any() and (pair.mu == 0 or not np.isnan(history.s_stick).all())
+    u[:, 1] = 0.01  # away from the surface: every slave node in range, none behind
+    idle = pair.evaluate(u, 0.5, history, predicting)
+    assert idle.K is None and idle.coupling is None and not idle.f.any()
+    assert idle.state.seen.proj.active.all() and (idle.state.seen.proj.g > 0).all()
+    pair._idle = lambda *args: False  # the law itself, on the same state
+    full = pair.evaluate(u, 0.5, history, predicting)
+    assert not full.f.any() and not full.K.any() and not full.coupling.any()
+    for name in ("x_prev", "s_stick", "stuck", "stuck_point", "first_contact", "damping_work"):
+        assert np.array_equal(getattr(idle.state, name), getattr(full.state, name), equal_nan=True), name
+    for name in ("x", "a", "status", "f", "traction"):
+        assert np.array_equal(getattr(idle.state.seen, name), getattr(full.state.seen, name)), name
