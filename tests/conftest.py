@@ -3,6 +3,37 @@ import pytest
 
 from axiform import rectangle
 
+# a bar of a Prony-series law (axisymmetric: r from the axis to 1), stretched by 0.3 in
+# 1 ms and held to t = 1 s: the relaxation tests' case file (test_viscoelastic,
+# test_process_time)
+RELAXING_BAR = """
+[mesh]
+kind = "rectangle"
+r = [0.0, 1.0]
+z = [0.0, 1.0]
+divisions = [2, 2]
+element = "q4"
+[material]
+model = "neo-hooke"
+C1 = 0.5
+kappa = 1.0e4
+viscoelastic = { g = [0.4, 0.3], tau = [0.05, 0.5] }
+[[fix]]
+at = { r = 0.0 }
+dofs = ["ur"]
+[[fix]]
+at = { z = 0.0 }
+dofs = ["uz"]
+[[fix]]
+at = { z = 1.0 }
+dofs = ["uz"]
+value = 0.3
+curve = [[0.0, 0.0], [0.001, 1.0], [1.0, 1.0]]
+[solver]
+target = 1.0
+steps = 10
+"""
+
 
 def distorted_rectangle(r, z, divisions, element, amount=0.25, seed=0):
     """A rectangle mesh whose interior corner nodes are moved at random by up to `amount`

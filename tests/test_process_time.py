@@ -24,41 +24,16 @@ from axiform.io.files import series_times
 from axiform.post.labels import case_labels
 from axiform.post.load_curve_plot import load_curve_figure
 from axiform.post.results_folder import FolderInfo, read_history
+from conftest import RELAXING_BAR
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 # the bar of test_viscoelastic, stretched in 1 ms and held to t = 1 s, its end force monitored
-BAR = """
-title = "relaxing bar"
-[mesh]
-kind = "rectangle"
-r = [0.0, 1.0]
-z = [0.0, 1.0]
-divisions = [2, 2]
-element = "q4"
-[material]
-model = "neo-hooke"
-C1 = 0.5
-kappa = 1.0e4
-viscoelastic = { g = [0.4, 0.3], tau = [0.05, 0.5] }
-[[fix]]
-at = { r = 0.0 }
-dofs = ["ur"]
-[[fix]]
-at = { z = 0.0 }
-dofs = ["uz"]
-[[fix]]
-at = { z = 1.0 }
-dofs = ["uz"]
-value = 0.3
-curve = [[0.0, 0.0], [0.001, 1.0], [1.0, 1.0]]
+BAR = 'title = "relaxing bar"\n' + RELAXING_BAR.replace("steps = 10", "steps = 8") + """
 [[monitor]]
 name = "force"
 reaction = { z = 1.0 }
 dof = "uz"
-[solver]
-target = 1.0
-steps = 8
 [output]
 every = 3
 [restart]

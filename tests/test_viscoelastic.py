@@ -7,6 +7,7 @@ import pytest
 from axiform import LoadControl, Model, NeoHooke, NewtonOptions, rectangle, select_nodes, solve
 from axiform.fem.curves import Curve
 from axiform.materials.viscoelastic import Prony, Viscoelastic
+from conftest import RELAXING_BAR
 
 PRONY = Prony((0.4, 0.3), (0.05, 0.5))
 RAMP = 1e-6  # the step of strain takes this long (2e-5 of the shortest relaxation time)
@@ -80,33 +81,7 @@ def test_checkpoints_carry_the_history():
         assert np.array_equal(again.solid[key], value)
 
 
-CASE = """
-[mesh]
-kind = "rectangle"
-r = [0.0, 1.0]
-z = [0.0, 1.0]
-divisions = [2, 2]
-element = "q4"
-[material]
-model = "neo-hooke"
-C1 = 0.5
-kappa = 1.0e4
-viscoelastic = { g = [0.4, 0.3], tau = [0.05, 0.5] }
-[[fix]]
-at = { r = 0.0 }
-dofs = ["ur"]
-[[fix]]
-at = { z = 0.0 }
-dofs = ["uz"]
-[[fix]]
-at = { z = 1.0 }
-dofs = ["uz"]
-value = 0.3
-curve = [[0.0, 0.0], [0.001, 1.0], [1.0, 1.0]]
-[solver]
-target = 1.0
-steps = 10
-"""
+CASE = RELAXING_BAR
 
 
 @pytest.mark.parametrize("edit, message", [
