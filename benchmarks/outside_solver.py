@@ -6,12 +6,12 @@ timed from outside (the process's wall time), plots as the case files have them 
         [--out DIR] [EXAMPLE ...]
 
 The two trees run alternately (before, after, before, ...), `--repeat` times each; the table
-gives the least wall time of each, and the solver's share (summary.json's `solve_s` where
-the tree writes it, else blank).  Then every file of the two results folders is compared
-byte for byte, except summary.json (its timings differ; its other keys are compared) and the
-PNG pictures (compared by eye).  The runs write their bytecode caches (PYTHONDONTWRITEBYTECODE
-is dropped from their environment), as an installed axiform has them: without, each run
-compiles axiform's modules again (about 0.09 s).
+gives the least wall time and the least CPU time (user + system of the run and of the
+processes it waited for: a plot worker's included) of each.  Then every file of the two
+results folders is compared byte for byte, except summary.json (its timings differ; its other
+keys are compared) and the PNG pictures (compared by eye).  The runs write their bytecode
+caches (PYTHONDONTWRITEBYTECODE is dropped from their environment), as an installed axiform
+has them: without, each run compiles axiform's modules again (about 0.09 s).
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ import argparse
 import filecmp
 import json
 import os
+import resource
 import subprocess
 import sys
 import time
@@ -30,15 +31,19 @@ EXAMPLES = ("bottle_blow_moulding", "cup_thermoforming", "stretch_blow_moulding"
 TIMINGS = ("wall_time_s",)
 
 
-def run(src: Path, example: str, out: Path, plots: bool) -> float:
-    """The wall time (s) of one `axiform run` of the example with the tree src."""
+def run(src: Path, example: str, out: Path, plots: bool) -> tuple[float, float]:
+    """The wall time and the CPU time (user + system, its own processes included) in s of one
+    `axiform run` of the example with the tree src."""
     env = dict(os.environ, PYTHONPATH=str(src))
     env.pop("PYTHONDONTWRITEBYTECODE", None)
     args = [sys.executable, "-m", "axiform.cli", "run", str(ROOT / "examples" / f"{example}.toml"), "--out",
             str(out), "-q"] + ([] if plots else ["--set", "output.plots=false"])
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     subprocess.run(args, env=env, cwd=ROOT, check=True, capture_output=True)
-    return time.perf_counter() - t0
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
 
 
 def differences(a: Path, b: Path) -> list[str]:
@@ -75,20 +80,23 @@ def main() -> None:
     rows = []
     for example in args.examples:
         for plots in (True, False):
-            best = {"before": float("inf"), "after": float("inf")}
+            best = {label: [float("inf"), float("inf")] for label in ("before", "after")}
             for _ in range(args.repeat):
                 for label, src in (("before", args.before), ("after", args.after)):
-                    wall = run(src.resolve(), example, args.out / label / f"{example}-{plots}", plots)
-                    best[label] = min(best[label], wall)
+                    wall, cpu = run(src.resolve(), example, args.out / label / f"{example}-{plots}", plots)
+                    best[label] = [min(best[label][0], wall), min(best[label][1], cpu)]
             diff = differences(*(args.out / label / f"{example}-{plots}" for label in ("before", "after")))
-            rows.append((example, "on" if plots else "off", best["before"], best["after"], diff))
-            print(f"{example} plots {rows[-1][1]}: {best['before']:.2f} -> {best['after']:.2f} s; "
-                  f"differ: {', '.join(diff) or 'none'}", flush=True)
+            rows.append((example, "on" if plots else "off", *best["before"], *best["after"], diff))
+            print(f"{example} plots {rows[-1][1]}: wall {best['before'][0]:.2f} -> {best['after'][0]:.2f} s, "
+                  f"CPU {best['before'][1]:.2f} -> {best['after'][1]:.2f} s; differ: {', '.join(diff) or 'none'}",
+                  flush=True)
     print(f"load average at end: {os.getloadavg()[0]:.2f}\n")
-    print("| example | plots | before (s) | after (s) | saved (s) | files that differ (PNGs aside) |")
-    print("|---|---|---|---|---|---|")
-    for example, plots, before, after, diff in rows:
-        print(f"| {example} | {plots} | {before:.2f} | {after:.2f} | {before - after:.2f} | {', '.join(diff) or 'none'} |")
+    print("| example | plots | wall before (s) | wall after (s) | saved | CPU before (s) | CPU after (s) | saved | "
+          "files that differ (PNGs aside) |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---|")
+    for example, plots, wall0, cpu0, wall1, cpu1, diff in rows:
+        print(f"| {example} | {plots} | {wall0:.2f} | {wall1:.2f} | {wall0 - wall1:.2f} | {cpu0:.2f} | {cpu1:.2f} | "
+              f"{cpu0 - cpu1:.2f} | {', '.join(diff) or 'none'} |")
 
 
 if __name__ == "__main__":
