@@ -91,3 +91,38 @@ def test_the_table_is_the_rows_of_csv_writer():
          "first_contact": np.array([])},
     ]
     assert contact_table(reports, x, STATUS) == _rows_by_csv_writer(reports, x)
+
+
+def test_a_failed_run_keeps_the_contact_table_of_its_last_step(tmp_path, monkeypatch):
+    """`axiform run` failing midway (status failed, exit 3): contact.csv is that of the last
+    converged step, its (r, z) the slave nodes moved by that step's displacements."""
+    import json
+
+    import meshio
+
+    from axiform.cli import main
+    from axiform.model import model as model_module
+
+    calls = {"n": 0}
+    evaluate = model_module.Model.evaluate
+
+    def crash_later(self, *args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] > 20:
+            raise RuntimeError("a fault in the law")
+        return evaluate(self, *args, **kwargs)
+
+    monkeypatch.setattr(model_module.Model, "evaluate", crash_later)
+    out = tmp_path / "out"
+    toric = Path(__file__).resolve().parents[1] / "examples" / "toric_plate.toml"
+    assert main(["run", str(toric), "--out", str(out), "-q", "--set", "output.plots=false",
+                 "--set", "output.every=1"]) == 3
+    steps = json.loads((out / "summary.json").read_text())["steps"]
+    assert steps >= 2
+    vtu = meshio.read(out / "fields" / f"step_{steps:04d}.vtu")
+    x = vtu.points[:, :2] + vtu.point_data["displacement"][:, :2]
+    rows = list(csv.DictReader((out / "contact.csv").read_text().splitlines()))
+    assert rows
+    for row in rows:
+        node = int(row["node"])
+        assert (row["r"], row["z"]) == (f"{x[node, 0]:.10g}", f"{x[node, 1]:.10g}")
