@@ -40,9 +40,12 @@ def save(fig, path: str | Path, dpi: float = DPI, **savefig: Any) -> Path | None
     path = Path(path)
     engine = fig.get_layout_engine()
     if engine is not None and "bbox_inches" not in savefig:
+        import matplotlib
+
         fig.set_dpi(dpi)
         engine.execute(fig)
-        fig.set_layout_engine(None)
+        with matplotlib.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
+            fig.set_layout_engine(None)  # none at all (a matplotlibrc's default engine is not taken)
     savefig.setdefault("format", path.suffix.lstrip(".").lower() or "png")
     if savefig["format"].lower() == "png":
         savefig.setdefault("pil_kwargs", {"compress_level": 1})
