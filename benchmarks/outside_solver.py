@@ -7,7 +7,7 @@ timed from outside (the process's wall time), plots as the case files have them 
 
 The two trees run alternately (before, after, before, ...), `--repeat` times each; the table
 gives the least wall time and the least CPU time (user + system of the run and of the
-processes it waited for: a plot worker's included) of each.  Then every file of the two
+processes it waited for) of each.  Then every file of the two
 results folders is compared byte for byte, except summary.json (its timings differ; its other
 keys are compared) and the PNG pictures (compared by eye).  The runs write their bytecode
 caches (PYTHONDONTWRITEBYTECODE is dropped from their environment), as an installed axiform
