@@ -50,7 +50,10 @@ class Projection:
 
     def rows(self, sl: slice) -> Projection:
         """The projections of the rows sl (views)."""
-        return Projection(*(getattr(self, f.name)[sl] for f in fields(self)))
+        return Projection(*(getattr(self, name)[sl] for name in _PROJECTION_FIELDS))
+
+
+_PROJECTION_FIELDS = tuple(f.name for f in fields(Projection))  # (dataclasses.fields is slow to ask)
 
 
 def _best_per_node(i: np.ndarray, score: np.ndarray, rank: np.ndarray) -> np.ndarray:
