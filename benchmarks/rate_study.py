@@ -31,6 +31,7 @@ import tomli_w  # noqa: E402
 
 from axiform.case.schema import read  # noqa: E402
 from axiform.cli import main  # noqa: E402
+from axiform.post.results_folder import read_history  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 EXAMPLES = HERE.parent / "examples"
@@ -74,11 +75,9 @@ def run(case: dict, folder: Path) -> dict:
         raise RuntimeError(f"{folder.name}: {summary['status']}: {summary.get('message')}")
     with open(folder / "out" / "thickness.csv", newline="") as stream:
         wall = list(csv.DictReader(line for line in stream if not line.startswith("#")))
-    with open(folder / "out" / "history.csv", newline="") as stream:
-        history = list(csv.DictReader(stream))
+    history = read_history(folder / "out" / "history.csv")
     return {"s": np.array([float(r["s"]) for r in wall]), "ratio": np.array([float(r["ratio"]) for r in wall]),
-            "t": np.array([float(r["load_factor"]) for r in history]),
-            "plug_force": np.array([float(r["plug_force"]) for r in history]),
+            "t": history["load_factor"], "plug_force": history["plug_force"],
             "steps": summary["steps"], "iterations": summary["newton_iterations"]}
 
 
