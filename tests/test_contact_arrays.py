@@ -106,12 +106,12 @@ def test_one_pass_over_several_sets_is_one_call_per_set(seed, dense, monkeypatch
             same(p, surf.local(x, x_prev, depth, method))
 
 
-def test_piece_local_is_the_reference_on_every_pair():
+def test_the_projection_is_the_reference_on_every_pair():
     rng = np.random.default_rng(7)
     surf = random_polyline(rng, 8)
     x = near_points(rng, surf, 500, 1.0)
     k = rng.integers(0, len(surf.a), len(x))
-    for a, b in zip(surf._piece_local(k, x), ref.piece_local(surf, k, x)):
+    for a, b in zip(surf._project(k, x), ref.piece_local(surf, k, x)):
         assert np.array_equal(a, b)
 
 
@@ -162,7 +162,7 @@ def test_many_pairs_path_is_the_reference(seed, monkeypatch):
     for depth in (0.05, 0.5):
         same(surf.local(x, x_prev, depth), ref.local(surf, x, x_prev, depth))
     k = rng.integers(0, len(surf.a), len(x))
-    for a, b in zip(surf._piece_local(k, x), ref.piece_local(surf, k, x)):
+    for a, b in zip(surf._project(k, x), ref.piece_local(surf, k, x)):
         assert np.array_equal(a, b)
 
 

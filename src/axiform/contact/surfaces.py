@@ -249,14 +249,10 @@ class Polyline(RigidSurface):
             out.append(self._arc_points(k, 25)[1:] if self.is_arc[k] else self.b[k:k + 1])
         return np.vstack(out)
 
-    def _piece_local(self, k: np.ndarray, x: np.ndarray):
-        """For pairs (piece k, point x): xi (fraction along the piece, < 0 before its start,
-        > 1 beyond its end), gap g, normal n, tangent t, curvature kappa, m, point."""
-        xi, g, n, t, kappa, m, point = self._project(k, x, True)
-        return xi, g, n, t, kappa, m, point
-
     def _project(self, k: np.ndarray, x: np.ndarray, full: bool = True, subset: bool = True):
-        """`_piece_local` on arrays, every pair at once: the pieces' data gathered by k and
+        """For pairs (piece k (p,), point x (p, 2)): xi (fraction along the piece, < 0 before
+        its start, > 1 beyond its end), gap g, normal n, tangent t, curvature kappa, m, point,
+        every pair at once: the pieces' data gathered by k and
         both the straight and the circular formula evaluated for every pair (the arc's only
         where a pair lies on an arc), the right one picked by np.where.  full=False: xi and g
         only (the last converged positions need no more)."""
