@@ -13,14 +13,17 @@ from pathlib import Path
 import numpy as np
 
 # a node table of the .dat file: "<what> for set <SET> and time <t>", a blank line, the rows
-NODE_TABLE = re.compile(r"^ *(\S[^\n]*?) for set (\w+) and time\s+([-+0-9.Ee]+)\s*\n\s*\n"
-                        r"((?:[ \t]*[-+0-9.Ee]+(?:[ \t]+[-+0-9.Ee]+)+[ \t]*\n)+)", re.MULTILINE)
+NODE_TABLE = re.compile(
+    r"^ *(\S[^\n]*?) for set (\w+) and time\s+([-+0-9.Ee]+)\s*\n\s*\n"
+    r"((?:[ \t]*[-+0-9.Ee]+(?:[ \t]+[-+0-9.Ee]+)+[ \t]*\n)+)",
+    re.MULTILINE,
+)
 
 
 def id_lines(ids, per: int = 12) -> list[str]:
     """Node or element numbers as the lines of a *NSET / *ELSET card, `per` to a line."""
     ids = [str(int(i)) for i in ids]
-    return [", ".join(ids[k:k + per]) for k in range(0, len(ids), per)]
+    return [", ".join(ids[k : k + per]) for k in range(0, len(ids), per)]
 
 
 def mesh_cards(mesh, elset: str, nset: str = "NALL") -> list[str]:
@@ -71,8 +74,9 @@ def node_tables(dat: str, what: str) -> dict[float, np.ndarray]:
     out = {}
     for m in NODE_TABLE.finditer(dat):
         if m.group(1).strip().startswith(what):
-            out[float(m.group(3))] = np.array([[float(v) for v in line.split()]
-                                                for line in m.group(4).strip().splitlines()])
+            out[float(m.group(3))] = np.array(
+                [[float(v) for v in line.split()] for line in m.group(4).strip().splitlines()]
+            )
     return out
 
 

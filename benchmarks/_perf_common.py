@@ -35,9 +35,14 @@ def divisions_for_dofs(element: str, n_dofs: int) -> tuple[int, int]:
     return n, n
 
 
-def build_model(element: str, divisions: tuple[int, int], pressure: float = 5.0,
-                top_displacement: float | None = -0.05, pressed: float = 0.5,
-                finalize: bool = True) -> Model:
+def build_model(
+    element: str,
+    divisions: tuple[int, int],
+    pressure: float = 5.0,
+    top_displacement: float | None = -0.05,
+    pressed: float = 0.5,
+    finalize: bool = True,
+) -> Model:
     """The benchmark body: a thick ring r in [1, 2], z in [0, 1], on a roller at z = 0, a
     follower pressure on the lower half of the inner face r = 1 and, if asked, a prescribed
     axial displacement of the top face (a non-empty K_fp block).
@@ -57,8 +62,7 @@ def build_model(element: str, divisions: tuple[int, int], pressure: float = 5.0,
     return model.finalize() if finalize else model
 
 
-def deformed_state(model: Model, seed: int = 0, lam: float = 0.5,
-                   noise: float = 0.01) -> tuple[np.ndarray, float]:
+def deformed_state(model: Model, seed: int = 0, lam: float = 0.5, noise: float = 0.01) -> tuple[np.ndarray, float]:
     """Free unknowns u_f of a homogeneous stretch (matching the prescribed top displacement)
     plus a small random perturbation (noise x the element size), so that F != I and every
     Gauss point differs, with J well away from 0."""
@@ -117,8 +121,10 @@ def machine() -> str:
         blas = cfg["Build Dependencies"]["blas"]["name"]
     except Exception:  # noqa: BLE001  (older NumPy)
         pass
-    return (f"{cpu}, {os.cpu_count()} cores{mem}; Python {platform.python_version()}, "
-            f"NumPy {np.__version__} ({blas}), SciPy {scipy.__version__}")
+    return (
+        f"{cpu}, {os.cpu_count()} cores{mem}; Python {platform.python_version()}, "
+        f"NumPy {np.__version__} ({blas}), SciPy {scipy.__version__}"
+    )
 
 
 def write_result(name: str, text: str) -> Path:

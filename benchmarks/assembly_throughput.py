@@ -52,8 +52,16 @@ if __name__ == "__main__":  # thread counts must be set before NumPy is imported
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _perf_common import (Timing, build_model, deformed_state, divisions_for_elements,  # noqa: E402
-                          load_average, machine, table, write_result)
+from _perf_common import (
+    Timing,
+    build_model,
+    deformed_state,
+    divisions_for_elements,  # noqa: E402
+    load_average,
+    machine,
+    table,
+    write_result,
+)
 
 from axiform.fem.assembly import SolidAssembly  # noqa: E402
 from axiform.fem.constraints import SparsePattern  # noqa: E402
@@ -96,7 +104,7 @@ def solid_pieces(solid: SolidAssembly, u: np.ndarray):
         c5 = clock()
         np.matmul(GdV_T, P.reshape(m, q * 5, 1), out=fe[sl, :, None])
         c6 = clock()
-        for k, a, b in zip(SOLID_PIECES, (c0, c1, c2, c3, c4, c5), (c1, c2, c3, c4, c5, c6)):
+        for k, a, b in zip(SOLID_PIECES, (c0, c1, c2, c3, c4, c5), (c1, c2, c3, c4, c5, c6), strict=False):
             t[k] += b - a
     return t, fe, Ke
 
@@ -117,10 +125,13 @@ def interleaved(fns: dict, min_time: float, min_repeat: int = 5, max_repeat: int
             w, c = time.perf_counter(), time.process_time()
             r = fn()
             t = Timing(time.perf_counter() - w, time.process_time() - c)
-            for k, v in (r.items() if isinstance(r, dict) else [(name, t)]):
+            for k, v in r.items() if isinstance(r, dict) else [(name, t)]:
                 b = best.get(k)
-                best[k] = v if b is None else (min(b, v) if isinstance(v, float)
-                                               else Timing(min(b.wall, v.wall), min(b.cpu, v.cpu)))
+                best[k] = (
+                    v
+                    if b is None
+                    else (min(b, v) if isinstance(v, float) else Timing(min(b.wall, v.wall), min(b.cpu, v.cpu)))
+                )
         n += 1
     return best
 
@@ -173,11 +184,11 @@ def timed_finalize(model) -> dict:
 
 
 def measure_case(element: str, n_elements: int, min_time: float, unique_limit: int) -> dict:
-    model, t_setup = timed_once(lambda: build_model(element, divisions_for_elements(n_elements),
-                                                    finalize=False))
+    model, t_setup = timed_once(lambda: build_model(element, divisions_for_elements(n_elements), finalize=False))
     build = timed_finalize(model) | dict(setup=t_setup, unique=None)
-    keys = np.concatenate([model.pattern._keys(b).ravel()
-                           for b in [model.solid.dofs] + [p.dofs for p in model.pressures]])
+    keys = np.concatenate(
+        [model.pattern._keys(b).ravel() for b in [model.solid.dofs] + [p.dofs for p in model.pressures]]
+    )
     if keys.size <= unique_limit:  # NumPy 2.4's np.unique: seconds at 1e5 elements
         uniq, build["unique"] = timed_once(lambda: np.unique(keys))  # noqa: F821 (bound before the del below)
         assert np.array_equal(uniq, model.pattern.keys)
@@ -207,22 +218,26 @@ def measure_case(element: str, n_elements: int, min_time: float, unique_limit: i
     def noise():  # Model.evaluate's round-off level: row sums of |K|
         np.add.reduceat(np.abs(K.data), K.indptr[:-1][np.diff(K.indptr) > 0]).max()
 
-    best = interleaved({
-        "total": lambda: model.evaluate(u_f, lam),
-        "solid": lambda: solid_pieces(s, u)[0],
-        "expand": lambda: model.expand(u_f, lam),
-        "refill": lambda: pat.accumulate(solid_pos, Ke),
-        "blocks": lambda: pat.blocks(data),
-        "forces": forces,
-        "load": lambda: model.external_load(u),
-        "noise": noise,
-    }, min_time)
+    best = interleaved(
+        {
+            "total": lambda: model.evaluate(u_f, lam),
+            "solid": lambda: solid_pieces(s, u)[0],
+            "expand": lambda: model.expand(u_f, lam),
+            "refill": lambda: pat.accumulate(solid_pos, Ke),
+            "blocks": lambda: pat.blocks(data),
+            "forces": forces,
+            "load": lambda: model.external_load(u),
+            "noise": noise,
+        },
+        min_time,
+    )
     total = best.pop("total")
     pieces = {k: best[k] for k in SOLID_PIECES}
     pieces |= {k: best[k].cpu for k in MODEL_PIECES}
     rest = total.cpu - sum(pieces.values())
-    return dict(element=element, n=e, gp=e * q, nf=model.n_free, nnz=K.nnz,
-                total=total, pieces=pieces, rest=rest, build=build)
+    return dict(
+        element=element, n=e, gp=e * q, nf=model.n_free, nnz=K.nnz, total=total, pieces=pieces, rest=rest, build=build
+    )
 
 
 def chunk_table(element: str, n_elements: int, min_time: float) -> dict:
@@ -264,6 +279,7 @@ def variants(element: str, n_elements: int, min_time: float) -> dict:
         def run():
             for sl in chunks:
                 body(sl)
+
         return run
 
     def fresh_Ke():  # src: a new K_e array on every call, written for the first time here
@@ -272,29 +288,34 @@ def variants(element: str, n_elements: int, min_time: float) -> dict:
             np.matmul(s._GdV[sl].transpose(0, 2, 1), AG[sl], out=out[sl])
 
     cases = [
-        ("g = G u_e", "matmul G2 (e,5q,nd) · u_e (src)",
-         loop(lambda sl: np.matmul(s._G2[sl], ue[sl, :, None]))),
-        ("g = G u_e", "einsum eqik,ek->eqi",
-         loop(lambda sl: np.einsum("eqik,ek->eqi", s.G[sl], ue[sl]))),
-        ("P, A", "MooneyRivlin.stress_tangent (src)",
-         loop(lambda sl: s.material.stress_tangent(x[sl]))),
-        ("f_e = GᵀP dV", "matmul, transposed view of GdV (e,5q,nd) (src)",
-         loop(lambda sl: np.matmul(s._GdV[sl].transpose(0, 2, 1), P2[sl, :, None],
-                                   out=fe[sl, :, None]))),
-        ("f_e = GᵀP dV", "einsum epk,ep->ek on GdV",
-         loop(lambda sl: np.einsum("epk,ep->ek", s._GdV[sl], P2[sl]))),
-        ("f_e = GᵀP dV", "matmul on a contiguous (e,nd,5q) copy",
-         loop(lambda sl: np.matmul(GdV_T_copy[sl], P2[sl, :, None], out=fe[sl, :, None]))),
+        ("g = G u_e", "matmul G2 (e,5q,nd) · u_e (src)", loop(lambda sl: np.matmul(s._G2[sl], ue[sl, :, None]))),
+        ("g = G u_e", "einsum eqik,ek->eqi", loop(lambda sl: np.einsum("eqik,ek->eqi", s.G[sl], ue[sl]))),
+        ("P, A", "MooneyRivlin.stress_tangent (src)", loop(lambda sl: s.material.stress_tangent(x[sl]))),
+        (
+            "f_e = GᵀP dV",
+            "matmul, transposed view of GdV (e,5q,nd) (src)",
+            loop(lambda sl: np.matmul(s._GdV[sl].transpose(0, 2, 1), P2[sl, :, None], out=fe[sl, :, None])),
+        ),
+        ("f_e = GᵀP dV", "einsum epk,ep->ek on GdV", loop(lambda sl: np.einsum("epk,ep->ek", s._GdV[sl], P2[sl]))),
+        (
+            "f_e = GᵀP dV",
+            "matmul on a contiguous (e,nd,5q) copy",
+            loop(lambda sl: np.matmul(GdV_T_copy[sl], P2[sl, :, None], out=fe[sl, :, None])),
+        ),
         ("A G", "matmul (src)", loop(lambda sl: np.matmul(A[sl], s.G[sl]))),
-        ("A G", "einsum eqij,eqjk->eqik",
-         loop(lambda sl: np.einsum("eqij,eqjk->eqik", A[sl], s.G[sl]))),
+        ("A G", "einsum eqij,eqjk->eqik", loop(lambda sl: np.einsum("eqij,eqjk->eqik", A[sl], s.G[sl]))),
         ("Gᵀ(AG) dV", "matmul, transposed view of GdV (e,5q,nd), into a new K_e (src)", fresh_Ke),
-        ("Gᵀ(AG) dV", "same, into a K_e array kept between calls",
-         loop(lambda sl: np.matmul(s._GdV[sl].transpose(0, 2, 1), AG[sl], out=Ke[sl]))),
-        ("Gᵀ(AG) dV", "matmul on a contiguous (e,nd,5q) copy, kept K_e",
-         loop(lambda sl: np.matmul(GdV_T_copy[sl], AG[sl], out=Ke[sl]))),
-        ("Gᵀ(AG) dV", "einsum epk,epl->ekl",
-         loop(lambda sl: np.einsum("epk,epl->ekl", s._GdV[sl], AG[sl]))),
+        (
+            "Gᵀ(AG) dV",
+            "same, into a K_e array kept between calls",
+            loop(lambda sl: np.matmul(s._GdV[sl].transpose(0, 2, 1), AG[sl], out=Ke[sl])),
+        ),
+        (
+            "Gᵀ(AG) dV",
+            "matmul on a contiguous (e,nd,5q) copy, kept K_e",
+            loop(lambda sl: np.matmul(GdV_T_copy[sl], AG[sl], out=Ke[sl])),
+        ),
+        ("Gᵀ(AG) dV", "einsum epk,epl->ekl", loop(lambda sl: np.einsum("epk,epl->ekl", s._GdV[sl], AG[sl]))),
     ]
     best = interleaved({(op, v): fn for op, v, fn in cases}, min_time)
     return dict(element=element, n=e, chunk=c, ms={k: t.cpu * 1e3 for k, t in best.items()})
@@ -309,79 +330,146 @@ def report(results, chunks, var, head, t_start) -> str:
     main_rows, piece_rows, build_rows = [], [], []
     for r in results:
         tot, p, b = r["total"], r["pieces"], r["build"]
-        main_rows.append([r["element"], f"{r['n']:,}", f"{r['gp']:,}", f"{r['nf']:,}",
-                          f"{r['nnz']:,}", f"{tot.cpu * 1e3:.1f}", f"{tot.wall * 1e3:.1f}",
-                          f"**{r['gp'] / tot.cpu:.2e}**", f"{tot.cpu / r['gp'] * 1e9:.0f}"])
+        main_rows.append(
+            [
+                r["element"],
+                f"{r['n']:,}",
+                f"{r['gp']:,}",
+                f"{r['nf']:,}",
+                f"{r['nnz']:,}",
+                f"{tot.cpu * 1e3:.1f}",
+                f"{tot.wall * 1e3:.1f}",
+                f"**{r['gp'] / tot.cpu:.2e}**",
+                f"{tot.cpu / r['gp'] * 1e9:.0f}",
+            ]
+        )
         solid = sum(p[k] for k in SOLID_PIECES)
-        piece_rows.append([r["element"], f"{r['n']:,}"]
-                          + [f"{p[k] * 1e3:.1f} ({100 * p[k] / tot.cpu:.0f}%)" for k in SOLID_PIECES]
-                          + [f"**{solid * 1e3:.1f} ({100 * solid / tot.cpu:.0f}%)**"]
-                          + [f"{p[k] * 1e3:.1f} ({100 * p[k] / tot.cpu:.0f}%)" for k in MODEL_PIECES]
-                          + [f"{r['rest'] * 1e3:.1f}", f"{tot.cpu * 1e3:.1f}"])
+        piece_rows.append(
+            [r["element"], f"{r['n']:,}"]
+            + [f"{p[k] * 1e3:.1f} ({100 * p[k] / tot.cpu:.0f}%)" for k in SOLID_PIECES]
+            + [f"**{solid * 1e3:.1f} ({100 * solid / tot.cpu:.0f}%)**"]
+            + [f"{p[k] * 1e3:.1f} ({100 * p[k] / tot.cpu:.0f}%)" for k in MODEL_PIECES]
+            + [f"{r['rest'] * 1e3:.1f}", f"{tot.cpu * 1e3:.1f}"]
+        )
         other = b["finalize"] - b["solid"] - b["pattern"] - b["pos"]
-        build_rows.append([r["element"], f"{r['n']:,}", f"{b['setup']:.2f}", f"**{b['finalize']:.2f}**",
-                           f"{b['solid']:.2f}", f"{b['pattern']:.2f}", f"{b['pos']:.2f}",
-                           f"{other:.2f}",
-                           "–" if b["unique"] is None else f"{b['unique']:.2f}"])
+        build_rows.append(
+            [
+                r["element"],
+                f"{r['n']:,}",
+                f"{b['setup']:.2f}",
+                f"**{b['finalize']:.2f}**",
+                f"{b['solid']:.2f}",
+                f"{b['pattern']:.2f}",
+                f"{b['pos']:.2f}",
+                f"{other:.2f}",
+                "–" if b["unique"] is None else f"{b['unique']:.2f}",
+            ]
+        )
     out = ["# Assembly throughput: Model.evaluate (residual + tangent)", ""] + head
-    out += ["Gauss points per second = (elements × Gauss points) / CPU time of one "
-            "`model.evaluate(u_f, lam)` with the tangent (minimum over repeats); ns/gp = its "
-            "inverse. src/ as it is: material law on component rows, element kernel in chunks "
-            f"of {SolidAssembly.chunk} elements.", ""]
-    out.append(table(["element", "elements", "Gauss points", "free dofs", "nnz(K_ff)",
-                      "evaluate CPU ms", "wall ms", "Gauss points/s", "ns/gp"], main_rows))
+    out += [
+        "Gauss points per second = (elements × Gauss points) / CPU time of one "
+        "`model.evaluate(u_f, lam)` with the tangent (minimum over repeats); ns/gp = its "
+        "inverse. src/ as it is: material law on component rows, element kernel in chunks "
+        f"of {SolidAssembly.chunk} elements.",
+        "",
+    ]
+    out.append(
+        table(
+            [
+                "element",
+                "elements",
+                "Gauss points",
+                "free dofs",
+                "nnz(K_ff)",
+                "evaluate CPU ms",
+                "wall ms",
+                "Gauss points/s",
+                "ns/gp",
+            ],
+            main_rows,
+        )
+    )
     worst = {}
     for r in results:
         worst[r["element"]] = min(worst.get(r["element"], np.inf), r["gp"] / r["total"].cpu)
-    out += ["Lowest throughput per element: " + ", ".join(f"{k} {v:.2e}" for k, v in worst.items())
-            + " Gauss points/s.", ""]
-    out += ["## Pieces of evaluate (CPU ms, share of the total)", "",
-            "Inside `SolidAssembly.evaluate`, summed over its chunks: F: u_e gather, G u_e and "
-            "F = I + g; J>0: inversion check; P,A: `MooneyRivlin.stress_tangent`; AG and GᵀAG: "
-            "the two batched products of the element tangent; GᵀP: internal forces; solid: their "
-            "sum. Around it in `Model.evaluate`: expand: free unknowns to the full vector; "
-            "refill: bincount of the element tangents into the pattern's data; blocks: K_ff and "
-            "K_fp as CSR; forces: bincounts of f_int and |f_e|, residual gather; load: follower "
-            "pressure with its stiffness; noise: row sums of |K| (round-off level); rest: the "
-            "difference to the total (allocation, page faults of the new arrays, small items).", ""]
-    out.append(table(["element", "elements"] + SOLID_PIECES + ["solid"] + MODEL_PIECES
-                     + ["rest", "total"], piece_rows))
-    out += ["## Model construction (CPU s)", "",
-            "setup: mesh + `Model(...)`, supports and pressure; finalize: `model.finalize()`; "
-            "of which (timed inside that call): SolidAssembly (G, dV, G dV), SparsePattern "
-            "(keys of all element and edge blocks, sort, de-duplication, CSR structure), "
-            "positions (`searchsorted` of the blocks' keys in the pattern); other: the rest of "
-            "finalize (DofMap, SFR ties). np.unique: NumPy's `np.unique` on the same keys, for "
-            "comparison with SparsePattern's sort + mask (not run above 8 million keys).", ""]
-    out.append(table(["element", "elements", "setup", "finalize", "SolidAssembly", "SparsePattern",
-                      "positions", "other", "np.unique(keys)"], build_rows))
+    out += [
+        "Lowest throughput per element: " + ", ".join(f"{k} {v:.2e}" for k, v in worst.items()) + " Gauss points/s.",
+        "",
+    ]
+    out += [
+        "## Pieces of evaluate (CPU ms, share of the total)",
+        "",
+        "Inside `SolidAssembly.evaluate`, summed over its chunks: F: u_e gather, G u_e and "
+        "F = I + g; J>0: inversion check; P,A: `MooneyRivlin.stress_tangent`; AG and GᵀAG: "
+        "the two batched products of the element tangent; GᵀP: internal forces; solid: their "
+        "sum. Around it in `Model.evaluate`: expand: free unknowns to the full vector; "
+        "refill: bincount of the element tangents into the pattern's data; blocks: K_ff and "
+        "K_fp as CSR; forces: bincounts of f_int and |f_e|, residual gather; load: follower "
+        "pressure with its stiffness; noise: row sums of |K| (round-off level); rest: the "
+        "difference to the total (allocation, page faults of the new arrays, small items).",
+        "",
+    ]
+    out.append(table(["element", "elements"] + SOLID_PIECES + ["solid"] + MODEL_PIECES + ["rest", "total"], piece_rows))
+    out += [
+        "## Model construction (CPU s)",
+        "",
+        "setup: mesh + `Model(...)`, supports and pressure; finalize: `model.finalize()`; "
+        "of which (timed inside that call): SolidAssembly (G, dV, G dV), SparsePattern "
+        "(keys of all element and edge blocks, sort, de-duplication, CSR structure), "
+        "positions (`searchsorted` of the blocks' keys in the pattern); other: the rest of "
+        "finalize (DofMap, SFR ties). np.unique: NumPy's `np.unique` on the same keys, for "
+        "comparison with SparsePattern's sort + mask (not run above 8 million keys).",
+        "",
+    ]
+    out.append(
+        table(
+            [
+                "element",
+                "elements",
+                "setup",
+                "finalize",
+                "SolidAssembly",
+                "SparsePattern",
+                "positions",
+                "other",
+                "np.unique(keys)",
+            ],
+            build_rows,
+        )
+    )
     if chunks:
-        hdr = ["element", "elements"] + [("whole mesh" if c is None else f"{c}")
-                                         + (" (src)" if c == SolidAssembly.chunk else "")
-                                         for c in CHUNKS]
+        hdr = ["element", "elements"] + [
+            ("whole mesh" if c is None else f"{c}") + (" (src)" if c == SolidAssembly.chunk else "") for c in CHUNKS
+        ]
         rows = []
         for r in chunks:
             best = max(r["gp_s"].values())
-            rows.append([r["element"], f"{r['n']:,}"]
-                        + [(f"**{v:.2e}**" if v == best else f"{v:.2e}") for v in r["gp_s"].values()])
-        out += ["## Chunk size of SolidAssembly.evaluate (Gauss points/s of model.evaluate)", "",
-                "`model.solid.chunk` set to each value (elements per chunk); bold: the fastest.", ""]
+            rows.append(
+                [r["element"], f"{r['n']:,}"]
+                + [(f"**{v:.2e}**" if v == best else f"{v:.2e}") for v in r["gp_s"].values()]
+            )
+        out += [
+            "## Chunk size of SolidAssembly.evaluate (Gauss points/s of model.evaluate)",
+            "",
+            "`model.solid.chunk` set to each value (elements per chunk); bold: the fastest.",
+            "",
+        ]
         out.append(table(hdr, rows))
     if var:
         keys = list(var[0]["ms"])
         rows = []
         for op, v in keys:
             ref = next(k for k in keys if k[0] == op)  # the first variant of each operation: src
-            rows.append([op, v] + [f"{r['ms'][(op, v)]:.1f} ({r['ms'][ref] / r['ms'][(op, v)]:.2f})"
-                                   for r in var])
-        out += ["## Kernel variants (CPU ms over the whole mesh, in src's chunks of "
-                f"{var[0]['chunk']} elements)", "",
-                "In brackets: the first (src) variant's time / this one's; > 1: faster than src. "
-                "Inputs (u_e, P, A, AG) precomputed for the whole mesh.", ""]
-        out.append(table(["operation", "variant"] + [f"{r['element']}, {r['n']:,} el." for r in var],
-                         rows))
-    out.append(f"Total run time {time.perf_counter() - t_start:.0f} s; load average at the end: "
-               f"{load_average()}.\n")
+            rows.append([op, v] + [f"{r['ms'][(op, v)]:.1f} ({r['ms'][ref] / r['ms'][(op, v)]:.2f})" for r in var])
+        out += [
+            f"## Kernel variants (CPU ms over the whole mesh, in src's chunks of {var[0]['chunk']} elements)",
+            "",
+            "In brackets: the first (src) variant's time / this one's; > 1: faster than src. "
+            "Inputs (u_e, P, A, AG) precomputed for the whole mesh.",
+            "",
+        ]
+        out.append(table(["operation", "variant"] + [f"{r['element']}, {r['n']:,} el." for r in var], rows))
+    out.append(f"Total run time {time.perf_counter() - t_start:.0f} s; load average at the end: {load_average()}.\n")
     return "\n".join(out)
 
 
@@ -390,20 +478,25 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="small meshes only (smoke run)")
     ap.add_argument("--elements", nargs="+", default=["q4", "sfr", "q8"])
     ap.add_argument("--sizes", nargs="+", type=float, help="numbers of elements")
-    ap.add_argument("--no-variants", action="store_true",
-                    help="skip the chunk-size and kernel-variant tables")
-    ap.add_argument("--out", default=None,
-                    help="results name (default: assembly_throughput for the full default run, "
-                         "assembly_throughput_quick with --quick, assembly_throughput_partial "
-                         "otherwise)")
+    ap.add_argument("--no-variants", action="store_true", help="skip the chunk-size and kernel-variant tables")
+    ap.add_argument(
+        "--out",
+        default=None,
+        help="results name (default: assembly_throughput for the full default run, "
+        "assembly_throughput_quick with --quick, assembly_throughput_partial "
+        "otherwise)",
+    )
     args = ap.parse_args(argv)
     sizes = [int(n) for n in (args.sizes or ([1e3, 3e3] if args.quick else [1e3, 1e4, 1e5]))]
     min_time = 0.1 if args.quick else 1.0
     t_start = time.perf_counter()
     tunables = os.environ.get("GLIBC_TUNABLES")
-    head = [f"Machine: {machine()}; BLAS threads: {os.environ.get('OPENBLAS_NUM_THREADS')}; "
-            + (f"GLIBC_TUNABLES={tunables}; " if tunables else "")
-            + f"load average at start: {load_average()}", ""]
+    head = [
+        f"Machine: {machine()}; BLAS threads: {os.environ.get('OPENBLAS_NUM_THREADS')}; "
+        + (f"GLIBC_TUNABLES={tunables}; " if tunables else "")
+        + f"load average at start: {load_average()}",
+        "",
+    ]
     print(head[0], flush=True)
 
     results = []
@@ -411,8 +504,11 @@ def main(argv=None) -> int:
         for n in sizes:
             r = measure_case(element, n, min_time, unique_limit=8_000_000)
             results.append(r)
-            print(f"{element} {r['n']} elements: {r['gp'] / r['total'].cpu:.3g} Gauss points/s, "
-                  f"finalize {r['build']['finalize']:.2f} s", flush=True)
+            print(
+                f"{element} {r['n']} elements: {r['gp'] / r['total'].cpu:.3g} Gauss points/s, "
+                f"finalize {r['build']['finalize']:.2f} s",
+                flush=True,
+            )
     chunks, var = [], []
     if not args.no_variants:
         for element in args.elements:
@@ -423,8 +519,7 @@ def main(argv=None) -> int:
     print()
     print(text)
     partial = args.sizes or args.no_variants or args.elements != ap.get_default("elements")
-    name = args.out or ("assembly_throughput"
-                        + ("_quick" if args.quick else "_partial" if partial else ""))
+    name = args.out or ("assembly_throughput" + ("_quick" if args.quick else "_partial" if partial else ""))
     path = write_result(name, text)
     print(f"written to {path}")
     return 0

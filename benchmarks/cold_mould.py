@@ -57,27 +57,45 @@ def study() -> None:
         a_c.plot(t["s"], t["first_contact_1"], "o", ms=3, color=f"C{k}", label=label)
         if "temperature" in t:
             a_T.plot(t["s"], t["temperature"], "-", color=f"C{k}", label=label)
-    a_t.set(xlabel="reference arc length s (mm), from the centre of the sheet", ylabel="final wall thickness (mm)",
-            ylim=(0, None), title="final wall")
-    a_c.set(xlabel="reference arc length s (mm)", ylabel="time of first contact with the mould (s)",
-            title="when each point reached the mould")
-    a_T.set(xlabel="reference arc length s (mm)", ylabel="mid-wall temperature at the end (C)",
-            title="temperature (the cold mould's case)")
+    a_t.set(
+        xlabel="reference arc length s (mm), from the centre of the sheet",
+        ylabel="final wall thickness (mm)",
+        ylim=(0, None),
+        title="final wall",
+    )
+    a_c.set(
+        xlabel="reference arc length s (mm)",
+        ylabel="time of first contact with the mould (s)",
+        title="when each point reached the mould",
+    )
+    a_T.set(
+        xlabel="reference arc length s (mm)",
+        ylabel="mid-wall temperature at the end (C)",
+        title="temperature (the cold mould's case)",
+    )
     for ax in (a_t, a_c, a_T):
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
     fig.suptitle("Plug-assisted thermoforming of a HIPS cup: a sticky mould against a cold one")
     fig.tight_layout()
     fig.savefig(RESULTS / "cold_mould.png", dpi=110)
-    head = ["mould", "thinnest wall (mm) at s", *[f"wall at {k} (s = {s:g})" for k, s in S_REPORT.items()],
-            "mid-wall T min / max (C)", "steps", "Newton iterations"]
+    head = [
+        "mould",
+        "thinnest wall (mm) at s",
+        *[f"wall at {k} (s = {s:g})" for k, s in S_REPORT.items()],
+        "mid-wall T min / max (C)",
+        "steps",
+        "Newton iterations",
+    ]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for label, (t, summary) in runs.items():
         i = int(np.nanargmin(t["thickness"]))
         walls = " | ".join(f"{np.interp(s, t['s'], t['thickness']):.3f}" for s in S_REPORT.values())
         temps = f"{np.nanmin(t['temperature']):.0f} / {np.nanmax(t['temperature']):.0f}" if "temperature" in t else "-"
-        lines.append(f"| {label} | {t['thickness'][i]:.3f} at {t['s'][i]:.1f} | {walls} | {temps} | "
-                     f"{summary['steps']} | {summary['newton_iterations']} |")
+        lines.append(
+            f"| {label} | {t['thickness'][i]:.3f} at {t['s'][i]:.1f} | {walls} | {temps} | "
+            f"{summary['steps']} | {summary['newton_iterations']} |"
+        )
     (RESULTS / "cold_mould.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 

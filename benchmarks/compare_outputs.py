@@ -26,16 +26,37 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
-EXAMPLES = ("die_drawing", "cup_thermoforming", "stretch_blow_moulding", "bottle_blow_moulding", "toric_plate",
-            "dxf_cup_mould")
+EXAMPLES = (
+    "die_drawing",
+    "cup_thermoforming",
+    "stretch_blow_moulding",
+    "bottle_blow_moulding",
+    "toric_plate",
+    "dxf_cup_mould",
+)
 FILES = ("history.csv", "contact.csv", "thickness.csv")
 
 
 def run(src: Path, example: str, out: Path) -> None:
     env = dict(os.environ, PYTHONPATH=str(src))
-    subprocess.run([sys.executable, "-m", "axiform.cli", "run", str(ROOT / "examples" / f"{example}.toml"), "--out",
-                    str(out), "-q", "--set", "output.plots=false"], env=env, cwd=ROOT, check=True,
-                   capture_output=True)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "axiform.cli",
+            "run",
+            str(ROOT / "examples" / f"{example}.toml"),
+            "--out",
+            str(out),
+            "-q",
+            "--set",
+            "output.plots=false",
+        ],
+        env=env,
+        cwd=ROOT,
+        check=True,
+        capture_output=True,
+    )
 
 
 def read(path: Path) -> list[list[str]]:
@@ -86,7 +107,7 @@ def compare(a: Path, b: Path) -> str:
     note = ""
     if len(ra) != len(rb) and a.name == "history.csv" and ra and ra[0][:2] == ["step", "load_factor"]:
         ra, rb, note = common_times(ra, rb)
-    if len(ra) != len(rb) or any(len(x) != len(y) for x, y in zip(ra, rb)):
+    if len(ra) != len(rb) or any(len(x) != len(y) for x, y in zip(ra, rb, strict=False)):
         return f"shapes differ ({len(ra)} vs {len(rb)} rows){extra}"
     ncol = max((len(r) for r in ra), default=0)
     scale = np.zeros(ncol)
@@ -96,8 +117,8 @@ def compare(a: Path, b: Path) -> str:
             if v is not None and np.isfinite(v):
                 scale[j] = max(scale[j], abs(v))
     worst, cells, text_diff = 0.0, 0, 0
-    for x, y in zip(ra, rb):
-        for j, (c, d) in enumerate(zip(x, y)):
+    for x, y in zip(ra, rb, strict=False):
+        for j, (c, d) in enumerate(zip(x, y, strict=False)):
             u, v = number(c), number(d)
             if u is None or v is None:
                 text_diff += c != d
@@ -106,8 +127,7 @@ def compare(a: Path, b: Path) -> str:
             if np.isnan(u) and np.isnan(v) or u == v:
                 continue
             worst = max(worst, abs(u - v) / max(abs(u), abs(v), 1e-12 * scale[j], 1e-300))
-    return (f"{worst:.1e} over {cells} numbers{note}" + (f"; {text_diff} text cells differ" if text_diff else "")
-            + extra)
+    return f"{worst:.1e} over {cells} numbers{note}" + (f"; {text_diff} text cells differ" if text_diff else "") + extra
 
 
 def main() -> None:

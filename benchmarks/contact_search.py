@@ -117,8 +117,11 @@ def layout(kind: str, n: int, m: int, seed: int = 0):
         t /= np.linalg.norm(t, axis=1)[:, None]
         nrm = np.column_stack([-t[:, 1], t[:, 0]])  # left of the direction of travel: the body side
         frac = s / L
-        gap = np.where(frac < 0.6, rng.uniform(-0.5, 2.0, n) * widen,
-                       0.3 * np.sin(np.pi * np.clip((frac - 0.6) / 0.4, 0, 1)) + 2.0 * widen)
+        gap = np.where(
+            frac < 0.6,
+            rng.uniform(-0.5, 2.0, n) * widen,
+            0.3 * np.sin(np.pi * np.clip((frac - 0.6) / 0.4, 0, 1)) + 2.0 * widen,
+        )
         x = p + gap[:, None] * nrm
         x[:, 0] = np.maximum(x[:, 0], 0.0)
     elif kind == "cloud":
@@ -159,7 +162,7 @@ def chunked_reference(x, a, b, widen, chunk_pairs: int = 20_000_000) -> np.ndarr
     step = max(1, chunk_pairs // max(len(a), 1))
     out = []
     for i0 in range(0, len(x), step):
-        p = x[i0:i0 + step]
+        p = x[i0 : i0 + step]
         ok = (p[:, None, 0] >= lo[None, :, 0]) & (p[:, None, 0] <= hi[None, :, 0])
         ok &= (p[:, None, 1] >= lo[None, :, 1]) & (p[:, None, 1] <= hi[None, :, 1])
         n, s = np.nonzero(ok)
@@ -230,11 +233,17 @@ def run_cell(kind, n, m, repeat, brute_limit, check_limit):
         same = {k: sampled[k] and bool(np.array_equal(pairs[k], base)) for k in names}
         n_pairs = len(base)
     return {
-        "layout": kind, "N": n, "M": m, "widen": widen, "pairs": n_pairs,
+        "layout": kind,
+        "N": n,
+        "M": m,
+        "widen": widen,
+        "pairs": n_pairs,
         "time": {k: statistics.median(v) for k, v in times.items()},
         "spread": {k: (min(v), max(v)) for k, v in times.items()},
         "wall": {k: statistics.median(v) for k, v in walls.items()},
-        "same": same, "reference": ref_name, "repeats": {k: len(v) for k, v in times.items()},
+        "same": same,
+        "reference": ref_name,
+        "repeats": {k: len(v) for k, v in times.items()},
     }
 
 
@@ -274,9 +283,12 @@ def main(argv=None):
             for n in Ns:
                 r = run_cell(kind, n, m, repeat, args.brute_limit, args.check_limit)
                 rows.append(r)
-                print(f"{kind:5s} N={n:.0e} M={m:.0e} pairs={r['pairs']:>9d}  "
-                      + "  ".join(f"{k} {fmt_t(t)}" for k, t in r["time"].items())
-                      + f"  same={all(r['same'].values())} ({r['reference']})", flush=True)
+                print(
+                    f"{kind:5s} N={n:.0e} M={m:.0e} pairs={r['pairs']:>9d}  "
+                    + "  ".join(f"{k} {fmt_t(t)}" for k, t in r["time"].items())
+                    + f"  same={all(r['same'].values())} ({r['reference']})",
+                    flush=True,
+                )
     total = time.perf_counter() - t_start
     write_report(rows, Ns, Ms, repeat, total, args)
     bad = [r for r in rows if not all(r["same"].values())]
@@ -330,24 +342,32 @@ def write_report(rows, Ns, Ms, repeat, total, args):
         for r in rows:
             if r["layout"] != kind:
                 continue
-            check = ("all = " + r["reference"]) if all(r["same"].values()) else \
-                "MISMATCH: " + ", ".join(k for k, v in r["same"].items() if not v)
-            body.append([f"{r['N']:.0e}", f"{r['M']:.0e}", r["pairs"]]
-                        + [fmt_t(r["time"].get(k)) for k in methods] + [check])
+            check = (
+                ("all = " + r["reference"])
+                if all(r["same"].values())
+                else "MISMATCH: " + ", ".join(k for k, v in r["same"].items() if not v)
+            )
+            body.append(
+                [f"{r['N']:.0e}", f"{r['M']:.0e}", r["pairs"]] + [fmt_t(r["time"].get(k)) for k in methods] + [check]
+            )
         lines.append(table(hdr, body))
     # slopes
-    lines += ["## Observed complexity", "",
-              "Least-squares slope of log(time) against log(N) at fixed M, and against log(M) at "
-              "fixed N, as *all points / upper points* (upper: N ≥ 1e4, M ≥ 1e3, where the fixed costs "
-              "of a call no longer dominate).  The number of pairs found grows too: its slopes are given "
-              "for comparison (an output-sensitive method cannot beat them).  `brute` lists the points "
-              "it ran on.", ""]
+    lines += [
+        "## Observed complexity",
+        "",
+        "Least-squares slope of log(time) against log(N) at fixed M, and against log(M) at "
+        "fixed N, as *all points / upper points* (upper: N ≥ 1e4, M ≥ 1e3, where the fixed costs "
+        "of a call no longer dominate).  The number of pairs found grows too: its slopes are given "
+        "for comparison (an output-sensitive method cannot beat them).  `brute` lists the points "
+        "it ran on.",
+        "",
+    ]
 
     def slopes(sel, var, key):
         pts = [(r[var], key(r)) for r in sel if key(r) is not None]
         top = [(v, t) for v, t in pts if v >= (1e4 if var == "N" else 1e3)]
-        a = f"{slope(*zip(*pts)):.2f}" if len(pts) >= 2 else "—"
-        b = f"{slope(*zip(*top)):.2f}" if len(top) >= 2 else "—"
+        a = f"{slope(*zip(*pts, strict=False)):.2f}" if len(pts) >= 2 else "—"
+        b = f"{slope(*zip(*top, strict=False)):.2f}" if len(top) >= 2 else "—"
         return f"{a} / {b}" + (f" ({len(pts)} pts)" if len(pts) < len(sel) and len(pts) >= 2 else "")
 
     hdr = ["layout", "fixed", "pairs"] + methods
@@ -360,18 +380,26 @@ def write_report(rows, Ns, Ms, repeat, total, args):
                 cells += [slopes(sel, var, lambda r, k=k: r["time"].get(k)) for k in methods]
                 body.append([kind, f"vs {var}, {fixed_name} = {v:.0e}"] + cells)
     lines.append(table(hdr, body))
-    spread = {k: max(((r["spread"][k][1] - r["spread"][k][0]) / r["time"][k]) for r in rows if k in r["time"])
-              for k in methods}
-    lines += ["Noise: largest (max − min) / median of the repeats over all cells: "
-              + ", ".join(f"{k} {100 * v:.0f} %" for k, v in spread.items()) + ".", ""]
+    spread = {
+        k: max(((r["spread"][k][1] - r["spread"][k][0]) / r["time"][k]) for r in rows if k in r["time"])
+        for k in methods
+    }
+    lines += [
+        "Noise: largest (max − min) / median of the repeats over all cells: "
+        + ", ".join(f"{k} {100 * v:.0f} %" for k, v in spread.items())
+        + ".",
+        "",
+    ]
     # ratios at the largest cells
     lines += ["## Speed relative to buckets (time / buckets time, median)", ""]
     body = []
     for r in rows:
         if r["N"] == Ns[-1] or r["M"] == Ms[-1]:
             tb = r["time"]["buckets"]
-            body.append([r["layout"], f"{r['N']:.0e}", f"{r['M']:.0e}"]
-                        + [f"{r['time'][k] / tb:.2f}" if k in r["time"] else "—" for k in methods])
+            body.append(
+                [r["layout"], f"{r['N']:.0e}", f"{r['M']:.0e}"]
+                + [f"{r['time'][k] / tb:.2f}" if k in r["time"] else "—" for k in methods]
+            )
     lines.append(table(["layout", "N", "M"] + methods, body))
     lines += ["`contact_search.png` plots time against N for every M and method.", ""]
     (out / "contact_search.md").write_text("\n".join(lines) + "\n")
@@ -388,13 +416,18 @@ def plot(rows, Ns, Ms, path):
     fig, axes = plt.subplots(1, 2, figsize=(12, 5), sharey=True)
     styles = {"buckets": "o-", "binary": "s--", "brute": "x:", "kdtree": "^-."}
     colors = plt.cm.viridis(np.linspace(0, 0.85, len(Ms)))
-    for ax, kind in zip(axes, ("wall", "cloud")):
-        for m, col in zip(Ms, colors):
+    for ax, kind in zip(axes, ("wall", "cloud"), strict=False):
+        for m, col in zip(Ms, colors, strict=False):
             for k in METHODS:
                 sel = [r for r in rows if r["layout"] == kind and r["M"] == m and k in r["time"]]
                 if sel:
-                    ax.loglog([r["N"] for r in sel], [r["time"][k] for r in sel], styles[k], color=col,
-                              label=f"{k}, M = {m:.0e}")
+                    ax.loglog(
+                        [r["N"] for r in sel],
+                        [r["time"][k] for r in sel],
+                        styles[k],
+                        color=col,
+                        label=f"{k}, M = {m:.0e}",
+                    )
         nn = np.array([Ns[0], Ns[-1]], float)
         ax.loglog(nn, 2e-7 * nn, "k-", lw=0.5, alpha=0.5)
         ax.text(nn[-1], 2e-7 * nn[-1], " slope 1", fontsize=8)

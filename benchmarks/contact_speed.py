@@ -53,7 +53,7 @@ from _perf_common import RESULTS, load_average, machine, table  # noqa: E402
 EXAMPLES = ("bottle_blow_moulding", "cup_thermoforming", "stretch_blow_moulding")
 SIZES = (100, 1_000, 10_000, 100_000)
 
-SCALING_CHILD = r'''
+SCALING_CHILD = r"""
 import json, sys, time
 import numpy as np
 from axiform.contact.surfaces import Polyline
@@ -123,9 +123,9 @@ for faceted in (False, True):
             saved[f"{key}:{f}"] = getattr(p, f)
 np.savez(out, **saved)
 print(json.dumps(res))
-'''
+"""
 
-PROFILE_CHILD = r'''
+PROFILE_CHILD = r"""
 import cProfile, json, pstats, sys
 from axiform.cli import main
 case, out = sys.argv[1], sys.argv[2]
@@ -149,10 +149,10 @@ for label, (file, func) in want.items():
               [(v[1], v[3]) for (f, _, fn), v in st.items() if f.endswith(file) and fn == names[0]]
     res[label] = [sum(h[0] for h in hit), sum(h[1] for h in hit)]
 print("PROFILE " + json.dumps(res))
-'''
+"""
 
 
-SHARE_CHILD = r'''
+SHARE_CHILD = r"""
 import json, sys, time
 from axiform.model import terms
 from axiform.solve import paths
@@ -173,14 +173,16 @@ from axiform.cli import main
 case, out, sets = sys.argv[1], sys.argv[2], json.loads(sys.argv[3])
 main(["run", case, "--out", out, "-q", "--set", "output.plots=false"] + [a for v in sets for a in ("--set", v)])
 print("SHARE " + json.dumps(acc))
-'''
+"""
 # the share's cases: (example, --set overrides, label)
-SHARE_CASES = (("cup_thermoforming", [], "cup (100 x 2, 101 slaves a tool)"),
-               ("cup_thermoforming", ["mesh.divisions=[200,2]"], "cup 200 x 2"),
-               ("cup_thermoforming", ["mesh.divisions=[400,4]"], "cup 400 x 4"),
-               ("die_drawing", [], "die drawing"),
-               ("bottle_blow_moulding", [], "bottle"),
-               ("stretch_blow_moulding", [], "stretch blow moulding"))
+SHARE_CASES = (
+    ("cup_thermoforming", [], "cup (100 x 2, 101 slaves a tool)"),
+    ("cup_thermoforming", ["mesh.divisions=[200,2]"], "cup 200 x 2"),
+    ("cup_thermoforming", ["mesh.divisions=[400,4]"], "cup 400 x 4"),
+    ("die_drawing", [], "die drawing"),
+    ("bottle_blow_moulding", [], "bottle"),
+    ("stretch_blow_moulding", [], "stretch blow moulding"),
+)
 
 
 def env_for(src: Path) -> dict:
@@ -196,19 +198,26 @@ def fmt(t: float) -> str:
 def section_scaling(trees: dict[str, Path], repeat: int, tmp: Path) -> str:
     runs: dict[str, list[dict]] = {name: [] for name in trees}
     npz = {}
-    for r in range(repeat):  # child processes in turn: before, after, before, ...
+    for _r in range(repeat):  # child processes in turn: before, after, before, ...
         for name, src in trees.items():
             out = tmp / f"scaling_{name}.npz"
-            proc = subprocess.run([sys.executable, "-c", SCALING_CHILD, json.dumps(SIZES), "3", str(out)],
-                                  env=env_for(src), capture_output=True, text=True, check=True)
+            proc = subprocess.run(
+                [sys.executable, "-c", SCALING_CHILD, json.dumps(SIZES), "3", str(out)],
+                env=env_for(src),
+                capture_output=True,
+                text=True,
+                check=True,
+            )
             runs[name].append(json.loads(proc.stdout.strip().splitlines()[-1]))
             npz[name] = out
     a, b = (np.load(npz[n]) for n in trees)
     rows = []
     names = list(trees)
     for key in runs[names[0]][0]:
-        diff = max(float(np.max(np.abs(a[f"{key}:{f}"].astype(float) - b[f"{key}:{f}"].astype(float)), initial=0.0))
-                   for f in ("active", "g", "n", "t", "s", "kappa", "m", "point", "s_prev", "kind"))
+        diff = max(
+            float(np.max(np.abs(a[f"{key}:{f}"].astype(float) - b[f"{key}:{f}"].astype(float)), initial=0.0))
+            for f in ("active", "g", "n", "t", "s", "kappa", "m", "point", "s_prev", "kind")
+        )
         row = []
         for suffix in ("", "_new"):
             med = [statistics.median(run[key]["median" + suffix] for run in runs[n]) for n in names]
@@ -216,12 +225,27 @@ def section_scaling(trees: dict[str, Path], repeat: int, tmp: Path) -> str:
             row += [f"{fmt(mins[0])} / {fmt(med[0])}", f"{fmt(mins[1])} / {fmt(med[1])}", f"{med[0] / med[1]:.1f}"]
         info = runs[names[0]][0][key]
         rows.append([info["pieces"], key.split("/")[1], info["active"], *row, f"{diff:.1e}"])
-    return ("### `Polyline.local` against the number of slave nodes\n\n"
-            f"Per call, min / median over {repeat} child processes per tree in turn (3 timings each).  "
-            "*iteration*: the same last converged positions at every call (the iterations of a "
-            "step); *new step*: different ones at every call.\n\n"
-            + table(["pieces", "N", "in contact", f"iteration {names[0]}", f"iteration {names[1]}", "speed-up",
-                     f"new step {names[0]}", f"new step {names[1]}", "speed-up", "max |diff|"], rows))
+    return (
+        "### `Polyline.local` against the number of slave nodes\n\n"
+        f"Per call, min / median over {repeat} child processes per tree in turn (3 timings each).  "
+        "*iteration*: the same last converged positions at every call (the iterations of a "
+        "step); *new step*: different ones at every call.\n\n"
+        + table(
+            [
+                "pieces",
+                "N",
+                "in contact",
+                f"iteration {names[0]}",
+                f"iteration {names[1]}",
+                "speed-up",
+                f"new step {names[0]}",
+                f"new step {names[1]}",
+                "speed-up",
+                "max |diff|",
+            ],
+            rows,
+        )
+    )
 
 
 def section_share(trees: dict[str, Path], repeat: int, tmp: Path, examples: Path) -> str:
@@ -229,11 +253,23 @@ def section_share(trees: dict[str, Path], repeat: int, tmp: Path, examples: Path
     for _ in range(repeat):
         for example, sets, label in SHARE_CASES:
             for name, src in trees.items():
-                proc = subprocess.run([sys.executable, "-c", SHARE_CHILD, str(examples / f"{example}.toml"),
-                                       str(tmp / f"share_{name}"), json.dumps(sets)], env=env_for(src),
-                                      capture_output=True, text=True, cwd=ROOT, check=True)
+                proc = subprocess.run(
+                    [
+                        sys.executable,
+                        "-c",
+                        SHARE_CHILD,
+                        str(examples / f"{example}.toml"),
+                        str(tmp / f"share_{name}"),
+                        json.dumps(sets),
+                    ],
+                    env=env_for(src),
+                    capture_output=True,
+                    text=True,
+                    cwd=ROOT,
+                    check=True,
+                )
                 line = next(s for s in proc.stdout.splitlines() if s.startswith("SHARE "))
-                got.setdefault((label, name), []).append(json.loads(line[len("SHARE "):]))
+                got.setdefault((label, name), []).append(json.loads(line[len("SHARE ") :]))
     names = list(trees)
     rows = []
     for _, _, label in SHARE_CASES:
@@ -242,22 +278,28 @@ def section_share(trees: dict[str, Path], repeat: int, tmp: Path, examples: Path
             best = min(got[(label, n)], key=lambda a: a["solve"])
             row.append(f"{best['contact']:.2f} / {best['solve']:.2f} s = {best['contact'] / best['solve']:.0%}")
         rows.append(row)
-    return ("### The share of contact in the solver's time\n\n"
-            f"Contact evaluations / the load path's steps, wall time, the run with the shortest solve of {repeat}, "
-            "plots off, the trees in turn.\n\n" + table(["case"] + names, rows))
+    return (
+        "### The share of contact in the solver's time\n\n"
+        f"Contact evaluations / the load path's steps, wall time, the run with the shortest solve of {repeat}, "
+        "plots off, the trees in turn.\n\n" + table(["case"] + names, rows)
+    )
 
 
 def section_process(trees: dict[str, Path], repeat: int, tmp: Path, examples: Path) -> str:
     times: dict[tuple[str, str], list[float]] = {}
     steps = {}
-    for r in range(repeat):
+    for _r in range(repeat):
         for ex in EXAMPLES:
             for name, src in trees.items():
                 out = tmp / f"{ex}_{name}"
                 t = time.perf_counter()
-                proc = subprocess.run([sys.executable, "-m", "axiform.cli", "run", str(examples / f"{ex}.toml"),
-                                       "--out", str(out), "-q"], env=env_for(src), capture_output=True, text=True,
-                                      cwd=ROOT)
+                proc = subprocess.run(
+                    [sys.executable, "-m", "axiform.cli", "run", str(examples / f"{ex}.toml"), "--out", str(out), "-q"],
+                    env=env_for(src),
+                    capture_output=True,
+                    text=True,
+                    cwd=ROOT,
+                )
                 wall = time.perf_counter() - t
                 if proc.returncode:
                     raise RuntimeError(proc.stdout[-2000:] + proc.stderr[-2000:])
@@ -267,32 +309,50 @@ def section_process(trees: dict[str, Path], repeat: int, tmp: Path, examples: Pa
     names = list(trees)
     rows = []
     for ex in EXAMPLES:
-        row = [ex, " → ".join(", ".join(s.strip() for s in steps[(ex, n)]).replace("axiform: finished after ", "")
-                             for n in names)]
+        row = [
+            ex,
+            " → ".join(
+                ", ".join(s.strip() for s in steps[(ex, n)]).replace("axiform: finished after ", "") for n in names
+            ),
+        ]
         for n in names:
             row.append(f"{min(times[(ex, n)]):.1f} / {statistics.median(times[(ex, n)]):.1f} s")
         row.append(f"{statistics.median(times[(ex, names[0])]) / statistics.median(times[(ex, names[1])]):.2f}")
         rows.append(row)
-    return ("### Whole process, the three process examples\n\n"
-            f"`axiform run {examples}/NAME.toml --out DIR -q` (outputs as in the case files, plots included), "
-            f"wall time min / median of {repeat} runs, the trees in turn.\n\n"
-            + table(["example", "steps, iterations", names[0], names[1], "speed-up (median)"], rows))
+    return (
+        "### Whole process, the three process examples\n\n"
+        f"`axiform run {examples}/NAME.toml --out DIR -q` (outputs as in the case files, plots included), "
+        f"wall time min / median of {repeat} runs, the trees in turn.\n\n"
+        + table(["example", "steps, iterations", names[0], names[1], "speed-up (median)"], rows)
+    )
 
 
 def section_profile(trees: dict[str, Path], tmp: Path) -> str:
     res = {}
     for name, src in trees.items():
-        proc = subprocess.run([sys.executable, "-c", PROFILE_CHILD, str(ROOT / "examples" / "cup_thermoforming.toml"),
-                               str(tmp / f"prof_{name}")], env=env_for(src), capture_output=True, text=True, cwd=ROOT,
-                              check=True)
+        proc = subprocess.run(
+            [
+                sys.executable,
+                "-c",
+                PROFILE_CHILD,
+                str(ROOT / "examples" / "cup_thermoforming.toml"),
+                str(tmp / f"prof_{name}"),
+            ],
+            env=env_for(src),
+            capture_output=True,
+            text=True,
+            cwd=ROOT,
+            check=True,
+        )
         line = next(s for s in (proc.stdout + proc.stderr).splitlines() if s.startswith("PROFILE "))
-        res[name] = json.loads(line[len("PROFILE "):])
+        res[name] = json.loads(line[len("PROFILE ") :])
     names = list(trees)
-    rows = [[label] + [f"{res[n][label][1]:.2f} s ({res[n][label][0]})" for n in names]
-            for label in res[names[0]]]
-    return ("### Profile of the cup example (cProfile, cumulative seconds and calls)\n\n"
-            "cProfile adds a cost to every Python call: the many small calls of contact weigh more "
-            "than they do unprofiled.\n\n" + table(["function"] + names, rows))
+    rows = [[label] + [f"{res[n][label][1]:.2f} s ({res[n][label][0]})" for n in names] for label in res[names[0]]]
+    return (
+        "### Profile of the cup example (cProfile, cumulative seconds and calls)\n\n"
+        "cProfile adds a cost to every Python call: the many small calls of contact weigh more "
+        "than they do unprofiled.\n\n" + table(["function"] + names, rows)
+    )
 
 
 def main() -> None:
@@ -301,15 +361,21 @@ def main() -> None:
     ap.add_argument("--after", type=Path, default=ROOT / "src", help="src/ of the tree after (default: this tree)")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--only", choices=["scaling", "process", "profile", "share"], action="append")
-    ap.add_argument("--examples", type=Path, default=ROOT / "examples",
-                    help="the folder of the case files run by 'process' and 'share' (default: this tree's)")
+    ap.add_argument(
+        "--examples",
+        type=Path,
+        default=ROOT / "examples",
+        help="the folder of the case files run by 'process' and 'share' (default: this tree's)",
+    )
     args = ap.parse_args()
     trees = {"before": args.before.resolve(), "after": args.after.resolve()}
     only = args.only or ["scaling", "process", "profile", "share"]
     examples = args.examples.resolve()
-    parts = [f"## Contact speed, before / after ({datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC)\n",
-             f"Machine: {machine()}; load average at the start {load_average()}.\n",
-             f"before: `{trees['before']}`, after: `{trees['after']}`.\n"]
+    parts = [
+        f"## Contact speed, before / after ({datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC)\n",
+        f"Machine: {machine()}; load average at the start {load_average()}.\n",
+        f"before: `{trees['before']}`, after: `{trees['after']}`.\n",
+    ]
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         if "scaling" in only:

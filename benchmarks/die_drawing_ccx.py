@@ -60,7 +60,7 @@ TRAVEL = 3.0
 
 def _lines(ids, per=12):
     ids = [str(int(i)) for i in ids]
-    return [", ".join(ids[k:k + per]) for k in range(0, len(ids), per)]
+    return [", ".join(ids[k : k + per]) for k in range(0, len(ids), per)]
 
 
 def sample(surface, h: float, arc_deg: float = 2.0, r_min: float = 0.0) -> np.ndarray:
@@ -112,14 +112,14 @@ def ccx_deck(built, friction: bool, penalty: float, incr: float) -> str:
     out += [f"{e + 1}, " + ", ".join(str(k + 1) for k in c) for e, c in enumerate(C)]
     nn, ne = len(P), len(C)
     tools = []
-    for name, pair in zip(("PUNCH", "DIE"), built.model.contacts):
+    for name, pair in zip(("PUNCH", "DIE"), built.model.contacts, strict=False):
         pts = sample(pair.surface, 0.025)
         nodes, cells = tool_strip(pts, 0.2)
         ids = nn + 1 + np.arange(len(nodes))
         eids = ne + 1 + np.arange(len(cells))
-        out += ["*NODE, NSET=" + name] + [f"{i}, {x:.15g}, {y:.15g}" for i, (x, y) in zip(ids, nodes)]
+        out += ["*NODE, NSET=" + name] + [f"{i}, {x:.15g}, {y:.15g}" for i, (x, y) in zip(ids, nodes, strict=False)]
         out += [f"*ELEMENT, TYPE=CAX4, ELSET=E{name}"]
-        out += [f"{e}, " + ", ".join(str(nn + 1 + k) for k in c) for e, c in zip(eids, cells)]
+        out += [f"{e}, " + ", ".join(str(nn + 1 + k) for k in c) for e, c in zip(eids, cells, strict=False)]
         out += [f"*SURFACE, NAME=M{name}"] + [f"{e}, S3" for e in eids]
         tools.append((name, pair))
         nn += len(nodes)
@@ -138,29 +138,55 @@ def ccx_deck(built, friction: bool, penalty: float, incr: float) -> str:
     for sname, zf in (("STOP", 0.3), ("SBOTTOM", 0.0)):
         on = np.abs(P[C[:, :4][:, ends], 1] - zf).max(axis=2) < tol  # (e, 4) faces on z = zf
         on &= P[C[:, :4][:, ends], 0].min(axis=2) > tol  # a slave node on the axis: singular in ccx
-        out += [f"*SURFACE, NAME={sname}"] + [f"{e + 1}, S{f + 1}" for e, f in zip(*np.nonzero(on))]
-    out += ["*MATERIAL, NAME=MR", "*HYPERELASTIC, MOONEY-RIVLIN", f"{mat.C1:.15g}, {mat.C2:.15g}, {2.0 / mat.kappa:.15g}",
-            "*SOLID SECTION, ELSET=SHEET, MATERIAL=MR",
-            "*MATERIAL, NAME=STEEL", "*ELASTIC", "1e6, 0.3",
-            "*SOLID SECTION, ELSET=EPUNCH, MATERIAL=STEEL", "*SOLID SECTION, ELSET=EDIE, MATERIAL=STEEL"]
-    for (name, pair), slave in zip(tools, ("STOP", "SBOTTOM")):
-        out += [f"*CONTACT PAIR, INTERACTION=I{name}, TYPE=NODE TO SURFACE", f"{slave}, M{name}",
-                f"*SURFACE INTERACTION, NAME=I{name}", "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR",
-                f"{penalty:.15g}, 1e-6, 1e-3"]
+        out += [f"*SURFACE, NAME={sname}"] + [f"{e + 1}, S{f + 1}" for e, f in zip(*np.nonzero(on), strict=False)]
+    out += [
+        "*MATERIAL, NAME=MR",
+        "*HYPERELASTIC, MOONEY-RIVLIN",
+        f"{mat.C1:.15g}, {mat.C2:.15g}, {2.0 / mat.kappa:.15g}",
+        "*SOLID SECTION, ELSET=SHEET, MATERIAL=MR",
+        "*MATERIAL, NAME=STEEL",
+        "*ELASTIC",
+        "1e6, 0.3",
+        "*SOLID SECTION, ELSET=EPUNCH, MATERIAL=STEEL",
+        "*SOLID SECTION, ELSET=EDIE, MATERIAL=STEEL",
+    ]
+    for (name, pair), slave in zip(tools, ("STOP", "SBOTTOM"), strict=False):
+        out += [
+            f"*CONTACT PAIR, INTERACTION=I{name}, TYPE=NODE TO SURFACE",
+            f"{slave}, M{name}",
+            f"*SURFACE INTERACTION, NAME=I{name}",
+            "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR",
+            f"{penalty:.15g}, 1e-6, 1e-3",
+        ]
         if friction and pair.mu > 0:
             out += ["*FRICTION", f"{pair.mu:.15g}, {penalty:.15g}"]
-    out += ["*BOUNDARY", "AXIS, 1, 1", "HOLDER, 2, 2", "DIE, 1, 2", "PUNCH, 1, 1",
-            "*STEP, NLGEOM, INC=100000", "*STATIC", f"{incr:.6g}, 1.0, 1e-7, {incr:.6g}",
-            "*BOUNDARY", f"PUNCH, 2, 2, {-TRAVEL:.15g}",
-            "*NODE PRINT, NSET=CENTRE", "U",
-            "*NODE PRINT, NSET=PUNCH, TOTALS=ONLY", "RF",
-            "*NODE PRINT, NSET=TOP", "U",
-            "*END STEP", ""]
+    out += [
+        "*BOUNDARY",
+        "AXIS, 1, 1",
+        "HOLDER, 2, 2",
+        "DIE, 1, 2",
+        "PUNCH, 1, 1",
+        "*STEP, NLGEOM, INC=100000",
+        "*STATIC",
+        f"{incr:.6g}, 1.0, 1e-7, {incr:.6g}",
+        "*BOUNDARY",
+        f"PUNCH, 2, 2, {-TRAVEL:.15g}",
+        "*NODE PRINT, NSET=CENTRE",
+        "U",
+        "*NODE PRINT, NSET=PUNCH, TOTALS=ONLY",
+        "RF",
+        "*NODE PRINT, NSET=TOP",
+        "U",
+        "*END STEP",
+        "",
+    ]
     return "\n".join(out)
 
 
-_BLOCK = re.compile(r"(displacements \(vx,vy,vz\)|total force \(fx,fy,fz\)) for set (\w+) and time\s+([-+0-9.Ee]+)\s*\n\s*\n"
-                    r"((?:[ \t]*[-+0-9.Ee]+(?:[ \t]+[-+0-9.Ee]+)+[ \t]*\n)+)")
+_BLOCK = re.compile(
+    r"(displacements \(vx,vy,vz\)|total force \(fx,fy,fz\)) for set (\w+) and time\s+([-+0-9.Ee]+)\s*\n\s*\n"
+    r"((?:[ \t]*[-+0-9.Ee]+(?:[ \t]+[-+0-9.Ee]+)+[ \t]*\n)+)"
+)
 
 
 def run_ccx(deck: str, name: str) -> dict:
@@ -185,8 +211,14 @@ def run_ccx(deck: str, name: str) -> dict:
         (WORK / f"{name}{ext}").unlink(missing_ok=True)
     (WORK / "spooles.out").unlink(missing_ok=True)
     ok = proc.returncode == 0 and "Job finished" in proc.stdout and len(t) and abs(t[-1] - 1.0) < 1e-9
-    return {"t": t, "uz": uz, "fz": fz, "top": top, "ok": bool(ok),
-            "message": "" if ok else (proc.stdout[-800:] + proc.stderr[-300:]).strip()}
+    return {
+        "t": t,
+        "uz": uz,
+        "fz": fz,
+        "top": top,
+        "ok": bool(ok),
+        "message": "" if ok else (proc.stdout[-800:] + proc.stderr[-300:]).strip(),
+    }
 
 
 def ring_factor(penalty: float) -> float:
@@ -200,16 +232,34 @@ def ring_factor(penalty: float) -> float:
     n = len(P)
     deck = ["*NODE"] + [f"{i + 1}, {x:.15g}, {y:.15g}" for i, (x, y) in enumerate(P)]
     deck += ["*NODE, NSET=TOOL"] + [f"{n + i + 1}, {x:.15g}, {y:.15g}" for i, (x, y) in enumerate(tool_nodes)]
-    deck += ["*ELEMENT, TYPE=CAX4, ELSET=E"] + [f"{e + 1}, " + ", ".join(str(k + 1) for k in c) for e, c in enumerate(cells)]
-    deck += ["*ELEMENT, TYPE=CAX4, ELSET=ET"] + [f"{100 + e}, " + ", ".join(str(n + k + 1) for k in c)
-                                                 for e, c in enumerate(tool_cells)]
+    deck += ["*ELEMENT, TYPE=CAX4, ELSET=E"] + [
+        f"{e + 1}, " + ", ".join(str(k + 1) for k in c) for e, c in enumerate(cells)
+    ]
+    deck += ["*ELEMENT, TYPE=CAX4, ELSET=ET"] + [
+        f"{100 + e}, " + ", ".join(str(n + k + 1) for k in c) for e, c in enumerate(tool_cells)
+    ]
     deck += ["*SURFACE, NAME=MT"] + [f"{100 + e}, S3" for e in range(len(tool_cells))]
     deck += ["*SURFACE, NAME=SB"] + [f"{e + 1}, S1" for e in range(10)]
-    deck += ["*NSET, NSET=HOLD", "21", "*MATERIAL, NAME=M", "*ELASTIC", "1000, 0.3",
-             "*SOLID SECTION, ELSET=E, MATERIAL=M", "*SOLID SECTION, ELSET=ET, MATERIAL=M",
-             "*CONTACT PAIR, INTERACTION=I, TYPE=NODE TO SURFACE", "SB, MT", "*SURFACE INTERACTION, NAME=I",
-             "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR", f"{penalty:.15g}, 1e-6, 1e-3",
-             "*BOUNDARY", "TOOL, 1, 2", "HOLD, 1, 1", "*STEP, NLGEOM", "*STATIC", "*DLOAD"]
+    deck += [
+        "*NSET, NSET=HOLD",
+        "21",
+        "*MATERIAL, NAME=M",
+        "*ELASTIC",
+        "1000, 0.3",
+        "*SOLID SECTION, ELSET=E, MATERIAL=M",
+        "*SOLID SECTION, ELSET=ET, MATERIAL=M",
+        "*CONTACT PAIR, INTERACTION=I, TYPE=NODE TO SURFACE",
+        "SB, MT",
+        "*SURFACE INTERACTION, NAME=I",
+        "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR",
+        f"{penalty:.15g}, 1e-6, 1e-3",
+        "*BOUNDARY",
+        "TOOL, 1, 2",
+        "HOLD, 1, 1",
+        "*STEP, NLGEOM",
+        "*STATIC",
+        "*DLOAD",
+    ]
     deck += [f"{e + 1}, P3, 1.0" for e in range(10)]
     deck += ["*NODE PRINT, NSET=TOOL, TOTALS=ONLY", "RF", "*END STEP", ""]
     WORK.mkdir(parents=True, exist_ok=True)
@@ -240,8 +290,14 @@ def run_axiform(friction: bool, penalty: float, element: str, formulation: str |
         sets += ["contact[0].friction=0.0", "contact[1].friction=0.0"]
     built = build(load(CASE, sets), CASE.parent)
     punch = built.model.contacts[0]
-    centre = int(built.model.dof(np.flatnonzero((np.abs(built.model.mesh.points[:, 0]) < 1e-9)
-                                                & (np.abs(built.model.mesh.points[:, 1] - 0.3) < 1e-9))[0], "uz"))
+    centre = int(
+        built.model.dof(
+            np.flatnonzero(
+                (np.abs(built.model.mesh.points[:, 0]) < 1e-9) & (np.abs(built.model.mesh.points[:, 1] - 0.3) < 1e-9)
+            )[0],
+            "uz",
+        )
+    )
     t, uz, fz = [0.0], [0.0], [0.0]
 
     def record(step):
@@ -255,9 +311,19 @@ def run_axiform(friction: bool, penalty: float, element: str, formulation: str |
     top = np.flatnonzero(np.abs(built.model.mesh.points[:, 1] - 0.3) < 1e-9)
     x = built.model.mesh.points[top] + res.last.u.reshape(-1, built.model.dpn)[top, :2]
     rep = punch.report(res.last.state.contacts[0])
-    return {"t": np.array(t), "uz": np.array(uz), "fz": np.array(fz), "x_top": x[np.argsort(x[:, 0])],
-            "status": res.status, "steps": len(res.steps), "iterations": res.newton_iterations,
-            "open": int((rep["status"] == 0).sum()), "slaves": len(rep["status"]), "built": built, "wall": wall}
+    return {
+        "t": np.array(t),
+        "uz": np.array(uz),
+        "fz": np.array(fz),
+        "x_top": x[np.argsort(x[:, 0])],
+        "status": res.status,
+        "steps": len(res.steps),
+        "iterations": res.newton_iterations,
+        "open": int((rep["status"] == 0).sum()),
+        "slaves": len(rep["status"]),
+        "built": built,
+        "wall": wall,
+    }
 
 
 def main(argv=None) -> int:
@@ -279,15 +345,17 @@ def main(argv=None) -> int:
     factor = ring_factor(penalty)
     print(f"ccx ring factor {factor:.6g}; penalty K = {penalty:.6g}")
     runs = []
-    for friction in ((True,) if args.quick else (True, False)):
+    for friction in (True,) if args.quick else (True, False):
         ax = run_axiform(friction, penalty, element)
         deck = ccx_deck(ax["built"], friction, penalty, 0.02 if args.quick else 0.01)
         name = f"die_{element}_{'friction' if friction else 'frictionless'}"
         cc = run_ccx(deck, name)
         cc["fz"] = factor * cc["fz"]  # the punch's reaction: its force on the sheet, whole ring
         runs.append((friction, ax, cc))
-        print(f"{name}: axiform {ax['status']} {ax['steps']} steps; ccx {'finished' if cc['ok'] else 'stopped'} "
-              f"{len(cc['t'])} increments; end gap axiform {-TRAVEL - ax['uz'][-1] * 1 + 0:.4f}")
+        print(
+            f"{name}: axiform {ax['status']} {ax['steps']} steps; ccx {'finished' if cc['ok'] else 'stopped'} "
+            f"{len(cc['t'])} increments; end gap axiform {-TRAVEL - ax['uz'][-1] * 1 + 0:.4f}"
+        )
     report(runs, element, penalty, factor)
     return 0
 
@@ -309,10 +377,14 @@ def timing(repeat: int) -> int:
     fa, fc = -ax["fz"][-1], -factor * cc["fz"][-1]
     print(f"source: {SRC}")
     print("| | wall min / median | steps, iterations | punch force at travel 3 |\n|---|---:|---:|---:|")
-    print(f"| axiform Q4, displacement | {min(ta):.2f} / {np.median(ta):.2f} s | {ax['steps']}, {ax['iterations']} | "
-          f"{fa:.4f} |")
-    print(f"| CalculiX CAX4 | {min(tc):.2f} / {np.median(tc):.2f} s | {len(cc['t'])} increments | {fc:.4f} "
-          f"({100 * (fa / fc - 1):+.2f} %) |")
+    print(
+        f"| axiform Q4, displacement | {min(ta):.2f} / {np.median(ta):.2f} s | {ax['steps']}, {ax['iterations']} | "
+        f"{fa:.4f} |"
+    )
+    print(
+        f"| CalculiX CAX4 | {min(tc):.2f} / {np.median(tc):.2f} s | {len(cc['t'])} increments | {fc:.4f} "
+        f"({100 * (fa / fc - 1):+.2f} %) |"
+    )
     print(f"| ratio axiform / CalculiX | {min(ta) / min(tc):.3f} / {np.median(ta) / np.median(tc):.3f} | | |")
     return 0
 
@@ -329,11 +401,17 @@ def report(runs, element, penalty, factor):
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.6))
-    L = ["# Die drawing: axiform against CalculiX", "",
-         (f"Element {element.upper()} / {'CAX8' if element == 'q8' else 'CAX4'}; penalty K = {penalty:.4g} per unit "
-          f"area (both codes); ccx ring factor {factor:.4g}."), "",
-         "| friction | travel | punch force axiform | punch force ccx | diff | centre gap axiform | centre gap ccx |",
-         "|---|---:|---:|---:|---:|---:|---:|"]
+    L = [
+        "# Die drawing: axiform against CalculiX",
+        "",
+        (
+            f"Element {element.upper()} / {'CAX8' if element == 'q8' else 'CAX4'}; penalty K = {penalty:.4g} per unit "
+            f"area (both codes); ccx ring factor {factor:.4g}."
+        ),
+        "",
+        "| friction | travel | punch force axiform | punch force ccx | diff | centre gap axiform | centre gap ccx |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+    ]
     for friction, a, c in runs:
         tag = "mu 0.1 / 0.3" if friction else "none"
         style = "-" if friction else "--"
@@ -356,12 +434,16 @@ def report(runs, element, penalty, factor):
         for s in (0.5, 1.0, 1.5, 2.0, 2.5, 3.0):
             fa = np.interp(s / TRAVEL, a["t"], a["fz"])
             fc = np.interp(s / TRAVEL, c["t"], c["fz"]) if len(c["t"]) and c["t"][-1] >= s / TRAVEL - 1e-9 else np.nan
-            L.append(f"| {tag} | {s:g} | {-fa:.4g} | {-fc:.4g} | {100 * (fc / fa - 1):+.1f} % | "
-                     f"{np.interp(s / TRAVEL, a['t'], ga):.4f} | "
-                     f"{np.interp(s / TRAVEL, c['t'], gc) if not np.isnan(fc) else np.nan:.4f} |")
-        L.append(f"| {tag} | runs | axiform {a['status']}, {a['steps']} steps, {a['iterations']} iterations, "
-                 f"{a['open']} of {a['slaves']} punch slaves open | ccx {'finished' if c['ok'] else 'stopped: ' + c['message'][-200:]}, "
-                 f"{len(c['t'])} increments | | | |")
+            L.append(
+                f"| {tag} | {s:g} | {-fa:.4g} | {-fc:.4g} | {100 * (fc / fa - 1):+.1f} % | "
+                f"{np.interp(s / TRAVEL, a['t'], ga):.4f} | "
+                f"{np.interp(s / TRAVEL, c['t'], gc) if not np.isnan(fc) else np.nan:.4f} |"
+            )
+        L.append(
+            f"| {tag} | runs | axiform {a['status']}, {a['steps']} steps, {a['iterations']} iterations, "
+            f"{a['open']} of {a['slaves']} punch slaves open | ccx {'finished' if c['ok'] else 'stopped: ' + c['message'][-200:]}, "
+            f"{len(c['t'])} increments | | | |"
+        )
     ax[0].set(xlabel="punch travel", ylabel="punch force (whole ring)", title="punch force")
     ax[1].set(xlabel="punch travel", ylabel="gap punch face - sheet centre", title="centre gap")
     ax[2].set(xlabel="r", ylabel="z", title="top face of the sheet at travel 3", xlim=(-0.1, 4.5))

@@ -39,10 +39,11 @@ ROOT = HERE.parent
 sys.path[:0] = [str(ROOT / "src"), str(ROOT / "tests"), str(HERE)]
 
 from _ccx import element_faces, mesh_cards, node_tables, node_values, run  # noqa: E402
+from test_heat import ALPHA, RHO, C, K, slab_series  # noqa: E402
+
 from axiform import rectangle, select_edges, solve  # noqa: E402
 from axiform.case.schema import build, parse  # noqa: E402
 from axiform.fem.heat import Conduction, Film, constant  # noqa: E402
-from test_heat import ALPHA, C, K, RHO, slab_series  # noqa: E402
 
 RESULTS = HERE / "results"
 WORK = RESULTS / "heat_ccx"
@@ -59,18 +60,31 @@ def deck(mesh, films: list[Film], dt: float, t_end: float, every: int, initial: 
     of each film, *HEAT TRANSFER DIRECT with increments dt, node temperatures every `every`
     increments."""
     out = ["*HEADING", "heat conduction against axiform"] + mesh_cards(mesh, "WALL")
-    out += ["*MATERIAL, NAME=M", "*CONDUCTIVITY", f"{K:.15g}", "*DENSITY", f"{RHO:.15g}",
-            "*SPECIFIC HEAT", f"{C:.15g}", "*SOLID SECTION, ELSET=WALL, MATERIAL=M",
-            "*INITIAL CONDITIONS, TYPE=TEMPERATURE", f"NALL, {initial:.15g}",
-            "*STEP, INC=100000", "*HEAT TRANSFER, DIRECT", f"{dt:.15g}, {t_end:.15g}", "*FILM"]
+    out += [
+        "*MATERIAL, NAME=M",
+        "*CONDUCTIVITY",
+        f"{K:.15g}",
+        "*DENSITY",
+        f"{RHO:.15g}",
+        "*SPECIFIC HEAT",
+        f"{C:.15g}",
+        "*SOLID SECTION, ELSET=WALL, MATERIAL=M",
+        "*INITIAL CONDITIONS, TYPE=TEMPERATURE",
+        f"NALL, {initial:.15g}",
+        "*STEP, INC=100000",
+        "*HEAT TRANSFER, DIRECT",
+        f"{dt:.15g}, {t_end:.15g}",
+        "*FILM",
+    ]
     for film in films:
         out += [f"{e}, F{f}, {film.ambient(0.0):.15g}, {film.h:.15g}" for e, f in element_faces(mesh, film.edges)]
     out += [f"*NODE PRINT, NSET=NALL, FREQUENCY={every}", "NT", "*END STEP", ""]
     return "\n".join(out)
 
 
-def run_ccx(name: str, mesh, films: list[Film], dt: float, steps: int, every: int, repeat: int = 1,
-            initial: float = T0) -> dict:
+def run_ccx(
+    name: str, mesh, films: list[Film], dt: float, steps: int, every: int, repeat: int = 1, initial: float = T0
+) -> dict:
     """ccx on the deck: {time: T (n,)} at every `every`-th increment, the best wall and CPU
     times."""
     walls, cpus, res = [], [], None
@@ -84,8 +98,9 @@ def run_ccx(name: str, mesh, films: list[Film], dt: float, steps: int, every: in
     return {"T": T, "wall_s": min(walls), "cpu_s": min(cpus)}
 
 
-def run_axiform(conduction: Conduction, dt: float, steps: int, every: int, repeat: int = 1,
-                initial: float = T0) -> dict:
+def run_axiform(
+    conduction: Conduction, dt: float, steps: int, every: int, repeat: int = 1, initial: float = T0
+) -> dict:
     """Backward Euler steps of dt from `initial` on the reference positions: {time: T (n,)}
     every `every` steps, the best wall and CPU times."""
     walls, cpus = [], []
@@ -213,14 +228,24 @@ def tube() -> dict:
     for _ in range(REPEAT):
         again = build(parse(data))
         start, cpu = time.perf_counter(), time.process_time()
-        res = solve(again.model, again.control, again.options,
-                    on_step=lambda s: case_T.__setitem__(round(s.lam, 9), s.state.temperature.copy()))
+        res = solve(
+            again.model,
+            again.control,
+            again.options,
+            on_step=lambda s: case_T.__setitem__(round(s.lam, 9), s.state.temperature.copy()),
+        )
         walls.append(time.perf_counter() - start)
         cpus.append(time.process_time() - cpu)
         if res.status != "finished":
             raise RuntimeError(f"the tube's case: {res.status} {res.message}")
-    return {"mesh": mesh, "dt": dt, "ax": ax, "ccx": cc, "case": {"T": case_T, "wall_s": min(walls), "cpu_s": min(cpus)},
-            "times": sorted(ax["T"])}
+    return {
+        "mesh": mesh,
+        "dt": dt,
+        "ax": ax,
+        "ccx": cc,
+        "case": {"T": case_T, "wall_s": min(walls), "cpu_s": min(cpus)},
+        "times": sorted(ax["T"]),
+    }
 
 
 def main() -> int:
@@ -244,60 +269,97 @@ def main() -> int:
 def report(scheme: dict, slabs: list[dict], wall: dict) -> list[str]:
     """The tables of results/heat_ccx.md."""
     span = T0 - T_INF
-    out = ["# Heat conduction: axiform against CalculiX (*HEAT TRANSFER, CAX8, *FILM)", "",
-           "Written by `benchmarks/heat_ccx.py`; same meshes, same fixed time steps in both codes. "
-           "Differences are max over all nodes, in % of T0 - T_inf = 125 (the tube: of its range 150 - 25).", "",
-           "## Which time integration ccx uses", "",
-           f"A slab 1 x 4 Q8, Bi = 2, two steps of dt = {scheme['dt']:g} s (Fo 0.105 each): ccx against axiform's "
-           "backward Euler and against Crank-Nicolson built from axiform's matrices.", "",
-           "| Fo | max abs(ccx - backward Euler) | max abs(ccx - Crank-Nicolson) |", "|---:|---:|---:|"]
+    out = [
+        "# Heat conduction: axiform against CalculiX (*HEAT TRANSFER, CAX8, *FILM)",
+        "",
+        "Written by `benchmarks/heat_ccx.py`; same meshes, same fixed time steps in both codes. "
+        "Differences are max over all nodes, in % of T0 - T_inf = 125 (the tube: of its range 150 - 25).",
+        "",
+        "## Which time integration ccx uses",
+        "",
+        f"A slab 1 x 4 Q8, Bi = 2, two steps of dt = {scheme['dt']:g} s (Fo 0.105 each): ccx against axiform's "
+        "backward Euler and against Crank-Nicolson built from axiform's matrices.",
+        "",
+        "| Fo | max abs(ccx - backward Euler) | max abs(ccx - Crank-Nicolson) |",
+        "|---:|---:|---:|",
+    ]
     out += [f"| {fo:.3f} | {be:.2e} | {cn:.2e} |" for fo, be, cn in scheme["rows"]]
-    out += ["", "ccx integrates `*HEAT TRANSFER` in time by backward Euler, as axiform: it matches to its printed "
-            "digits where Crank-Nicolson is tens of degrees away at these big steps. Its capacity is the "
-            "consistent one, int rho c N N^T dV, as axiform's (its element routine lumps only for explicit "
-            "dynamics). Its CAX8 is a 20-node brick over a thin wedge integrated 3 x 3 x 3, its film 3 x 3 over "
-            "the face; axiform integrates 3 x 3 in the meridian plane and 3 points along the edge with the "
-            "weight 2 pi r: both exact on these straight-sided meshes. The two codes solve the same discrete "
-            "equations, and the differences below (at most 5e-5 degree) are the rounding of ccx's .dat output "
-            "(7 significant digits): the same slab at Bi = 2 cooled from 1 into 0, where ccx prints more digits "
-            "after the point, differs by " + " and ".join(f"{d:.1e} at Fo {fo:g}" for fo, d in scheme["unit"].items())
-            + " of T0 - T_inf."]
-    out += ["", "## Slab (r 10..11, z 0..2, 1 x 24 elements, film on z = 2), 200 steps to Fo = 0.5", "",
-            "| element | Bi | Fo | axiform - ccx | axiform - series | ccx - series |", "|---|---:|---:|---:|---:|---:|"]
+    out += [
+        "",
+        "ccx integrates `*HEAT TRANSFER` in time by backward Euler, as axiform: it matches to its printed "
+        "digits where Crank-Nicolson is tens of degrees away at these big steps. Its capacity is the "
+        "consistent one, int rho c N N^T dV, as axiform's (its element routine lumps only for explicit "
+        "dynamics). Its CAX8 is a 20-node brick over a thin wedge integrated 3 x 3 x 3, its film 3 x 3 over "
+        "the face; axiform integrates 3 x 3 in the meridian plane and 3 points along the edge with the "
+        "weight 2 pi r: both exact on these straight-sided meshes. The two codes solve the same discrete "
+        "equations, and the differences below (at most 5e-5 degree) are the rounding of ccx's .dat output "
+        "(7 significant digits): the same slab at Bi = 2 cooled from 1 into 0, where ccx prints more digits "
+        "after the point, differs by "
+        + " and ".join(f"{d:.1e} at Fo {fo:g}" for fo, d in scheme["unit"].items())
+        + " of T0 - T_inf.",
+    ]
+    out += [
+        "",
+        "## Slab (r 10..11, z 0..2, 1 x 24 elements, film on z = 2), 200 steps to Fo = 0.5",
+        "",
+        "| element | Bi | Fo | axiform - ccx | axiform - series | ccx - series |",
+        "|---|---:|---:|---:|---:|---:|",
+    ]
     for s in slabs:
         for fo, v in s["fo"].items():
-            out.append(f"| {s['element'].upper()} / CAX{s['mesh'].cells.shape[1]} | {s['bi']:g} | {fo:g} | {pct(v['ax'] - v['ccx'], span)} | "
-                       f"{pct(v['ax'] - v['series'], span)} | {pct(v['ccx'] - v['series'], span)} |")
-    out += ["", "The distance to the series is the discretisation error that both codes share, mostly backward "
-            "Euler's: first order in dt (axiform alone, Bi = 10, Fo = 0.5: 0.117 %, 0.059 %, 0.029 % with 200, "
-            "400, 800 steps)."]
+            out.append(
+                f"| {s['element'].upper()} / CAX{s['mesh'].cells.shape[1]} | {s['bi']:g} | {fo:g} | {pct(v['ax'] - v['ccx'], span)} | "
+                f"{pct(v['ax'] - v['series'], span)} | {pct(v['ccx'] - v['series'], span)} |"
+            )
+    out += [
+        "",
+        "The distance to the series is the discretisation error that both codes share, mostly backward "
+        "Euler's: first order in dt (axiform alone, Bi = 10, Fo = 0.5: 0.117 %, 0.059 %, 0.029 % with 200, "
+        "400, 800 steps).",
+    ]
     s = slabs[1]
     mesh = s["mesh"]
     face = np.flatnonzero(np.abs(mesh.points[:, 0] - 10.0) < 1e-9)
     face = face[np.argsort(mesh.points[face, 1])][::4]
-    out += ["", "Bi = 2, the nodes on r = 10 (every fourth), side by side:", "",
-            "| z | T axiform Fo 0.2 | T ccx Fo 0.2 | series Fo 0.2 | T axiform Fo 0.5 | T ccx Fo 0.5 | series Fo 0.5 |",
-            "|---:|---:|---:|---:|---:|---:|---:|"]
+    out += [
+        "",
+        "Bi = 2, the nodes on r = 10 (every fourth), side by side:",
+        "",
+        "| z | T axiform Fo 0.2 | T ccx Fo 0.2 | series Fo 0.2 | T axiform Fo 0.5 | T ccx Fo 0.5 | series Fo 0.5 |",
+        "|---:|---:|---:|---:|---:|---:|---:|",
+    ]
     for n in face:
         row = f"| {mesh.points[n, 1]:.3f} |"
         for fo in (0.2, 0.5):
             v = s["fo"][fo]
             row += f" {v['ax'][n]:.4f} | {v['ccx'][n]:.4f} | {v['series'][n]:.4f} |"
         out.append(row)
-    out += ["", "## Tube wall (r 20..22, z 0..40, Q8 4 x 40), banded film outside, 300 steps of 0.2 s", "",
-            "Outside h = " + ", ".join(f"{h:g} on z {a:g}-{b:g}" for a, b, h in BANDS)
-            + f" (ambient {T_INF:g}); inside h = {BORE_H:g} (ambient {BORE_T:g}).", "",
-            "| t (s) | T min ccx | T max ccx | axiform Conduction - ccx | axiform case - ccx | case - Conduction |",
-            "|---:|---:|---:|---:|---:|---:|"]
+    out += [
+        "",
+        "## Tube wall (r 20..22, z 0..40, Q8 4 x 40), banded film outside, 300 steps of 0.2 s",
+        "",
+        "Outside h = "
+        + ", ".join(f"{h:g} on z {a:g}-{b:g}" for a, b, h in BANDS)
+        + f" (ambient {T_INF:g}); inside h = {BORE_H:g} (ambient {BORE_T:g}).",
+        "",
+        "| t (s) | T min ccx | T max ccx | axiform Conduction - ccx | axiform case - ccx | case - Conduction |",
+        "|---:|---:|---:|---:|---:|---:|",
+    ]
     for t in wall["times"]:
         c, a, k = at(wall["ccx"]["T"], t), at(wall["ax"]["T"], t), at(wall["case"]["T"], t)
-        out.append(f"| {t:g} | {c.min():.3f} | {c.max():.3f} | {pct(a - c, span)} | {pct(k - c, span)} | "
-                   f"{pct(k - a, span)} |")
-    out += ["", "## Time of the same run (s, CPU / wall, best of 3, one thread, this shared 2-core machine)", "",
-            "| run | axiform Conduction | axiform whole case (solve) | ccx (process) |", "|---|---:|---:|---:|",
-            f"| slab Bi = 2, {s['mesh'].n_nodes} nodes, {s['steps']} steps | {times(s['ax'])} | | {times(s['ccx'])} |",
-            f"| tube, {wall['mesh'].n_nodes} nodes, {TUBE_STEPS} steps | {times(wall['ax'])} | "
-            f"{times(wall['case'])} | {times(wall['ccx'])} |"]
+        out.append(
+            f"| {t:g} | {c.min():.3f} | {c.max():.3f} | {pct(a - c, span)} | {pct(k - c, span)} | {pct(k - a, span)} |"
+        )
+    out += [
+        "",
+        "## Time of the same run (s, CPU / wall, best of 3, one thread, this shared 2-core machine)",
+        "",
+        "| run | axiform Conduction | axiform whole case (solve) | ccx (process) |",
+        "|---|---:|---:|---:|",
+        f"| slab Bi = 2, {s['mesh'].n_nodes} nodes, {s['steps']} steps | {times(s['ax'])} | | {times(s['ccx'])} |",
+        f"| tube, {wall['mesh'].n_nodes} nodes, {TUBE_STEPS} steps | {times(wall['ax'])} | "
+        f"{times(wall['case'])} | {times(wall['ccx'])} |",
+    ]
     return out
 
 
@@ -323,11 +385,16 @@ def figure(s: dict, wall: dict) -> None:
     z = mesh.points[line, 1]
     fine = np.linspace(0.0, L, 200)
     for k, (fo, v) in enumerate(s["fo"].items()):
-        ax[0].plot(fine, T_INF + (T0 - T_INF) * slab_series(fine / L, fo, 2.0), f"C{k}-", lw=1, label=f"series, Fo {fo:g}")
+        ax[0].plot(
+            fine, T_INF + (T0 - T_INF) * slab_series(fine / L, fo, 2.0), f"C{k}-", lw=1, label=f"series, Fo {fo:g}"
+        )
         ax[0].plot(z, v["ax"][line], f"C{k}o", mfc="none", ms=6, label=f"axiform, Fo {fo:g}")
         ax[0].plot(z, v["ccx"][line], f"C{k}x", ms=5, label=f"CalculiX, Fo {fo:g}")
-    ax[0].set(xlabel="z (through the slab; film at z = 2)", ylabel="T",
-              title="slab, Bi = 2, Q8 1 x 24 (axiform - CalculiX < 1e-4)")
+    ax[0].set(
+        xlabel="z (through the slab; film at z = 2)",
+        ylabel="T",
+        title="slab, Bi = 2, Q8 1 x 24 (axiform - CalculiX < 1e-4)",
+    )
     tm = wall["mesh"]
     t_end = wall["times"][-1]
     for k, (z0, z1, h) in enumerate(BANDS):
@@ -335,8 +402,15 @@ def figure(s: dict, wall: dict) -> None:
         nodes = np.flatnonzero(np.abs(tm.points[:, 1] - zm) < 1e-9)
         nodes = nodes[np.argsort(tm.points[nodes, 0])]
         r = tm.points[nodes, 0]
-        ax[1].plot(r, at(wall["ax"]["T"], t_end)[nodes], f"C{k}o-", mfc="none", ms=6, lw=1,
-                   label=f"axiform, z = {zm:g} (h = {h:g})")
+        ax[1].plot(
+            r,
+            at(wall["ax"]["T"], t_end)[nodes],
+            f"C{k}o-",
+            mfc="none",
+            ms=6,
+            lw=1,
+            label=f"axiform, z = {zm:g} (h = {h:g})",
+        )
         ax[1].plot(r, at(wall["ccx"]["T"], t_end)[nodes], f"C{k}x", ms=6, label=f"CalculiX, z = {zm:g}")
     ax[1].set(xlabel="r (through the tube's wall; bore at 20)", ylabel="T", title=f"tube wall at t = {t_end:g} s")
     outer = np.flatnonzero(np.abs(tm.points[:, 0] - 22.0) < 1e-9)
@@ -346,8 +420,11 @@ def figure(s: dict, wall: dict) -> None:
         ax[2].plot(tm.points[outer, 1], at(wall["ccx"]["T"], t)[outer], f"C{k}x", ms=4, label=f"CalculiX, t = {t:g} s")
     for z0, _, _ in BANDS[1:]:
         ax[2].axvline(z0, color="0.7", lw=0.8)
-    ax[2].set(xlabel="z along the outside r = 22 (film bands: h 0.4 | 0.2 | 0.1 | 0.05)", ylabel="T",
-              title="tube, outside face")
+    ax[2].set(
+        xlabel="z along the outside r = 22 (film bands: h 0.4 | 0.2 | 0.1 | 0.05)",
+        ylabel="T",
+        title="tube, outside face",
+    )
     for a in ax:
         a.grid(alpha=0.3)
         a.legend(fontsize=7)

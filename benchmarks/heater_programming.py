@@ -36,8 +36,9 @@ KNOWN = [146.0, 153.0, 149.0, 147.0, 152.0]
 def write_target(folder: Path) -> None:
     """The final wall of the case at the known profile, stations with 1 <= s <= 48."""
     tree = copy.deepcopy(read(CASE))
-    tree["temperature"]["initial"]["table"] = [[row[0], v] for row, v in zip(tree["temperature"]["initial"]["table"],
-                                                                              KNOWN)]
+    tree["temperature"]["initial"]["table"] = [
+        [row[0], v] for row, v in zip(tree["temperature"]["initial"]["table"], KNOWN, strict=False)
+    ]
     for table in tree["contact"]:
         table["surface"]["dxf"] = str(EXAMPLES / table["surface"]["dxf"])
     case = folder / "known.toml"
@@ -52,21 +53,40 @@ def write_target(folder: Path) -> None:
 
 def study() -> None:
     RESULTS.mkdir(exist_ok=True)
-    lines = ["| method | forward solves | max deviation after 3 solves | best max deviation | optimized profile (C) |",
-             "|---|---:|---:|---:|---|"]
+    lines = [
+        "| method | forward solves | max deviation after 3 solves | best max deviation | optimized profile (C) |",
+        "|---|---:|---:|---:|---|",
+    ]
     with tempfile.TemporaryDirectory() as tmp:
         write_target(Path(tmp))
         for method in ("gradient", "fixed-point"):
             out = Path(tmp) / method
-            main(["optimize", str(CASE), "--target", str(TARGET), "--out", str(out), "--vary", "temperature",
-                  "--method", method, "--max-iter", "15", "-q"])
+            main(
+                [
+                    "optimize",
+                    str(CASE),
+                    "--target",
+                    str(TARGET),
+                    "--out",
+                    str(out),
+                    "--vary",
+                    "temperature",
+                    "--method",
+                    method,
+                    "--max-iter",
+                    "15",
+                    "-q",
+                ]
+            )
             summary = json.loads((out / "optimize.json").read_text())
             with open(out / "optimize.csv", newline="") as fh:
                 rows = list(csv.DictReader(fh))
             at3 = min(float(r["max_rel_deviation"]) for r in rows if int(r["forward_solves"]) <= 3)
             profile = ", ".join(f"{v:.1f}" for v in summary["optimized_temperature"])
-            lines.append(f"| {method} | {summary['forward_solves']} | {100 * at3:.2f} % | "
-                         f"{100 * summary['max_rel_deviation']:.2f} % | {profile} |")
+            lines.append(
+                f"| {method} | {summary['forward_solves']} | {100 * at3:.2f} % | "
+                f"{100 * summary['max_rel_deviation']:.2f} % | {profile} |"
+            )
             if method == "gradient":
                 shutil.copy(out / "optimize.png", RESULTS / "heater_programming.png")
     lines.append(f"| (the known profile) | | | | {', '.join(f'{v:.1f}' for v in KNOWN)} |")

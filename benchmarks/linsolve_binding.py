@@ -95,14 +95,20 @@ def main() -> None:
     for r in range(args.repeat):
         for dofs in args.dofs:
             inner = args.inner or (20 if dofs < 10**4 else 5)
-            for name in names[r % len(names):] + names[:r % len(names)]:
-                out = subprocess.run([sys.executable, __file__, "--child", modules[name], str(dofs), str(inner)],
-                                     capture_output=True, text=True, check=True)
+            for name in names[r % len(names) :] + names[: r % len(names)]:
+                out = subprocess.run(
+                    [sys.executable, __file__, "--child", modules[name], str(dofs), str(inner)],
+                    capture_output=True,
+                    text=True,
+                    check=True,
+                )
                 res = json.loads(out.stdout.strip().splitlines()[-1])
                 runs.setdefault((name, dofs), []).append(res)
-                print(f"repeat {r} {name:10s} n={res['n']:7d} first {res['first']:.4f} "
-                      f"fs min {min(res['fs']):.4f} newton min {min(res['newton']):.4f} err {res['err']:.1e}",
-                      flush=True)
+                print(
+                    f"repeat {r} {name:10s} n={res['n']:7d} first {res['first']:.4f} "
+                    f"fs min {min(res['fs']):.4f} newton min {min(res['newton']):.4f} err {res['err']:.1e}",
+                    flush=True,
+                )
         loads.append(load_average())
 
     def cell(values: list[float], base: list[float] | None) -> str:
@@ -113,23 +119,29 @@ def main() -> None:
 
     rows = []
     for dofs in args.dofs:
-        for what, key in (("first factorize + solve", "first"), ("factorize + solve", "fs"),
-                          ("Newton iteration", "newton")):
+        for what, key in (
+            ("first factorize + solve", "first"),
+            ("factorize + solve", "fs"),
+            ("Newton iteration", "newton"),
+        ):
             vals = {}
             for name in names:
                 rs = runs[(name, dofs)]
                 vals[name] = [r[key] for r in rs] if key == "first" else [v for r in rs for v in r[key]]
-            rows.append([f"{runs[(names[0], dofs)][0]['n']:,}", what]
-                        + [cell(vals[name], None if name == names[0] else vals[names[0]]) for name in names])
+            rows.append(
+                [f"{runs[(names[0], dofs)][0]['n']:,}", what]
+                + [cell(vals[name], None if name == names[0] else vals[names[0]]) for name in names]
+            )
     errs = max(r["err"] for rs in runs.values() for r in rs)
-    text = (f"# PARDISO bindings of linsolve.py side by side\n\n"
-            f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; {machine()}; load average "
-            f"(1, 5, 15 min) at the start and after each repeat: {'; '.join(loads)}.  Modules: "
-            + ", ".join(f"{k} = {v}" for k, v in modules.items())
-            + f".  Wall ms, min / median over {args.repeat} fresh processes per module (interleaved) and "
-            f"their timed calls; in brackets the ratio of the medians to {names[0]}.  Q4 ring, 2 right-hand "
-            f"sides; max |x - spsolve| / |x| {errs:.1e}.\n\n"
-            + table(["free dofs", "what"] + names, rows))
+    text = (
+        f"# PARDISO bindings of linsolve.py side by side\n\n"
+        f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; {machine()}; load average "
+        f"(1, 5, 15 min) at the start and after each repeat: {'; '.join(loads)}.  Modules: "
+        + ", ".join(f"{k} = {v}" for k, v in modules.items())
+        + f".  Wall ms, min / median over {args.repeat} fresh processes per module (interleaved) and "
+        f"their timed calls; in brackets the ratio of the medians to {names[0]}.  Q4 ring, 2 right-hand "
+        f"sides; max |x - spsolve| / |x| {errs:.1e}.\n\n" + table(["free dofs", "what"] + names, rows)
+    )
     print(text)
     print(write_result("linsolve_binding", text))
 

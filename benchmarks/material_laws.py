@@ -68,13 +68,23 @@ def cost_per_point(n_points: int, repeats: int) -> dict[tuple[str, str], float]:
     return best
 
 
-FITS = [("neo-hooke", None), ("mooney-rivlin", None), ("yeoh", None), ("gent", None), ("arruda-boyce", None),
-        ("ogden", 1), ("ogden", 2), ("ogden", 3)]
+FITS = [
+    ("neo-hooke", None),
+    ("mooney-rivlin", None),
+    ("yeoh", None),
+    ("gent", None),
+    ("arruda-boyce", None),
+    ("ogden", 1),
+    ("ogden", 2),
+    ("ogden", 3),
+]
 
 
 def constants(table_: dict) -> str:
-    return ", ".join(f"{k} = [{', '.join(f'{v:.4g}' for v in val)}]" if isinstance(val, list) else f"{k} = {val:.4g}"
-                     for k, val in table_.items())
+    return ", ".join(
+        f"{k} = [{', '.join(f'{v:.4g}' for v in val)}]" if isinstance(val, list) else f"{k} = {val:.4g}"
+        for k, val in table_.items()
+    )
 
 
 def main() -> None:
@@ -95,24 +105,41 @@ def main() -> None:
         result = fit(data, model, terms or 3)
         seconds = time.process_time() - t0
         both = combined_range(result)
-        fit_rows.append([model + (f", {terms} term{'s' if terms > 1 else ''}" if terms else ""),
-                         constants(result.table), f"{result.law.shear_modulus:.4f}",
-                         *(f"{100 * result.rms[m]:.1f} %" for m in MODES),
-                         f"{both[0]:.3g} to {both[1]:.3g}" if both else "none", f"{seconds:.2f}"])
+        fit_rows.append(
+            [
+                model + (f", {terms} term{'s' if terms > 1 else ''}" if terms else ""),
+                constants(result.table),
+                f"{result.law.shear_modulus:.4f}",
+                *(f"{100 * result.rms[m]:.1f} %" for m in MODES),
+                f"{both[0]:.3g} to {both[1]:.3g}" if both else "none",
+                f"{seconds:.2f}",
+            ]
+        )
         print(f"fitted {fit_rows[-1][0]}", file=sys.stderr)
-    part2 = table(["law", "constants (MPa)", "mu0 (MPa)", *(f"RMS {m}" for m in MODES),
-                   "Drucker-stable stretches (all modes)", "fit CPU s"], fit_rows)
+    part2 = table(
+        [
+            "law",
+            "constants (MPa)",
+            "mu0 (MPa)",
+            *(f"RMS {m}" for m in MODES),
+            "Drucker-stable stretches (all modes)",
+            "fit CPU s",
+        ],
+        fit_rows,
+    )
 
-    text = (f"# Hyperelastic laws: cost per point and fits to Treloar's data\n\n"
-            f"`python benchmarks/material_laws.py{' --quick' if args.quick else ''}`; {machine()}; "
-            f"load average {load_average()}.\n\n"
-            f"## 1. Cost per quadrature point\n\n{n_points} points (F = I + 20 % random), one thread, process CPU "
-            f"time, minimum of {repeats} interleaved repeats; in brackets the ratio to Mooney-Rivlin's hand-written "
-            f"kernel in the same run.\n\n{part1}\n"
-            f"## 2. `axiform fit` on Treloar's data\n\n{TRELOAR.relative_to(RESULTS.parents[1])}: uniaxial "
-            f"{data.count('uniaxial')}, equibiaxial {data.count('equibiaxial')}, planar {data.count('planar')} "
-            f"points; least squares on the relative error over all points; RMS relative error per mode; Drucker "
-            f"stability checked at stretches 0.1 to 10 (for Gent the range ends where I1 - 3 reaches Jm).\n\n{part2}")
+    text = (
+        f"# Hyperelastic laws: cost per point and fits to Treloar's data\n\n"
+        f"`python benchmarks/material_laws.py{' --quick' if args.quick else ''}`; {machine()}; "
+        f"load average {load_average()}.\n\n"
+        f"## 1. Cost per quadrature point\n\n{n_points} points (F = I + 20 % random), one thread, process CPU "
+        f"time, minimum of {repeats} interleaved repeats; in brackets the ratio to Mooney-Rivlin's hand-written "
+        f"kernel in the same run.\n\n{part1}\n"
+        f"## 2. `axiform fit` on Treloar's data\n\n{TRELOAR.relative_to(RESULTS.parents[1])}: uniaxial "
+        f"{data.count('uniaxial')}, equibiaxial {data.count('equibiaxial')}, planar {data.count('planar')} "
+        f"points; least squares on the relative error over all points; RMS relative error per mode; Drucker "
+        f"stability checked at stretches 0.1 to 10 (for Gent the range ends where I1 - 3 reaches Jm).\n\n{part2}"
+    )
     print(text)
     path = write_result("material_laws_quick" if args.quick else "material_laws", text)
     print(f"wrote {path}", file=sys.stderr)

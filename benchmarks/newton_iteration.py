@@ -57,8 +57,16 @@ import numpy as np
 import scipy.sparse.linalg as sla
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _perf_common import (Timing, build_model, deformed_state, divisions_for_dofs,  # noqa: E402
-                     load_average, machine, table, write_result)
+from _perf_common import (
+    Timing,
+    build_model,
+    deformed_state,
+    divisions_for_dofs,  # noqa: E402
+    load_average,
+    machine,
+    table,
+    write_result,
+)
 
 from axiform.solve import linsolve  # noqa: E402
 
@@ -71,6 +79,7 @@ def _superlu(permc: str, **kw):
     def factor(K):
         lu = sla.splu(K.tocsc(), permc_spec=permc, **kw)
         return lu.solve, lu.L.nnz + lu.U.nnz
+
     return factor
 
 
@@ -82,8 +91,10 @@ def src_solver() -> str:
     """What axiform.solve.linsolve.factorize uses on this machine."""
     if linsolve._mkl() is None:
         return "SciPy SuperLU, permc_spec MMD_ATA (MKL is not installed)"
-    return ("MKL PARDISO, matrix type 11, through ctypes (analysis kept per pattern; minimum degree "
-            f"up to {linsolve.MINIMUM_DEGREE_MAX} unknowns, METIS above)")
+    return (
+        "MKL PARDISO, matrix type 11, through ctypes (analysis kept per pattern; minimum degree "
+        f"up to {linsolve.MINIMUM_DEGREE_MAX} unknowns, METIS above)"
+    )
 
 
 def _umfpack():
@@ -95,6 +106,7 @@ def _umfpack():
     def factor(K):
         lu = um.splu(K.tocsc())
         return lu.solve, None
+
     return factor
 
 
@@ -116,8 +128,10 @@ def _pardiso(mtype: int):
 
         def solve(B):
             return s.solve(K, B)  # phase 33: forward and back substitution
+
         solve.release = lambda: s.free_memory(everything=True)
         return solve, nnz
+
     return factor
 
 
@@ -128,8 +142,7 @@ def solvers() -> dict:
         "superlu-MMD_AT_PLUS_A": _superlu("MMD_AT_PLUS_A"),
         "superlu-MMD_ATA": _superlu("MMD_ATA"),
         "superlu-NATURAL": _superlu("NATURAL"),
-        "superlu-mmd-sym": _superlu("MMD_AT_PLUS_A", diag_pivot_thresh=0.001,
-                                    options={"SymmetricMode": True}),
+        "superlu-mmd-sym": _superlu("MMD_AT_PLUS_A", diag_pivot_thresh=0.001, options={"SymmetricMode": True}),
         "umfpack": _umfpack(),
         "pardiso": _pardiso(11),
         "pardiso-ss": _pardiso(1),
@@ -150,8 +163,9 @@ def tmin(a: Timing | None, b: Timing) -> Timing:
 # --------------------------------------------------------------------------------------------
 
 
-def run(element: str, dof_targets: list[int], names: list[str], repeat: int, budget: float,
-        log) -> tuple[list[dict], dict]:
+def run(
+    element: str, dof_targets: list[int], names: list[str], repeat: int, budget: float, log
+) -> tuple[list[dict], dict]:
     available = solvers()
     names = [n for n in names if n in available]
     last: dict[str, tuple[int, float]] = {}  # solver -> (n, factorization time) at the last size
@@ -173,8 +187,10 @@ def run(element: str, dof_targets: list[int], names: list[str], repeat: int, bud
             t_eval = tmin(t_eval, t)
         del ev
         asym = abs(K - K.T).max() / abs(K).max()
-        log(f"{element}: {n:,} free dofs, nnz(K) {K.nnz:,}, |K-K^T|/|K| {asym:.1e}, "
-            f"evaluate {t_eval.cpu:.2f} s CPU, built in {t_build:.1f} s")
+        log(
+            f"{element}: {n:,} free dofs, nnz(K) {K.nnz:,}, |K-K^T|/|K| {asym:.1e}, "
+            f"evaluate {t_eval.cpu:.2f} s CPU, built in {t_build:.1f} s"
+        )
         todo = []
         for name in names:
             if name in dropped:
@@ -189,7 +205,7 @@ def run(element: str, dof_targets: list[int], names: list[str], repeat: int, bud
             todo.append(name)
         res: dict[str, dict] = {name: {} for name in todo}
         for rep in range(reps):
-            order = todo[rep % len(todo):] + todo[:rep % len(todo)] if todo else []
+            order = todo[rep % len(todo) :] + todo[: rep % len(todo)] if todo else []
             for name in order:
                 r = res[name]
                 if r.get("error"):
@@ -208,8 +224,10 @@ def run(element: str, dof_targets: list[int], names: list[str], repeat: int, bud
                 if hasattr(solve, "release"):
                     solve.release()
                 del solve, X
-                log(f"  {name:24s} factorize {tf.cpu:7.3f} s CPU ({tf.wall:7.3f} wall), "
-                    f"solve {ts.cpu:6.3f} s, fill {fill or '-'}, residual {r['res']:.1e}")
+                log(
+                    f"  {name:24s} factorize {tf.cpu:7.3f} s CPU ({tf.wall:7.3f} wall), "
+                    f"solve {ts.cpu:6.3f} s, fill {fill or '-'}, residual {r['res']:.1e}"
+                )
         for name, r in res.items():
             if "fact" in r:
                 last[name] = (n, r["fact"].cpu)
@@ -230,8 +248,10 @@ def sensitivity(element: str, target: int, names: list[str], log) -> str:
         for seed, noise in ((0, 0.01), (1, 0.01), (2, 0.03)):
             u_f, lam = deformed_state(model, seed=seed, noise=noise)
             K = model.evaluate(u_f, lam).K.tocsr()
-            cells = [f"{'half' if pressed < 1 else 'whole'} face, seed {seed}, noise {noise:g} h",
-                     f"{abs(K - K.T).max() / abs(K).max():.0e}"]
+            cells = [
+                f"{'half' if pressed < 1 else 'whole'} face, seed {seed}, noise {noise:g} h",
+                f"{abs(K - K.T).max() / abs(K).max():.0e}",
+            ]
             for name in names:
                 (solve, fill), t = timed(lambda: available[name](K))
                 if hasattr(solve, "release"):
@@ -240,11 +260,12 @@ def sensitivity(element: str, target: int, names: list[str], log) -> str:
             log("  " + " | ".join(cells))
             rows.append(cells)
     n = model.n_free
-    return (f"## Sensitivity to the matrix values ({element}, {n:,} free dofs)\n\n"
-            "Factorization CPU s / fill (non-zeros of L + U, millions) on six tangents of the "
-            "same mesh. asym = |K - Kᵀ|max / |K|max (whole face: the load stiffness cancels, "
-            "K_ff is symmetric to round-off).\n\n"
-            + table(["tangent", "asym"] + names, rows))
+    return (
+        f"## Sensitivity to the matrix values ({element}, {n:,} free dofs)\n\n"
+        "Factorization CPU s / fill (non-zeros of L + U, millions) on six tangents of the "
+        "same mesh. asym = |K - Kᵀ|max / |K|max (whole face: the load stiffness cancels, "
+        "K_ff is symmetric to round-off).\n\n" + table(["tangent", "asym"] + names, rows)
+    )
 
 
 def singular(element: str, names: list[str], log) -> str:
@@ -271,16 +292,19 @@ def singular(element: str, names: list[str], log) -> str:
             if not np.all(np.isfinite(x)):
                 what = "returns inf / nan"
             else:
-                what = (f"returns a finite x: |x|max {np.abs(x).max():.0e}, residual "
-                        f"{np.linalg.norm(K @ x - b) / np.linalg.norm(b):.0e}")
+                what = (
+                    f"returns a finite x: |x|max {np.abs(x).max():.0e}, residual "
+                    f"{np.linalg.norm(K @ x - b) / np.linalg.norm(b):.0e}"
+                )
             if hasattr(solve, "release"):
                 solve.release()
         except Exception as exc:  # noqa: BLE001
             what = f"raises {type(exc).__name__}: {str(exc)[:50]}"
         log(f"  singular K: {name}: {what}")
         rows.append([name, what])
-    return (f"## A singular tangent ({element}, {K.shape[0]:,} dofs, no axial support)\n\n"
-            + table(["solver", "factorize + solve"], rows))
+    return f"## A singular tangent ({element}, {K.shape[0]:,} dofs, no axial support)\n\n" + table(
+        ["solver", "factorize + solve"], rows
+    )
 
 
 def report(element, rows, dropped, key) -> str:
@@ -307,10 +331,11 @@ def report(element, rows, dropped, key) -> str:
                 cells.append(f"{it:.3f}")
         trows.append(cells)
     out.append(table(hdr, trows))
-    what = (" (the solver of linsolve.py before this benchmark)" if base == "superlu-MMD_AT_PLUS_A"
-            else "")
-    out += [f"## {element.upper()}: factorize + solve (s), and in brackets the ratio to {base}"
-            f"{what}; < 1: faster than it", ""]
+    what = " (the solver of linsolve.py before this benchmark)" if base == "superlu-MMD_AT_PLUS_A" else ""
+    out += [
+        f"## {element.upper()}: factorize + solve (s), and in brackets the ratio to {base}{what}; < 1: faster than it",
+        "",
+    ]
     trows = []
     for r in rows:
         b = r["res"].get(base)
@@ -332,11 +357,18 @@ def report(element, rows, dropped, key) -> str:
             x = r["res"].get(name)
             if not x or "fact" not in x:
                 continue
-            trows.append([f"{r['n']:,}", name, f"{getattr(x['fact'], key):.3f}",
-                          f"{getattr(x['solve'], key):.3f}", f"{x['fact'].wall:.3f}",
-                          f"{x['fill']:,}" if x.get("fill") else "–", f"{x['res']:.1e}"])
-    out.append(table(["free dofs", "solver", "factorize", "solve", "factorize wall", "fill",
-                      "residual"], trows))
+            trows.append(
+                [
+                    f"{r['n']:,}",
+                    name,
+                    f"{getattr(x['fact'], key):.3f}",
+                    f"{getattr(x['solve'], key):.3f}",
+                    f"{x['fact'].wall:.3f}",
+                    f"{x['fill']:,}" if x.get("fill") else "–",
+                    f"{x['res']:.1e}",
+                ]
+            )
+    out.append(table(["free dofs", "solver", "factorize", "solve", "factorize wall", "fill", "residual"], trows))
     if dropped:
         out += ["Dropped: " + "; ".join(f"{k} {v}" for k, v in dropped.items()) + ".", ""]
     return "\n".join(out)
@@ -354,10 +386,12 @@ def main(argv=None) -> int:
     ap.add_argument("--solvers", nargs="+", help="subset of the solver names")
     ap.add_argument("--threads", type=int, default=1, help="BLAS / MKL / OpenMP threads")
     ap.add_argument("--repeat", type=int, default=2, help="interleaved repeats per size")
-    ap.add_argument("--budget", type=float, default=40.0,
-                    help="drop a solver whose factorization would take longer (s)")
-    ap.add_argument("--sensitivity-dofs", type=int, default=30000,
-                    help="mesh size of the value-sensitivity table (0: none)")
+    ap.add_argument(
+        "--budget", type=float, default=40.0, help="drop a solver whose factorization would take longer (s)"
+    )
+    ap.add_argument(
+        "--sensitivity-dofs", type=int, default=30000, help="mesh size of the value-sensitivity table (0: none)"
+    )
     ap.add_argument("--out", default=None, help="results name (default newton_iteration)")
     args = ap.parse_args(argv)
     names = args.solvers or list(solvers())
@@ -374,17 +408,23 @@ def main(argv=None) -> int:
         log("values sensitivity")
         sections.append(sensitivity(args.elements[0], args.sensitivity_dofs, names, log))
     sections.append(singular(args.elements[0], names, log))
-    what = ("CPU time of the process (one thread: about the wall time of an idle core)"
-            if key == "cpu" else "wall clock")
+    what = "CPU time of the process (one thread: about the wall time of an idle core)" if key == "cpu" else "wall clock"
     text = "\n".join(
-        ["# Newton iteration: evaluate + factorize + solve (2 right-hand sides)", "",
-         f"Machine: {machine()}; square meshes; solver threads: {args.threads}; load average "
-         f"at the end: {load_average()}.", "",
-         f"Times in s, {what}, minimum over {args.repeat} interleaved repeats (1 above 150,000 "
-         "dofs). Iteration = evaluate + factorize + solve. fill = non-zeros of L + U. residual "
-         "= ||K X - B|| / ||B||. src = axiform.solve.linsolve.factorize as it is now: "
-         f"{src_solver()}; evaluate = `model.evaluate` as it is now.", ""]
-        + sections + [f"Total run time {time.perf_counter() - t_start:.0f} s.", ""])
+        [
+            "# Newton iteration: evaluate + factorize + solve (2 right-hand sides)",
+            "",
+            f"Machine: {machine()}; square meshes; solver threads: {args.threads}; load average "
+            f"at the end: {load_average()}.",
+            "",
+            f"Times in s, {what}, minimum over {args.repeat} interleaved repeats (1 above 150,000 "
+            "dofs). Iteration = evaluate + factorize + solve. fill = non-zeros of L + U. residual "
+            "= ||K X - B|| / ||B||. src = axiform.solve.linsolve.factorize as it is now: "
+            f"{src_solver()}; evaluate = `model.evaluate` as it is now.",
+            "",
+        ]
+        + sections
+        + [f"Total run time {time.perf_counter() - t_start:.0f} s.", ""]
+    )
     print()
     print(text)
     name = args.out or ("newton_iteration" + ("_quick" if args.quick else ""))

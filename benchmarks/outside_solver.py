@@ -36,8 +36,16 @@ def run(src: Path, example: str, out: Path, plots: bool) -> tuple[float, float]:
     `axiform run` of the example with the tree src."""
     env = dict(os.environ, PYTHONPATH=str(src))
     env.pop("PYTHONDONTWRITEBYTECODE", None)
-    args = [sys.executable, "-m", "axiform.cli", "run", str(ROOT / "examples" / f"{example}.toml"), "--out",
-            str(out), "-q"] + ([] if plots else ["--set", "output.plots=false"])
+    args = [
+        sys.executable,
+        "-m",
+        "axiform.cli",
+        "run",
+        str(ROOT / "examples" / f"{example}.toml"),
+        "--out",
+        str(out),
+        "-q",
+    ] + ([] if plots else ["--set", "output.plots=false"])
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     subprocess.run(args, env=env, cwd=ROOT, check=True, capture_output=True)
@@ -48,8 +56,9 @@ def run(src: Path, example: str, out: Path, plots: bool) -> tuple[float, float]:
 
 def differences(a: Path, b: Path) -> list[str]:
     """The files of two results folders that differ (or that only one has), PNGs left out."""
-    names = {p.relative_to(a) for p in a.rglob("*") if p.is_file()} | \
-            {p.relative_to(b) for p in b.rglob("*") if p.is_file()}
+    names = {p.relative_to(a) for p in a.rglob("*") if p.is_file()} | {
+        p.relative_to(b) for p in b.rglob("*") if p.is_file()
+    }
     out = []
     for name in sorted(names):
         fa, fb = a / name, b / name
@@ -87,16 +96,22 @@ def main() -> None:
                     best[label] = [min(best[label][0], wall), min(best[label][1], cpu)]
             diff = differences(*(args.out / label / f"{example}-{plots}" for label in ("before", "after")))
             rows.append((example, "on" if plots else "off", *best["before"], *best["after"], diff))
-            print(f"{example} plots {rows[-1][1]}: wall {best['before'][0]:.2f} -> {best['after'][0]:.2f} s, "
-                  f"CPU {best['before'][1]:.2f} -> {best['after'][1]:.2f} s; differ: {', '.join(diff) or 'none'}",
-                  flush=True)
+            print(
+                f"{example} plots {rows[-1][1]}: wall {best['before'][0]:.2f} -> {best['after'][0]:.2f} s, "
+                f"CPU {best['before'][1]:.2f} -> {best['after'][1]:.2f} s; differ: {', '.join(diff) or 'none'}",
+                flush=True,
+            )
     print(f"load average at end: {os.getloadavg()[0]:.2f}\n")
-    print("| example | plots | wall before (s) | wall after (s) | saved | CPU before (s) | CPU after (s) | saved | "
-          "files that differ (PNGs aside) |")
+    print(
+        "| example | plots | wall before (s) | wall after (s) | saved | CPU before (s) | CPU after (s) | saved | "
+        "files that differ (PNGs aside) |"
+    )
     print("|---|---|---:|---:|---:|---:|---:|---:|---|")
     for example, plots, wall0, cpu0, wall1, cpu1, diff in rows:
-        print(f"| {example} | {plots} | {wall0:.2f} | {wall1:.2f} | {wall0 - wall1:.2f} | {cpu0:.2f} | {cpu1:.2f} | "
-              f"{cpu0 - cpu1:.2f} | {', '.join(diff) or 'none'} |")
+        print(
+            f"| {example} | {plots} | {wall0:.2f} | {wall1:.2f} | {wall0 - wall1:.2f} | {cpu0:.2f} | {cpu1:.2f} | "
+            f"{cpu0 - cpu1:.2f} | {', '.join(diff) or 'none'} |"
+        )
 
 
 if __name__ == "__main__":

@@ -208,10 +208,20 @@ def linsolve_identity() -> str:
     state = ""
     try:
         root = Path(__file__).resolve().parents[1]
-        rev = subprocess.run(["git", "log", "-1", "--format=%h", "--", "src/axiform/linsolve.py"], cwd=root,
-                             capture_output=True, text=True, timeout=10).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "--", "src/axiform/linsolve.py"], cwd=root,
-                               capture_output=True, text=True, timeout=10).stdout.strip()
+        rev = subprocess.run(
+            ["git", "log", "-1", "--format=%h", "--", "src/axiform/linsolve.py"],
+            cwd=root,
+            capture_output=True,
+            text=True,
+            timeout=10,
+        ).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "status", "--porcelain", "--", "src/axiform/linsolve.py"],
+            cwd=root,
+            capture_output=True,
+            text=True,
+            timeout=10,
+        ).stdout.strip()
         state = f"; src/axiform/linsolve.py at commit {rev or '?'}{' with uncommitted changes' if dirty else ''}"
     except Exception:  # noqa: BLE001
         pass
@@ -233,9 +243,17 @@ def linear_solver(name: str):
         _solver.factorize = original
 
 
-def run_axiform(element: str, nr: int, nz: int, steps: int = 40, w_max: float = W_MAX,
-                solver: str = "shipped", options: af.NewtonOptions | None = None,
-                kappa: float = KAPPA, keep_model: bool = False) -> dict:
+def run_axiform(
+    element: str,
+    nr: int,
+    nz: int,
+    steps: int = 40,
+    w_max: float = W_MAX,
+    solver: str = "shipped",
+    options: af.NewtonOptions | None = None,
+    kappa: float = KAPPA,
+    keep_model: bool = False,
+) -> dict:
     """One displacement-controlled run, timed from model building to the last step:
     CPU time of this process (time.process_time) and wall time."""
     with linear_solver(solver):
@@ -249,11 +267,23 @@ def run_axiform(element: str, nr: int, nz: int, steps: int = 40, w_max: float = 
     if keep_model and result.steps:  # for inspecting the tangent (not JSON-serializable)
         extra = {"_model": model, "_state": (result.steps[-1].u_f, result.steps[-1].lam)}
     return extra | {
-        "code": "axiform", "element": element, "mesh": mesh_name(nr, nz), "nr": nr, "nz": nz,
-        "solver": solver, "steps_nominal": steps, "steps": len(result.steps),
-        "iterations": int(result.newton_iterations), "status": result.status, "message": result.message,
-        "dofs": int(model.n_free), "elements": int(model.mesh.n_cells),
-        "cpu_s": cpu, "wall_s": wall, "w": w.tolist(), "p": p.tolist(),
+        "code": "axiform",
+        "element": element,
+        "mesh": mesh_name(nr, nz),
+        "nr": nr,
+        "nz": nz,
+        "solver": solver,
+        "steps_nominal": steps,
+        "steps": len(result.steps),
+        "iterations": int(result.newton_iterations),
+        "status": result.status,
+        "message": result.message,
+        "dofs": int(model.n_free),
+        "elements": int(model.mesh.n_cells),
+        "cpu_s": cpu,
+        "wall_s": wall,
+        "w": w.tolist(),
+        "p": p.tolist(),
     }
 
 
@@ -274,11 +304,12 @@ def ccx_version() -> str | None:
 
 def _lines(ids, per=12):
     ids = [str(int(i)) for i in ids]
-    return [", ".join(ids[k:k + per]) for k in range(0, len(ids), per)]
+    return [", ".join(ids[k : k + per]) for k in range(0, len(ids), per)]
 
 
-def ccx_deck(mesh: af.Mesh, etype: str, pressures: np.ndarray, title: str = "", tight: bool = True,
-             kappa: float = KAPPA) -> str:
+def ccx_deck(
+    mesh: af.Mesh, etype: str, pressures: np.ndarray, title: str = "", tight: bool = True, kappa: float = KAPPA
+) -> str:
     """A CalculiX deck for the plate on this (axiform) mesh: node k+1 is axiform's node k,
     element e+1 its cell e (same node order: corners counter-clockwise, then mid-sides 1-2,
     2-3, 3-4, 4-1 as in CAX8).  Pressure on face P1 (nodes 1-2) of the cells along z = 0;
@@ -300,34 +331,54 @@ def ccx_deck(mesh: af.Mesh, etype: str, pressures: np.ndarray, title: str = "", 
     out += ["*NSET, NSET=RIM"] + _lines(rim)
     out += ["*NSET, NSET=AXIS"] + _lines(axis)
     out += ["*NSET, NSET=CENTRE"] + _lines(centre)
-    out += ["*MATERIAL, NAME=MR", "*HYPERELASTIC, MOONEY-RIVLIN",
-            f"{C1:.15g}, {C2:.15g}, {2.0 / kappa:.15g}",
-            "*SOLID SECTION, ELSET=EALL, MATERIAL=MR",
-            "*AMPLITUDE, NAME=RAMP"]
-    pts = [f"{ti:.15g}, {ai:.15g}" for ti, ai in zip(t, a)]
-    out += [", ".join(pts[k:k + 4]) for k in range(0, len(pts), 4)]
-    out += ["*BOUNDARY", "RIM, 1, 2", "AXIS, 1, 1",
-            "*STEP, NLGEOM, INC=100000",
-            "*STATIC, DIRECT", f"{1.0 / n:.15g}, 1.0"]
+    out += [
+        "*MATERIAL, NAME=MR",
+        "*HYPERELASTIC, MOONEY-RIVLIN",
+        f"{C1:.15g}, {C2:.15g}, {2.0 / kappa:.15g}",
+        "*SOLID SECTION, ELSET=EALL, MATERIAL=MR",
+        "*AMPLITUDE, NAME=RAMP",
+    ]
+    pts = [f"{ti:.15g}, {ai:.15g}" for ti, ai in zip(t, a, strict=False)]
+    out += [", ".join(pts[k : k + 4]) for k in range(0, len(pts), 4)]
+    out += [
+        "*BOUNDARY",
+        "RIM, 1, 2",
+        "AXIS, 1, 1",
+        "*STEP, NLGEOM, INC=100000",
+        "*STATIC, DIRECT",
+        f"{1.0 / n:.15g}, 1.0",
+    ]
     if tight:
         # tight equilibrium: residual 1e-7 of the average force, correction 1e-6 of the
         # increment (defaults 5e-3 and 1e-2); let slow (symmetrized tangent) iterations run
-        out += ["*CONTROLS, PARAMETERS=FIELD, FIELD=DISPLACEMENT",
-                "1.e-7, 1.e-6, , , 1.e-7, 1.e-5, 1.e-3, 1.e-8",
-                "*CONTROLS, PARAMETERS=TIME INCREMENTATION",
-                "30, 40, 41, 60, 42, 4, , 5"]
+        out += [
+            "*CONTROLS, PARAMETERS=FIELD, FIELD=DISPLACEMENT",
+            "1.e-7, 1.e-6, , , 1.e-7, 1.e-5, 1.e-3, 1.e-8",
+            "*CONTROLS, PARAMETERS=TIME INCREMENTATION",
+            "30, 40, 41, 60, 42, 4, , 5",
+        ]
     out += ["*DLOAD, AMPLITUDE=RAMP"]
     out += [f"{e}, P1, {p_max:.15g}" for e in bottom]
     out += ["*NODE PRINT, NSET=CENTRE", "U", "*END STEP", ""]
     return "\n".join(out)
 
 
-_DAT = re.compile(r"displacements \(vx,vy,vz\) for set CENTRE and time\s+([-+0-9.Ee]+)\s*\n\s*\n"
-                  r"\s*(\d+)\s+([-+0-9.Ee]+)\s+([-+0-9.Ee]+)")
+_DAT = re.compile(
+    r"displacements \(vx,vy,vz\) for set CENTRE and time\s+([-+0-9.Ee]+)\s*\n\s*\n"
+    r"\s*(\d+)\s+([-+0-9.Ee]+)\s+([-+0-9.Ee]+)"
+)
 
 
-def run_ccx(mesh: af.Mesh, etype: str, pressures: np.ndarray, workdir: Path, name: str,
-            tight: bool = True, kappa: float = KAPPA, deck: str | None = None) -> dict:
+def run_ccx(
+    mesh: af.Mesh,
+    etype: str,
+    pressures: np.ndarray,
+    workdir: Path,
+    name: str,
+    tight: bool = True,
+    kappa: float = KAPPA,
+    deck: str | None = None,
+) -> dict:
     """Run ccx on the deck; w per increment from the .dat file; wall time and the CPU time of
     the child process; Newton iterations from the .sta file."""
     exe = shutil.which("ccx")
@@ -335,8 +386,9 @@ def run_ccx(mesh: af.Mesh, etype: str, pressures: np.ndarray, workdir: Path, nam
     (workdir / f"{name}.inp").write_text(deck or ccx_deck(mesh, etype, pressures, f"plate {name}", tight, kappa))
     for ext in (".dat", ".sta", ".frd", ".cvg", ".12d"):
         (workdir / f"{name}{ext}").unlink(missing_ok=True)
-    env = dict(os.environ, OMP_NUM_THREADS="1", CCX_NPROC_EQUATION_SOLVER="1",
-               CCX_NPROC_STIFFNESS="1", CCX_NPROC_RESULTS="1")
+    env = dict(
+        os.environ, OMP_NUM_THREADS="1", CCX_NPROC_EQUATION_SOLVER="1", CCX_NPROC_STIFFNESS="1", CCX_NPROC_RESULTS="1"
+    )
     ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.run([exe, "-i", name], cwd=workdir, capture_output=True, text=True, env=env)
@@ -366,11 +418,19 @@ def run_ccx(mesh: af.Mesh, etype: str, pressures: np.ndarray, workdir: Path, nam
     for ext in (".frd", ".12d", ".cvg"):  # bulky or unused outputs
         (workdir / f"{name}{ext}").unlink(missing_ok=True)
     (workdir / "spooles.out").unlink(missing_ok=True)
-    return {"code": "calculix" if tight else "calculix-default-tol", "element": etype,
-            "increments": int(len(w)), "iterations": its,
-            "equations": int(m.group(1)) if m else None, "status": "finished" if ok else "stopped",
-            "message": "" if ok else (proc.stdout[-600:] + proc.stderr[-300:]).strip(),
-            "cpu_s": cpu, "wall_s": wall, "w": w.tolist(), "p": p.tolist()}
+    return {
+        "code": "calculix" if tight else "calculix-default-tol",
+        "element": etype,
+        "increments": int(len(w)),
+        "iterations": its,
+        "equations": int(m.group(1)) if m else None,
+        "status": "finished" if ok else "stopped",
+        "message": "" if ok else (proc.stdout[-600:] + proc.stderr[-300:]).strip(),
+        "cpu_s": cpu,
+        "wall_s": wall,
+        "w": w.tolist(),
+        "p": p.tolist(),
+    }
 
 
 # --------------------------------------------------------------------------------------
@@ -402,13 +462,24 @@ def _lame_deck(mesh: af.Mesh, etype: str, p: float, kappa: float, a: float, leng
     out.append(f"*ELEMENT, TYPE={etype}, ELSET=EALL")
     out += [f"{e + 1}, " + ", ".join(str(k + 1) for k in c) for e, c in enumerate(C)]
     out += ["*NSET, NSET=ENDS"] + _lines(ends) + ["*NSET, NSET=BORE"] + _lines(bore)
-    out += ["*MATERIAL, NAME=MR", "*HYPERELASTIC, MOONEY-RIVLIN", f"{C1:.15g}, {C2:.15g}, {2.0 / kappa:.15g}",
-            "*SOLID SECTION, ELSET=EALL, MATERIAL=MR", "*BOUNDARY", "ENDS, 2, 2",
-            "*STEP, NLGEOM", "*STATIC, DIRECT", "1.0, 1.0",
-            "*CONTROLS, PARAMETERS=FIELD, FIELD=DISPLACEMENT", "1.e-9, 1.e-8, , , 1.e-9, 1.e-5, 1.e-3, 1.e-8",
-            "*DLOAD"]
+    out += [
+        "*MATERIAL, NAME=MR",
+        "*HYPERELASTIC, MOONEY-RIVLIN",
+        f"{C1:.15g}, {C2:.15g}, {2.0 / kappa:.15g}",
+        "*SOLID SECTION, ELSET=EALL, MATERIAL=MR",
+        "*BOUNDARY",
+        "ENDS, 2, 2",
+        "*STEP, NLGEOM",
+        "*STATIC, DIRECT",
+        "1.0, 1.0",
+        "*CONTROLS, PARAMETERS=FIELD, FIELD=DISPLACEMENT",
+        "1.e-9, 1.e-8, , , 1.e-9, 1.e-5, 1.e-3, 1.e-8",
+        "*DLOAD",
+    ]
     # the bore r = a is edge 4-1 (P4) of the cells of the first radial column
-    out += [f"{e + 1}, P4, {p:.15g}" for e, c in enumerate(C) if abs(P[c[0], 0] - a) < tol and abs(P[c[3], 0] - a) < tol]
+    out += [
+        f"{e + 1}, P4, {p:.15g}" for e, c in enumerate(C) if abs(P[c[0], 0] - a) < tol and abs(P[c[3], 0] - a) < tol
+    ]
     out += ["*NODE PRINT, NSET=BORE", "U", "*END STEP", ""]
     return "\n".join(out)
 
@@ -425,16 +496,19 @@ def cax4_diagnostics(workdir: Path) -> dict:
             ref = curve(ax["w"], ax["p"])
             wk = 2.0 * np.arange(1, 21) / 20
             sched = np.maximum.accumulate(OVERSHOOT * ref(wk))
-            r = run_ccx(plate_mesh("q4", nr, nz), "CAX4", sched, workdir, f"diag_CAX4_k{kappa:.0e}_{nz}x{nr}",
-                        kappa=kappa)
+            r = run_ccx(
+                plate_mesh("q4", nr, nz), "CAX4", sched, workdir, f"diag_CAX4_k{kappa:.0e}_{nz}x{nr}", kappa=kappa
+            )
             _, _, d = compare(r["w"], r["p"], ref, max(ax["w"]), lo=0.1, hi=2.0)
             row = {"kappa": kappa, "mesh": mesh_name(nr, nz), "status": r["status"], "diff_at": {}}
             if len(d):
-                row["diff_at"] = {w: float(np.interp(w, d[:, 0], d[:, 1])) for w in DIAG_W
-                                  if d[0, 0] <= w <= d[-1, 0]}
+                row["diff_at"] = {w: float(np.interp(w, d[:, 0], d[:, 1])) for w in DIAG_W if d[0, 0] <= w <= d[-1, 0]}
             out["plate"].append(row)
-            print(f"  diagnostics: CAX4 vs Q4 plate {mesh_name(nr, nz)} kappa {kappa:g}: "
-                  + ", ".join(f"w={w:g}: {100 * v:+.3f} %" for w, v in out['plate'][-1]['diff_at'].items()), flush=True)
+            print(
+                f"  diagnostics: CAX4 vs Q4 plate {mesh_name(nr, nz)} kappa {kappa:g}: "
+                + ", ".join(f"w={w:g}: {100 * v:+.3f} %" for w, v in out["plate"][-1]["diff_at"].items()),
+                flush=True,
+            )
     a, b, length, p = 1.0, 2.0, 0.25, 0.01
     kappa = KAPPA
     mu = 2.0 * (C1 + C2)
@@ -457,22 +531,28 @@ def cax4_diagnostics(workdir: Path) -> dict:
             env = dict(os.environ, OMP_NUM_THREADS="1")
             subprocess.run([shutil.which("ccx"), "-i", name], cwd=workdir, capture_output=True, text=True, env=env)
             txt = (workdir / f"{name}.dat").read_text() if (workdir / f"{name}.dat").exists() else ""
-            vals = [float(m.group(1)) for m in re.finditer(r"^\s*\d+\s+([-+0-9.Ee]+)\s+[-+0-9.Ee]+\s+[-+0-9.Ee]+\s*$",
-                                                          txt, re.M)]
-            u_cc = float(np.mean(vals[-len(bore):])) if vals else float("nan")
+            vals = [
+                float(m.group(1))
+                for m in re.finditer(r"^\s*\d+\s+([-+0-9.Ee]+)\s+[-+0-9.Ee]+\s+[-+0-9.Ee]+\s*$", txt, re.M)
+            ]
+            u_cc = float(np.mean(vals[-len(bore) :])) if vals else float("nan")
             row[element] = u_ax / u_exact - 1.0
             row[etype] = u_cc / u_exact - 1.0
             for ext in (".frd", ".12d", ".cvg"):
                 (workdir / f"{name}{ext}").unlink(missing_ok=True)
         out["lame"].append(row)
-        print(f"  diagnostics: Lame n={n}: " + ", ".join(f"{k} {100 * v:+.4f} %" for k, v in row.items() if k != "n"),
-              flush=True)
+        print(
+            f"  diagnostics: Lame n={n}: " + ", ".join(f"{k} {100 * v:+.4f} %" for k, v in row.items() if k != "n"),
+            flush=True,
+        )
     (workdir / "spooles.out").unlink(missing_ok=True)
     a8 = run_axiform("q8", 40, 4, solver="colamd")
     b8 = run_axiform("q8", 40, 4, solver="colamd", kappa=2.0 * KAPPA)
-    out["d1_sensitivity"] = [y / x - 1.0 for x, y in zip(at(a8["w"], a8["p"]), at(b8["w"], b8["p"]))]
-    out["wedge"] = {f"{phi:g}": {"zeta=-1/sqrt3": wedge_spurious_strain(phi), "zeta=0": wedge_spurious_strain(phi, zeta=0.0)}
-                    for phi in (0.001, 0.01, 0.1)}
+    out["d1_sensitivity"] = [y / x - 1.0 for x, y in zip(at(a8["w"], a8["p"]), at(b8["w"], b8["p"]), strict=False)]
+    out["wedge"] = {
+        f"{phi:g}": {"zeta=-1/sqrt3": wedge_spurious_strain(phi), "zeta=0": wedge_spurious_strain(phi, zeta=0.0)}
+        for phi in (0.001, 0.01, 0.1)
+    }
     return out
 
 
@@ -510,8 +590,10 @@ def run_felupe(element: str, nr: int, nz: int, pressures: np.ndarray, tol: float
     mesh = fem.Mesh(m.points[:, ::-1].copy(), m.cells[:, order].copy(), ctype)
     x = mesh.points
     field = fem.FieldContainer([fem.FieldAxisymmetric(Region(mesh), dim=2)])
-    bounds = {"rim": fem.Boundary(field[0], mask=np.isclose(x[:, 1], R)),
-              "axis": fem.Boundary(field[0], mask=np.isclose(x[:, 1], 0.0), skip=(1, 0))}
+    bounds = {
+        "rim": fem.Boundary(field[0], mask=np.isclose(x[:, 1], R)),
+        "axis": fem.Boundary(field[0], mask=np.isclose(x[:, 1], 0.0), skip=(1, 0)),
+    }
     umat = fem.Hyperelastic(fem.mooney_rivlin, C10=C1, C01=C2) & fem.Volumetric(bulk=KAPPA)
     solid = fem.SolidBody(umat, field)
     face = Boundary(mesh, only_surface=True, mask=np.isclose(x[:, 0], 0.0), ensure_3d=True)
@@ -524,8 +606,7 @@ def run_felupe(element: str, nr: int, nz: int, pressures: np.ndarray, tol: float
     for value in pressures:
         pressure.update(float(value))
         try:
-            res = newton(items=[solid, pressure], x0=field, dof1=dof1, dof0=dof0, ext0=ext0,
-                         tol=tol, verbose=0)
+            res = newton(items=[solid, pressure], x0=field, dof1=dof1, dof0=dof0, ext0=ext0, tol=tol, verbose=0)
         except Exception as exc:  # noqa: BLE001  (NewtonConvergenceError)
             status, message = "stopped", f"no convergence at p = {value:.4g}: {exc}"[:300]
             break
@@ -537,9 +618,19 @@ def run_felupe(element: str, nr: int, nz: int, pressures: np.ndarray, tol: float
         w.append(float(field[0].values[centre, 0]))
         p.append(float(value))
     cpu, wall = time.process_time() - c0, time.perf_counter() - t0
-    return {"code": "felupe", "element": ctype, "increments": len(w), "iterations": its,
-            "dofs": int(len(dof1)), "status": status, "message": message,
-            "cpu_s": cpu, "wall_s": wall, "w": w, "p": p}
+    return {
+        "code": "felupe",
+        "element": ctype,
+        "increments": len(w),
+        "iterations": its,
+        "dofs": int(len(dof1)),
+        "status": status,
+        "message": message,
+        "cpu_s": cpu,
+        "wall_s": wall,
+        "w": w,
+        "p": p,
+    }
 
 
 # --------------------------------------------------------------------------------------
@@ -585,19 +676,32 @@ def plot_curves(runs: list[dict], path: Path) -> None:
         colours.setdefault(key, palette[len(colours) % len(palette)])
         col = colours[key]
         ax = case["axiform"]
-        ax1.plot(ax["w"], ax["p"], styles["axiform"], color=col, lw=1.2,
-                 label=f"axiform {ax['element'].upper()} {case['mesh']}")
+        ax1.plot(
+            ax["w"],
+            ax["p"],
+            styles["axiform"],
+            color=col,
+            lw=1.2,
+            label=f"axiform {ax['element'].upper()} {case['mesh']}",
+        )
         for peer in ("calculix", "felupe"):
             r = case.get(peer)
             if not r or not r["w"]:
                 continue
             lab = f"{'CalculiX ' + r['element'] if peer == 'calculix' else 'FElupe ' + r['element']} {case['mesh']}"
-            ax1.plot(r["w"], r["p"], linestyle="none", marker=markers[peer], ms=3.5, mfc="none",
-                     color=col, label=lab)
+            ax1.plot(r["w"], r["p"], linestyle="none", marker=markers[peer], ms=3.5, mfc="none", color=col, label=lab)
             d = np.asarray(r["diff"])
             if len(d):
-                ax2.plot(d[:, 0], 100 * d[:, 1], marker=markers[peer], ms=3, mfc="none", lw=0.6,
-                         color=col, label=lab + " vs axiform")
+                ax2.plot(
+                    d[:, 0],
+                    100 * d[:, 1],
+                    marker=markers[peer],
+                    ms=3,
+                    mfc="none",
+                    lw=0.6,
+                    color=col,
+                    label=lab + " vs axiform",
+                )
     ax1.set_xlabel("centre deflection w [in]")
     ax1.set_ylabel("pressure p [psi]")
     ax1.set_title("Clamped plate: load curves (lines axiform, markers peers)")
@@ -618,8 +722,12 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="2x20 only, 20 load increments (smoke run)")
     ap.add_argument("--meshes", default="2x20,4x40", help="comma-separated NZxNR meshes (default 2x20,4x40)")
-    ap.add_argument("--increments", type=int, default=40,
-                    help="load increments of the peers (default 40, as many as axiform's steps)")
+    ap.add_argument(
+        "--increments",
+        type=int,
+        default=40,
+        help="load increments of the peers (default 40, as many as axiform's steps)",
+    )
     ap.add_argument("--steps", type=int, default=40, help="axiform nominal steps (default 40)")
     ap.add_argument("--no-ccx", action="store_true")
     ap.add_argument("--no-felupe", action="store_true")
@@ -650,8 +758,10 @@ def main(argv=None) -> int:
             case["axiform-colamd"] = axc
             ref = curve(ax["w"], ax["p"])
             w_ax_max = max(ax["w"])
-            print(f"  axiform {element} {mname}: {ax['status']}, {ax['iterations']} its, "
-                  f"{ax['wall_s']:.2f} s wall", flush=True)
+            print(
+                f"  axiform {element} {mname}: {ax['status']}, {ax['iterations']} its, {ax['wall_s']:.2f} s wall",
+                flush=True,
+            )
             wk = W_MAX * np.arange(1, increments + 1) / increments
             schedule = OVERSHOOT * ref(np.minimum(wk, w_ax_max))
             schedule = np.maximum.accumulate(schedule)
@@ -660,24 +770,32 @@ def main(argv=None) -> int:
                 r["max_diff"], r["w_at_max"], d = compare(r["w"], r["p"], ref, w_ax_max)
                 r["diff"] = d.tolist()
                 case["calculix"] = r
-                print(f"  ccx {etype} {mname}: {r['status']}, {r['increments']} incs, {r['iterations']} its, "
-                      f"{r['wall_s']:.2f} s wall, max |dp/p| {pct(r['max_diff'])} %", flush=True)
-                r = run_ccx(plate_mesh(element, nr, nz), etype, schedule, workdir, f"{etype}_{mname}_deftol",
-                            tight=False)
+                print(
+                    f"  ccx {etype} {mname}: {r['status']}, {r['increments']} incs, {r['iterations']} its, "
+                    f"{r['wall_s']:.2f} s wall, max |dp/p| {pct(r['max_diff'])} %",
+                    flush=True,
+                )
+                r = run_ccx(
+                    plate_mesh(element, nr, nz), etype, schedule, workdir, f"{etype}_{mname}_deftol", tight=False
+                )
                 r["max_diff"], r["w_at_max"], d = compare(r["w"], r["p"], ref, w_ax_max)
                 r["diff"] = d.tolist()
                 case["calculix-default-tol"] = r
-                print(f"  ccx {etype} {mname} (default tolerances): {r['status']}, {r['increments']} incs, "
-                      f"{r['iterations']} its, {r['wall_s']:.2f} s wall, max |dp/p| {pct(r['max_diff'])} %",
-                      flush=True)
+                print(
+                    f"  ccx {etype} {mname} (default tolerances): {r['status']}, {r['increments']} incs, "
+                    f"{r['iterations']} its, {r['wall_s']:.2f} s wall, max |dp/p| {pct(r['max_diff'])} %",
+                    flush=True,
+                )
             if fel:
                 r = run_felupe(element, nr, nz, schedule)
                 r["max_diff"], r["w_at_max"], d = compare(r["w"], r["p"], ref, w_ax_max)
                 r["diff"] = d.tolist()
                 case["felupe"] = r
-                print(f"  FElupe {r['element']} {mname}: {r['status']}, {r['increments']} incs, "
-                      f"{r['iterations']} its, {r['wall_s']:.2f} s wall, max |dp/p| {pct(r['max_diff'])} %",
-                      flush=True)
+                print(
+                    f"  FElupe {r['element']} {mname}: {r['status']}, {r['increments']} incs, "
+                    f"{r['iterations']} its, {r['wall_s']:.2f} s wall, max |dp/p| {pct(r['max_diff'])} %",
+                    flush=True,
+                )
             runs.append(case)
     diag = None
     if ccx and not args.quick and not args.no_diagnostics:
@@ -686,29 +804,41 @@ def main(argv=None) -> int:
 
     # ---- report ---------------------------------------------------------------------------
     L = [f"# Peers: the clamped plate in axiform, CalculiX and FElupe{' (quick run)' if args.quick else ''}", ""]
-    L += [f"Written by `benchmarks/peers.py{' --quick' if args.quick else ''}` on {time.strftime('%Y-%m-%d %H:%M')}; "
-          f"{machine()}. axiform {af.__version__}, CalculiX {ccx or 'not run'}, FElupe {fel or 'not run'}. "
-          f"Total run time {total:.0f} s.", ""]
-    L += ["Hughes & Carnoy plate (paper 4.1): R = 7.5 in, h = 0.5 in, C1 = 80, C2 = 20, kappa = 1e4 psi "
-          "(CalculiX D1 = 2/kappa = 2e-4), rim clamped, ur = 0 on the axis, follower pressure on the lower "
-          "face, w = uz at (r, z) = (0, 0.5). Meshes NZxNR (through the thickness x radial). "
-          f"axiform: displacement control to w = 8, {args.steps} nominal steps, its own linear solver as "
-          f"shipped. Peers: load control through {increments} pressures placed at w = 8k/{increments} "
-          f"on axiform's curve, up to {OVERSHOOT} p_axiform(8); CalculiX *STATIC DIRECT with tight "
-          "*CONTROLS (residual 1e-7 of the average force); FElupe Newton tol 1e-8. All single-threaded; "
-          "times include model set-up (and, for CalculiX, reading the deck and expanding the 2D mesh "
-          "to 3D wedges).", ""]
-    L += ["Agreement: max |p_peer(w) / p_axiform(w) - 1| over the peer's converged points with "
-          f"{W_COMPARE[0]} <= w <= {W_COMPARE[1]} in (axiform's curve interpolated by a cubic spline), "
-          "and the pressure at w = 1, 2, 4, 6, 8 (each code's curve interpolated).", ""]
-    L += ["| mesh | code | element | unknowns | incs / steps | Newton its | wall [s] | CPU [s] | wall / axiform | "
-          "p(1) | p(2) | p(4) | p(6) | p(8) | max abs dp/p [%] | at w |",
-          "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    L += [
+        f"Written by `benchmarks/peers.py{' --quick' if args.quick else ''}` on {time.strftime('%Y-%m-%d %H:%M')}; "
+        f"{machine()}. axiform {af.__version__}, CalculiX {ccx or 'not run'}, FElupe {fel or 'not run'}. "
+        f"Total run time {total:.0f} s.",
+        "",
+    ]
+    L += [
+        "Hughes & Carnoy plate (paper 4.1): R = 7.5 in, h = 0.5 in, C1 = 80, C2 = 20, kappa = 1e4 psi "
+        "(CalculiX D1 = 2/kappa = 2e-4), rim clamped, ur = 0 on the axis, follower pressure on the lower "
+        "face, w = uz at (r, z) = (0, 0.5). Meshes NZxNR (through the thickness x radial). "
+        f"axiform: displacement control to w = 8, {args.steps} nominal steps, its own linear solver as "
+        f"shipped. Peers: load control through {increments} pressures placed at w = 8k/{increments} "
+        f"on axiform's curve, up to {OVERSHOOT} p_axiform(8); CalculiX *STATIC DIRECT with tight "
+        "*CONTROLS (residual 1e-7 of the average force); FElupe Newton tol 1e-8. All single-threaded; "
+        "times include model set-up (and, for CalculiX, reading the deck and expanding the 2D mesh "
+        "to 3D wedges).",
+        "",
+    ]
+    L += [
+        "Agreement: max |p_peer(w) / p_axiform(w) - 1| over the peer's converged points with "
+        f"{W_COMPARE[0]} <= w <= {W_COMPARE[1]} in (axiform's curve interpolated by a cubic spline), "
+        "and the pressure at w = 1, 2, 4, 6, 8 (each code's curve interpolated).",
+        "",
+    ]
+    L += [
+        "| mesh | code | element | unknowns | incs / steps | Newton its | wall [s] | CPU [s] | wall / axiform | "
+        "p(1) | p(2) | p(4) | p(6) | p(8) | max abs dp/p [%] | at w |",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
     summary = {}
     for case in runs:
         ax = case["axiform"]
-        rows = [("axiform", ax)] + [(k, case[k]) for k in ("axiform-colamd", "calculix", "calculix-default-tol",
-                                                          "felupe") if case.get(k)]
+        rows = [("axiform", ax)] + [
+            (k, case[k]) for k in ("axiform-colamd", "calculix", "calculix-default-tol", "felupe") if case.get(k)
+        ]
         for code, r in rows:
             unknowns = r.get("dofs") or r.get("equations")
             incs = r.get("steps") if code.startswith("axiform") else r.get("increments")
@@ -716,105 +846,149 @@ def main(argv=None) -> int:
             ratio = r["wall_s"] / ax["wall_s"]
             el = r["element"].upper() if code.startswith("axiform") else r["element"]
             status = "" if r["status"] == "finished" else " (stopped)"
-            L.append(f"| {case['mesh']} | {code}{status} | {el} | {fmt(unknowns, 'd') if unknowns else '-'} | "
-                     f"{incs} | {r['iterations']} | {r['wall_s']:.2f} | {r['cpu_s']:.2f} | {ratio:.2f} | "
-                     + " | ".join(fmt(v) for v in pv)
-                     + f" | {'-' if code.startswith('axiform') else pct(r.get('max_diff'), '.4f')} | "
-                       f"{'-' if code.startswith('axiform') or r.get('w_at_max') is None else format(r['w_at_max'], '.2f')} |")
+            L.append(
+                f"| {case['mesh']} | {code}{status} | {el} | {fmt(unknowns, 'd') if unknowns else '-'} | "
+                f"{incs} | {r['iterations']} | {r['wall_s']:.2f} | {r['cpu_s']:.2f} | {ratio:.2f} | "
+                + " | ".join(fmt(v) for v in pv)
+                + f" | {'-' if code.startswith('axiform') else pct(r.get('max_diff'), '.4f')} | "
+                f"{'-' if code.startswith('axiform') or r.get('w_at_max') is None else format(r['w_at_max'], '.2f')} |"
+            )
             if not code.startswith("axiform"):
                 summary[f"{code} {r['element']} {case['mesh']}"] = {
-                    "max_abs_rel_diff": r.get("max_diff"), "wall_ratio": ratio}
+                    "max_abs_rel_diff": r.get("max_diff"),
+                    "wall_ratio": ratio,
+                }
     L.append("")
-    L.append("Unknowns: axiform and FElupe free dofs; CalculiX the number of equations it reports (the "
-             "nodes of the expanded 3D wedge are tied to the 2D ones by MPCs and eliminated, so the count is "
-             "the 2D one). 'calculix-default-tol': the same deck without the *CONTROLS cards (CalculiX's "
-             "default tolerances, what a user gets), for the timing; its curve is also compared. "
-             "'axiform': its factorization as found in the tree (" + linsolve_identity() + "). "
-             "'axiform-colamd': SuperLU/COLAMD swapped in for it by this script (the factorization of the committed "
-             "axiform.solve.linsolve, MMD_AT_PLUS_A with partial pivoting, loses its ordering on Q8 and SFR tangents, see "
-             "element_study.md); same curve to round-off. The wall ratio is against 'axiform'.")
+    L.append(
+        "Unknowns: axiform and FElupe free dofs; CalculiX the number of equations it reports (the "
+        "nodes of the expanded 3D wedge are tied to the 2D ones by MPCs and eliminated, so the count is "
+        "the 2D one). 'calculix-default-tol': the same deck without the *CONTROLS cards (CalculiX's "
+        "default tolerances, what a user gets), for the timing; its curve is also compared. "
+        "'axiform': its factorization as found in the tree (" + linsolve_identity() + "). "
+        "'axiform-colamd': SuperLU/COLAMD swapped in for it by this script (the factorization of the committed "
+        "axiform.solve.linsolve, MMD_AT_PLUS_A with partial pivoting, loses its ordering on Q8 and SFR tangents, see "
+        "element_study.md); same curve to round-off. The wall ratio is against 'axiform'."
+    )
     L.append("")
     # acceptance
     acc = next((c for c in runs if c["mesh"] == "4x40" and c["family"] == "q8" and c.get("calculix")), None)
     if acc is not None:
         d = acc["calculix"]["max_diff"]
         verdict = "met" if d is not None and d <= 0.01 and acc["calculix"]["status"] == "finished" else "NOT met"
-        L += ["## Acceptance", "",
-              f"axiform Q8 4x40 against CalculiX CAX8 4x40: max |dp/p| = {pct(d, '.4f')} % over "
-              f"{W_COMPARE[0]} <= w <= {W_COMPARE[1]} in (target 1 %): **{verdict}**.", ""]
+        L += [
+            "## Acceptance",
+            "",
+            f"axiform Q8 4x40 against CalculiX CAX8 4x40: max |dp/p| = {pct(d, '.4f')} % over "
+            f"{W_COMPARE[0]} <= w <= {W_COMPARE[1]} in (target 1 %): **{verdict}**.",
+            "",
+        ]
     # CAX4 vs Q4
     q4rows = [(c["mesh"], c["calculix"]) for c in runs if c["family"] == "q4" and c.get("calculix")]
-    fe_max = max([c["felupe"]["max_diff"] for c in runs if c.get("felupe") and c["felupe"]["max_diff"] is not None],
-                 default=None)
+    fe_max = max(
+        [c["felupe"]["max_diff"] for c in runs if c.get("felupe") and c["felupe"]["max_diff"] is not None], default=None
+    )
     L += ["## Differences, explained", ""]
-    L += ["- **Q8 / CAX8 / FElupe quad8** and **FElupe quad vs axiform Q4** agree to the convergence tolerances "
-          f"(FElupe: max {pct(fe_max, '.5f')} %): the three codes solve the same discrete problem. CAX8 is expanded "
-          "by CalculiX into a C3D20 wedge with dedicated axisymmetric shape functions (shape20h_ax) and 3x3x3 Gauss "
-          "points; FElupe's RegionQuadraticQuad / RegionQuad use 3x3 / 2x2 Gauss-Legendre; all are plain "
-          "displacement elements with full integration, no B-bar or mixed pressure, like axiform's Q8 (3x3) and "
-          "Q4 (2x2)."]
+    L += [
+        "- **Q8 / CAX8 / FElupe quad8** and **FElupe quad vs axiform Q4** agree to the convergence tolerances "
+        f"(FElupe: max {pct(fe_max, '.5f')} %): the three codes solve the same discrete problem. CAX8 is expanded "
+        "by CalculiX into a C3D20 wedge with dedicated axisymmetric shape functions (shape20h_ax) and 3x3x3 Gauss "
+        "points; FElupe's RegionQuadraticQuad / RegionQuad use 3x3 / 2x2 Gauss-Legendre; all are plain "
+        "displacement elements with full integration, no B-bar or mixed pressure, like axiform's Q8 (3x3) and "
+        "Q4 (2x2)."
+    ]
     if q4rows:
-        L += ["- **CAX4 vs axiform Q4** differ more: " + "; ".join(
-            f"{m}: max {pct(r['max_diff'], '.3f')} % at w = {fmt(r['w_at_max'], '.2f')}" for m, r in q4rows)
+        L += [
+            "- **CAX4 vs axiform Q4** differ more: "
+            + "; ".join(f"{m}: max {pct(r['max_diff'], '.3f')} % at w = {fmt(r['w_at_max'], '.2f')}" for m, r in q4rows)
             + ". CAX4 is the stiffer one; the difference is largest at small deflections (bending) and small "
-              "at w = 8 (membrane), and it does not shrink from 2x20 to 4x40. It is not a volumetric treatment: "
-              "CAX4 becomes a C3D8 'A' element with a 2x2x1 rule (mint3d = 4 in e_c3d.f), no B-bar (a B-bar or "
-              "mixed formulation would make CAX4 *softer* than Q4, the more so the larger kappa). FElupe's "
-              "independent Q4 matches axiform's to 1e-6, so axiform's Q4 is the textbook axisymmetric Q4; the "
-              "difference comes from CalculiX's 3D expansion of CAX4 (see the diagnostics below)."]
-    L += ["- CalculiX's follower pressure: in e_c3d.f (ccx source) the face load of a *DLOAD P<face> is integrated "
-          "on the current face coordinates (co + vold) whenever NLGEOM is on, with its load stiffness (Dhondt "
-          "2004, eq. 3.54). That stiffness is symmetrized for the symmetric SPOOLES solver (\"Factoring the "
-          "system of equations using the symmetric spooles solver\" in the log), so CalculiX's Newton converges "
-          "linearly near the end (more iterations with the tight tolerances); the equilibrium it converges to is "
-          "the follower-load one, as the agreement with axiform and FElupe (both follower, consistent tangent) "
-          "shows.",
-          "- D1 convention: CalculiX's Mooney-Rivlin is C10 (I1b - 3) + C01 (I2b - 3) + (J - 1)^2 / D1, so "
-          "D1 = 2 / kappa gives axiform's kappa/2 (J - 1)^2."
-          + (" A wrong D1 = 1 / kappa (kappa doubled) would move the Q8 4x40 curve by "
-             + ", ".join(f"{100 * v:+.2f} %" for v in diag["d1_sensitivity"]) + " at w = 1, 2, 4, 6, 8 (axiform, "
-             "computed here), far more than the CAX8 differences above." if diag else ""),
-          "- Timing: CalculiX expands every 2D element into a 3D wedge (CAX8: 20 nodes, 27 Gauss points) and "
-          "solves with a symmetrized tangent (more iterations); its times include reading the deck and writing "
-          "the outputs. FElupe's times include its (tensortrax, automatic-differentiation) material evaluation. "
-          "Ratios on a shared 2-core machine vary by some 20 % from run to run.",
-          "- The first increments (w < 0.5 in) are left out of the relative comparison: p is tiny there.",
-          ""]
+            "at w = 8 (membrane), and it does not shrink from 2x20 to 4x40. It is not a volumetric treatment: "
+            "CAX4 becomes a C3D8 'A' element with a 2x2x1 rule (mint3d = 4 in e_c3d.f), no B-bar (a B-bar or "
+            "mixed formulation would make CAX4 *softer* than Q4, the more so the larger kappa). FElupe's "
+            "independent Q4 matches axiform's to 1e-6, so axiform's Q4 is the textbook axisymmetric Q4; the "
+            "difference comes from CalculiX's 3D expansion of CAX4 (see the diagnostics below)."
+        ]
+    L += [
+        "- CalculiX's follower pressure: in e_c3d.f (ccx source) the face load of a *DLOAD P<face> is integrated "
+        "on the current face coordinates (co + vold) whenever NLGEOM is on, with its load stiffness (Dhondt "
+        '2004, eq. 3.54). That stiffness is symmetrized for the symmetric SPOOLES solver ("Factoring the '
+        "system of equations using the symmetric spooles solver\" in the log), so CalculiX's Newton converges "
+        "linearly near the end (more iterations with the tight tolerances); the equilibrium it converges to is "
+        "the follower-load one, as the agreement with axiform and FElupe (both follower, consistent tangent) "
+        "shows.",
+        "- D1 convention: CalculiX's Mooney-Rivlin is C10 (I1b - 3) + C01 (I2b - 3) + (J - 1)^2 / D1, so "
+        "D1 = 2 / kappa gives axiform's kappa/2 (J - 1)^2."
+        + (
+            " A wrong D1 = 1 / kappa (kappa doubled) would move the Q8 4x40 curve by "
+            + ", ".join(f"{100 * v:+.2f} %" for v in diag["d1_sensitivity"])
+            + " at w = 1, 2, 4, 6, 8 (axiform, "
+            "computed here), far more than the CAX8 differences above."
+            if diag
+            else ""
+        ),
+        "- Timing: CalculiX expands every 2D element into a 3D wedge (CAX8: 20 nodes, 27 Gauss points) and "
+        "solves with a symmetrized tangent (more iterations); its times include reading the deck and writing "
+        "the outputs. FElupe's times include its (tensortrax, automatic-differentiation) material evaluation. "
+        "Ratios on a shared 2-core machine vary by some 20 % from run to run.",
+        "- The first increments (w < 0.5 in) are left out of the relative comparison: p is tiny there.",
+        "",
+    ]
     if diag:
         L += ["## CAX4 diagnostics", ""]
-        L += ["1. The plate, CAX4 vs axiform Q4, p_CAX4(w) / p_Q4(w) - 1 in %, for three bulk moduli:", "",
-              "| kappa [psi] | mesh | " + " | ".join(f"w = {w:g}" for w in DIAG_W) + " |",
-              "|---:|---|" + "---:|" * len(DIAG_W)]
+        L += [
+            "1. The plate, CAX4 vs axiform Q4, p_CAX4(w) / p_Q4(w) - 1 in %, for three bulk moduli:",
+            "",
+            "| kappa [psi] | mesh | " + " | ".join(f"w = {w:g}" for w in DIAG_W) + " |",
+            "|---:|---|" + "---:|" * len(DIAG_W),
+        ]
         for row in diag["plate"]:
-            L.append(f"| {row['kappa']:g} | {row['mesh']} | " + " | ".join(
-                pct(row["diff_at"].get(w), "+.3f") for w in DIAG_W) + " |")
-        L += ["", "2. A thick cylinder in plane strain (r from 1 to 2 in, uz held at both ends, n x 1 elements, "
-              "p = 0.01 psi, kappa = 1e4): no fibre rotation (U,Z = W,R = 0). Bore displacement against Lame's "
-              "solution, in %:", "",
-              "| n | axiform Q4 | CalculiX CAX4 | axiform Q8 | CalculiX CAX8 |", "|---:|---:|---:|---:|---:|"]
+            L.append(
+                f"| {row['kappa']:g} | {row['mesh']} | "
+                + " | ".join(pct(row["diff_at"].get(w), "+.3f") for w in DIAG_W)
+                + " |"
+            )
+        L += [
+            "",
+            "2. A thick cylinder in plane strain (r from 1 to 2 in, uz held at both ends, n x 1 elements, "
+            "p = 0.01 psi, kappa = 1e4): no fibre rotation (U,Z = W,R = 0). Bore displacement against Lame's "
+            "solution, in %:",
+            "",
+            "| n | axiform Q4 | CalculiX CAX4 | axiform Q8 | CalculiX CAX8 |",
+            "|---:|---:|---:|---:|---:|",
+        ]
         for row in diag["lame"]:
-            L.append(f"| {row['n']} | {pct(row['q4'], '+.4f')} | {pct(row['CAX4'], '+.4f')} | "
-                     f"{pct(row['q8'], '+.4f')} | {pct(row['CAX8'], '+.4f')} |")
+            L.append(
+                f"| {row['n']} | {pct(row['q4'], '+.4f')} | {pct(row['CAX4'], '+.4f')} | "
+                f"{pct(row['q8'], '+.4f')} | {pct(row['CAX8'], '+.4f')} |"
+            )
         wd = diag["wedge"]
-        L += ["", "3. Kinematics of the expanded CAX4 (nodes of the section rotated by +-1 degree about the axis, "
-              "trilinear C3D8 between them, sampled by the 2x2x1 rule at zeta = -1/sqrt(3)): for a pure rotation "
-              "phi of the meridian fibres, which strains nothing in the axisymmetric kinematics, the wedge's "
-              "Green-Lagrange strain is not zero: max |E| = "
-              + ", ".join(f"{v['zeta=-1/sqrt3']:.2e} (phi = {k})" for k, v in wd.items())
-              + " at the Gauss points, i.e. about 0.5 % of the rotation (mostly E_23 = sin(1 deg) zeta U,Z / 2), "
-              "against " + ", ".join(f"{v['zeta=0']:.1e}" for v in wd.values()) + " in the meridian plane "
-              "(zeta = 0).", "",
-              "Reading: the difference vanishes where the fibres do not rotate (the cylinder: CAX4 and Q4 differ by "
-              "a constant 0.02 %, the O(1e-4) of the 2-degree chord, while both converge to Lame's solution), and it "
-              "is largest where a thin plate bends, where rotations exceed strains by about the slenderness; there "
-              "the flat wedge adds a spurious shear strain of about 0.5 % of the rotation and so a spurious "
-              "stiffness. It is a property of CalculiX's CAX4 expansion, not of axiform's Q4 (which FElupe "
-              "reproduces) and not a volumetric (B-bar / hybrid) treatment. CAX8 uses dedicated axisymmetric shape "
-              "functions and shows nothing of the kind (0.003 %).", ""]
+        L += [
+            "",
+            "3. Kinematics of the expanded CAX4 (nodes of the section rotated by +-1 degree about the axis, "
+            "trilinear C3D8 between them, sampled by the 2x2x1 rule at zeta = -1/sqrt(3)): for a pure rotation "
+            "phi of the meridian fibres, which strains nothing in the axisymmetric kinematics, the wedge's "
+            "Green-Lagrange strain is not zero: max |E| = "
+            + ", ".join(f"{v['zeta=-1/sqrt3']:.2e} (phi = {k})" for k, v in wd.items())
+            + " at the Gauss points, i.e. about 0.5 % of the rotation (mostly E_23 = sin(1 deg) zeta U,Z / 2), "
+            "against " + ", ".join(f"{v['zeta=0']:.1e}" for v in wd.values()) + " in the meridian plane "
+            "(zeta = 0).",
+            "",
+            "Reading: the difference vanishes where the fibres do not rotate (the cylinder: CAX4 and Q4 differ by "
+            "a constant 0.02 %, the O(1e-4) of the 2-degree chord, while both converge to Lame's solution), and it "
+            "is largest where a thin plate bends, where rotations exceed strains by about the slenderness; there "
+            "the flat wedge adds a spurious shear strain of about 0.5 % of the rotation and so a spurious "
+            "stiffness. It is a property of CalculiX's CAX4 expansion, not of axiform's Q4 (which FElupe "
+            "reproduces) and not a volumetric (B-bar / hybrid) treatment. CAX8 uses dedicated axisymmetric shape "
+            "functions and shows nothing of the kind (0.003 %).",
+            "",
+        ]
     (out / f"{stem}.md").write_text("\n".join(L))
     with open(out / f"{stem}.json", "w") as f:
-        json.dump({"summary": summary, "runs": runs, "ccx": ccx, "felupe": fel, "diagnostics": diag, "total_s": total},
-                  f, indent=1, default=float)
+        json.dump(
+            {"summary": summary, "runs": runs, "ccx": ccx, "felupe": fel, "diagnostics": diag, "total_s": total},
+            f,
+            indent=1,
+            default=float,
+        )
     plot_curves(runs, out / f"{stem}_curves.png")
     print("\n".join(L))
     print(f"wrote {out / (stem + '.md')}, {stem}.json, {stem}_curves.png ({total:.0f} s)")

@@ -76,22 +76,37 @@ def run(case: dict, folder: Path) -> dict:
     with open(folder / "out" / "thickness.csv", newline="") as stream:
         wall = list(csv.DictReader(line for line in stream if not line.startswith("#")))
     history = read_history(folder / "out" / "history.csv")
-    return {"s": np.array([float(r["s"]) for r in wall]), "ratio": np.array([float(r["ratio"]) for r in wall]),
-            "t": history["load_factor"], "plug_force": history["plug_force"],
-            "steps": summary["steps"], "iterations": summary["newton_iterations"]}
+    return {
+        "s": np.array([float(r["s"]) for r in wall]),
+        "ratio": np.array([float(r["ratio"]) for r in wall]),
+        "t": history["load_factor"],
+        "plug_force": history["plug_force"],
+        "steps": summary["steps"],
+        "iterations": summary["newton_iterations"],
+    }
 
 
 def table(runs: dict[str, dict], thickness: float) -> str:
     """The markdown table of the runs."""
-    head = ["run", "process time (s)", "thinnest wall (mm)", "at s (mm)",
-            *[f"{name} (mm)" for name in S_REPORT], "largest plug force (N)", "steps", "Newton iterations"]
+    head = [
+        "run",
+        "process time (s)",
+        "thinnest wall (mm)",
+        "at s (mm)",
+        *[f"{name} (mm)" for name in S_REPORT],
+        "largest plug force (N)",
+        "steps",
+        "Newton iterations",
+    ]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for name, res in runs.items():
         wall = res["ratio"] * thickness
         at = [np.interp(s, res["s"], wall) for s in S_REPORT.values()]
-        lines.append(f"| {name} | {res['t'][-1]:g} | {wall.min():.3f} | {res['s'][np.argmin(wall)]:.1f} | "
-                     + " | ".join(f"{w:.3f}" for w in at)
-                     + f" | {-res['plug_force'].min():.1f} | {res['steps']} | {res['iterations']} |")
+        lines.append(
+            f"| {name} | {res['t'][-1]:g} | {wall.min():.3f} | {res['s'][np.argmin(wall)]:.1f} | "
+            + " | ".join(f"{w:.3f}" for w in at)
+            + f" | {-res['plug_force'].min():.1f} | {res['steps']} | {res['iterations']} |"
+        )
     return "\n".join(lines) + "\n"
 
 
@@ -103,10 +118,13 @@ def figure(runs: dict[str, dict], thickness: float, path: Path) -> None:
         colour, line = styles.get(name, (None, "-"))
         left.plot(res["s"], res["ratio"] * thickness, color=colour, linestyle=line, label=name)
         right.plot(res["t"] / res["t"][-1], -res["plug_force"], color=colour, linestyle=line, label=name)
-    left.set(xlabel="reference arc length s (mm), from the centre of the sheet", ylabel="wall thickness (mm)",
-             title="final wall", ylim=(0, None))
-    right.set(xlabel="t / process time (plug down to 2/3, vacuum after)", ylabel="plug force (N)",
-              title="plug force")
+    left.set(
+        xlabel="reference arc length s (mm), from the centre of the sheet",
+        ylabel="wall thickness (mm)",
+        title="final wall",
+        ylim=(0, None),
+    )
+    right.set(xlabel="t / process time (plug down to 2/3, vacuum after)", ylabel="plug force (N)", title="plug force")
     for ax in (left, right):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
@@ -119,17 +137,21 @@ def figure(runs: dict[str, dict], thickness: float, path: Path) -> None:
 def study() -> None:
     """Run the four cases, write the figure and the table."""
     data = read(CASE)
-    cases = {"10x faster (0.15 s)": scaled(data, 10.0), "nominal (1.5 s)": scaled(data, 1.0),
-             "10x slower (15 s)": scaled(data, 0.1),
-             "elastic, instantaneous modulus": elastic(data)}
+    cases = {
+        "10x faster (0.15 s)": scaled(data, 10.0),
+        "nominal (1.5 s)": scaled(data, 1.0),
+        "10x slower (15 s)": scaled(data, 0.1),
+        "elastic, instantaneous modulus": elastic(data),
+    }
     thickness = data["mesh"]["z"][1] - data["mesh"]["z"][0]
     with tempfile.TemporaryDirectory() as tmp:
         runs = {name: run(case, Path(tmp) / f"run{k}") for k, (name, case) in enumerate(cases.items())}
     RESULTS.mkdir(exist_ok=True)
     figure(runs, thickness, RESULTS / "rate_study.png")
     text = table(runs, thickness)
-    (RESULTS / "rate_study.md").write_text("# Rate study: the cup at 0.1x, 1x and 10x its rate\n\n"
-                                           "Written by `benchmarks/rate_study.py`.\n\n" + text)
+    (RESULTS / "rate_study.md").write_text(
+        "# Rate study: the cup at 0.1x, 1x and 10x its rate\n\nWritten by `benchmarks/rate_study.py`.\n\n" + text
+    )
     print(text)
 
 

@@ -48,8 +48,7 @@ import numpy as np
 from scipy.sparse.linalg import splu
 
 import axiform.solve.newton
-from axiform import (DisplacementControl, Model, MooneyRivlin, rectangle, select_edges,
-                     select_nodes, solve)
+from axiform import DisplacementControl, Model, MooneyRivlin, rectangle, select_edges, select_nodes, solve
 from axiform.solve.linsolve import SingularTangentError
 
 HERE = Path(__file__).resolve().parent
@@ -75,8 +74,7 @@ _stock_factorize = axiform.solve.newton.factorize
 def symmetric_mode_factorize(K):
     """SuperLU with the minimum-degree ordering on K^T + K kept (threshold pivoting)."""
     try:
-        lu = splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.01,
-                  options=dict(SymmetricMode=True))
+        lu = splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.01, options=dict(SymmetricMode=True))
     except RuntimeError as exc:
         raise SingularTangentError(str(exc)) from exc
 
@@ -129,12 +127,25 @@ def plate(element: str, nt: int, nr: int, rule: str = "tie", rim_rot: bool = Fal
     p = np.array([0.0] + [s.lam for s in res.steps])
     t = np.array([THICK] + [THICK + s.u[c] - s.u[b] for s in res.steps])
     exact = all(np.isclose(w, x, rtol=0, atol=1e-9).any() for x in W_REPORT)
-    return dict(element=element, mesh=f"{nt}x{nr}", rule=rule, rim_rot=rim_rot,
-                status=res.status, message=res.message, steps=len(res.steps),
-                iterations=res.newton_iterations, dofs=model.n_free, wall=wall,
-                w=w, p=p, t=t, exact=exact, bow=bow,
-                p_at=np.interp(W_REPORT, w, p) if w[-1] >= W_END - 1e-9 else None,
-                t_at=np.interp(W_REPORT, w, t) if w[-1] >= W_END - 1e-9 else None)
+    return dict(
+        element=element,
+        mesh=f"{nt}x{nr}",
+        rule=rule,
+        rim_rot=rim_rot,
+        status=res.status,
+        message=res.message,
+        steps=len(res.steps),
+        iterations=res.newton_iterations,
+        dofs=model.n_free,
+        wall=wall,
+        w=w,
+        p=p,
+        t=t,
+        exact=exact,
+        bow=bow,
+        p_at=np.interp(W_REPORT, w, p) if w[-1] >= W_END - 1e-9 else None,
+        t_at=np.interp(W_REPORT, w, t) if w[-1] >= W_END - 1e-9 else None,
+    )
 
 
 def small_deflection(element: str, nt: int, nr: int, kappa: float, w: float = 0.05) -> float:
@@ -169,14 +180,24 @@ def cylinder(element: str, nr: int, rule: str = "tie") -> dict:
     p = np.array([0.0] + [s.lam for s in res.steps])
     dpn = model.dpn
     # how much the fibre rotations move, as a displacement over the wall (B - A), relative to ur
-    theta = max((np.abs(s.u[2::3]).max() * (B - A) / np.abs(s.u[0::dpn]).max() if dpn == 3 else 0.0)
-                for s in res.steps)
+    theta = max((np.abs(s.u[2::3]).max() * (B - A) / np.abs(s.u[0::dpn]).max() if dpn == 3 else 0.0) for s in res.steps)
     uz = max(np.abs(s.u[1::dpn]).max() / np.abs(s.u[0::dpn]).max() for s in res.steps)
     exact = all(np.isclose(a, x, rtol=0, atol=1e-9).any() for x in A_REPORT)
-    return dict(element=element, nr=nr, rule=rule, status=res.status, steps=len(res.steps),
-                iterations=res.newton_iterations, dofs=model.n_free, wall=wall, exact=exact,
-                p_at=np.interp(A_REPORT, a, p) if res.status == "finished" else None,
-                theta=theta, uz=uz, bow=bow)
+    return dict(
+        element=element,
+        nr=nr,
+        rule=rule,
+        status=res.status,
+        steps=len(res.steps),
+        iterations=res.newton_iterations,
+        dofs=model.n_free,
+        wall=wall,
+        exact=exact,
+        p_at=np.interp(A_REPORT, a, p) if res.status == "finished" else None,
+        theta=theta,
+        uz=uz,
+        bow=bow,
+    )
 
 
 # ------------------------------------------------------------------------------ output
@@ -199,8 +220,9 @@ def label(run: dict) -> str:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="smoke run: coarse meshes and reference")
-    ap.add_argument("--stock-linsolve", action="store_true",
-                    help="keep axiform's own factorization (slow on these meshes)")
+    ap.add_argument(
+        "--stock-linsolve", action="store_true", help="keep axiform's own factorization (slow on these meshes)"
+    )
     ap.add_argument("--out", type=Path, default=HERE / "results" / "sfr_edge_study.md")
     args = ap.parse_args()
     t_start = time.perf_counter()
@@ -219,17 +241,21 @@ def main() -> int:
 
     emit("# SFR edge rule: mesh-convergence study" + (" (--quick smoke run)" if quick else ""))
     emit()
-    emit(f"Written by `benchmarks/sfr_edge_study.py{' --quick' if quick else ''}` on "
-         f"{datetime.date.today()} ({platform.machine()}, Python {platform.python_version()}, "
-         f"numpy {np.__version__}; wall times on a shared, loaded 2-core machine).")
+    emit(
+        f"Written by `benchmarks/sfr_edge_study.py{' --quick' if quick else ''}` on "
+        f"{datetime.date.today()} ({platform.machine()}, Python {platform.python_version()}, "
+        f"numpy {np.__version__}; wall times on a shared, loaded 2-core machine)."
+    )
     emit()
-    emit("Rules (`Model(sfr_edges=...)`) for the fibre rotations of an SFR edge whose normal "
-         "displacement is held at both nodes: **tie** (one shared theta per chain of such "
-         "edges), **fix** (theta = 0), **free** (nothing; one theta is then fixed somewhere "
-         "against the uniform-theta mode).  Under tie and fix the held edge is held everywhere "
-         "(the theta bubble s (L - s)/L (theta_i - theta_j) vanishes), under free it bows "
-         "between its nodes by up to L/4 |theta_i - theta_j|: the column *bow* reports that, "
-         "relative to the controlled displacement.")
+    emit(
+        "Rules (`Model(sfr_edges=...)`) for the fibre rotations of an SFR edge whose normal "
+        "displacement is held at both nodes: **tie** (one shared theta per chain of such "
+        "edges), **fix** (theta = 0), **free** (nothing; one theta is then fixed somewhere "
+        "against the uniform-theta mode).  Under tie and fix the held edge is held everywhere "
+        "(the theta bubble s (L - s)/L (theta_i - theta_j) vanishes), under free it bows "
+        "between its nodes by up to L/4 |theta_i - theta_j|: the column *bow* reports that, "
+        "relative to the controlled displacement."
+    )
     emit()
 
     # ---- linear solver check, side by side
@@ -244,16 +270,26 @@ def main() -> int:
         use_factorization(True)
         fast = plate("sfr", 4, 40, "tie")
         dp = np.abs(fast["p"] - slow["p"]).max() / np.abs(slow["p"]).max()
-        emit("axiform.solve.linsolve (SuperLU, MMD_AT_PLUS_A, default partial pivoting) replaced by "
-             "SuperLU, MMD_AT_PLUS_A, diag_pivot_thresh = 0.01, SymmetricMode (see the module "
-             "docstring).  Same run (SFR tie 4x40 plate, to w = 8), side by side:")
+        emit(
+            "axiform.solve.linsolve (SuperLU, MMD_AT_PLUS_A, default partial pivoting) replaced by "
+            "SuperLU, MMD_AT_PLUS_A, diag_pivot_thresh = 0.01, SymmetricMode (see the module "
+            "docstring).  Same run (SFR tie 4x40 plate, to w = 8), side by side:"
+        )
         emit()
-        emit(table(["factorization", "Newton its", "wall [s]"],
-                   [["axiform.solve.linsolve (stock)", str(slow["iterations"]), f"{slow['wall']:.2f}"],
-                    ["symmetric mode", str(fast["iterations"]), f"{fast['wall']:.2f}"]]))
+        emit(
+            table(
+                ["factorization", "Newton its", "wall [s]"],
+                [
+                    ["axiform.solve.linsolve (stock)", str(slow["iterations"]), f"{slow['wall']:.2f}"],
+                    ["symmetric mode", str(fast["iterations"]), f"{fast['wall']:.2f}"],
+                ],
+            )
+        )
         emit()
-        emit(f"Speed-up {slow['wall'] / fast['wall']:.1f}x; max |p difference| over the path "
-             f"{dp:.1e} of max p (same solution to round-off).")
+        emit(
+            f"Speed-up {slow['wall'] / fast['wall']:.1f}x; max |p difference| over the path "
+            f"{dp:.1e} of max p (same solution to round-off)."
+        )
     emit()
 
     # ---- plate
@@ -268,12 +304,14 @@ def main() -> int:
     with np.errstate(divide="ignore", invalid="ignore"):
         order = np.log2((p1 - p2) / (p2 - p3))
         p_rich = p3 + (p3 - p2) / (2.0**order - 1)
-    emit(f"Reference: Q8 {ref['mesh']} ({ref['dofs']} unknowns, {ref['wall']:.0f} s).  Its own "
-         f"error is estimated by Richardson from the three Q8 meshes (observed order and "
-         f"extrapolated p below).  The convergence is slow (observed order 1-1.7, consistent "
-         f"with the stress singularities at the clamped rim corners), so the reference itself "
-         f"is off by the last row of that table, a fraction of a per cent.  The SFR errors below are relative to Q8 "
-         f"{ref['mesh']}, not to the extrapolation.")
+    emit(
+        f"Reference: Q8 {ref['mesh']} ({ref['dofs']} unknowns, {ref['wall']:.0f} s).  Its own "
+        f"error is estimated by Richardson from the three Q8 meshes (observed order and "
+        f"extrapolated p below).  The convergence is slow (observed order 1-1.7, consistent "
+        f"with the stress singularities at the clamped rim corners), so the reference itself "
+        f"is off by the last row of that table, a fraction of a per cent.  The SFR errors below are relative to Q8 "
+        f"{ref['mesh']}, not to the extrapolation."
+    )
     emit()
     rows = [[f"p Q8 {r['mesh']}"] + [f"{x:.5g}" for x in r["p_at"]] for r in q8]
     rows.append(["observed order (Q8)"] + [f"{o:.2f}" for o in order])
@@ -300,11 +338,13 @@ def main() -> int:
             return [("sfr", nt, r, False) for r in RULES]
         return [("sfr", nt, r, rr) for r, rr in configs] + [("q4", nt, "-", False)]
 
-    emit("Relative error of p, in %, (p - p_ref) / p_ref.  Without \"+ rim rot=0\": rot not "
-         "fixed at r = 7.5, the rule acts on the rim and on the axis; \"+ rim rot=0\": rot fixed "
-         "at the rim explicitly (as in DESIGN.md's case-file example), the rule acts on the axis "
-         "only (fix + rim rot=0 is fix).  bow: max over the path of the largest bow of the rim "
-         "and axis edges / w.")
+    emit(
+        'Relative error of p, in %, (p - p_ref) / p_ref.  Without "+ rim rot=0": rot not '
+        'fixed at r = 7.5, the rule acts on the rim and on the axis; "+ rim rot=0": rot fixed '
+        "at the rim explicitly (as in DESIGN.md's case-file example), the rule acts on the axis "
+        "only (fix + rim rot=0 is fix).  bow: max over the path of the largest bow of the rim "
+        "and axis edges / w."
+    )
     emit()
     header = ["mesh", "element / rule"] + [f"w={w:g}" for w in W_REPORT] + ["bow", "its", "s"]
     rows = []
@@ -312,22 +352,27 @@ def main() -> int:
         for key in keys(nt):
             run = runs[key]
             if run["p_at"] is None:
-                rows.append([run["mesh"], label(run), f"stopped at w = {run['w'][-1]:.3g}: "
-                             f"{run['message']}"] + [""] * 8)
+                rows.append(
+                    [run["mesh"], label(run), f"stopped at w = {run['w'][-1]:.3g}: {run['message']}"] + [""] * 8
+                )
                 continue
             e = run["p_at"] / p_ref - 1
-            rows.append([run["mesh"], label(run) + ("" if run["exact"] else " (interp.)")]
-                        + [pct(x) for x in e]
-                        + [f"{run['bow']:.1e}", str(run["iterations"]), f"{run['wall']:.1f}"])
+            rows.append(
+                [run["mesh"], label(run) + ("" if run["exact"] else " (interp.)")]
+                + [pct(x) for x in e]
+                + [f"{run['bow']:.1e}", str(run["iterations"]), f"{run['wall']:.1f}"]
+            )
     emit(table(header, rows))
     emit()
     same = 0.0
     for nt, _ in plate_meshes:
         pa, pb = runs[("sfr", nt, "tie", True)]["p"][1:], runs[("sfr", nt, "tie", False)]["p"][1:]
         same = max(same, np.abs(pa / pb - 1).max() if len(pa) == len(pb) else np.inf)
-    emit(f"tie and tie + rim rot=0 agree to {same:.1e} (relative, every step, every mesh): under "
-         "tie the rim and the axis are two tied groups, and the uniform-theta mode shifts one "
-         "group's value to zero at no cost, so fixing the rim's theta changes nothing.")
+    emit(
+        f"tie and tie + rim rot=0 agree to {same:.1e} (relative, every step, every mesh): under "
+        "tie the rim and the axis are two tied groups, and the uniform-theta mode shifts one "
+        "group's value to zero at no cost, so fixing the rim's theta changes nothing."
+    )
     emit()
 
     emit("Thickness at the centre (r = 0), relative error in % vs the reference:")
@@ -342,8 +387,10 @@ def main() -> int:
     emit(table(["mesh", "element / rule"] + [f"w={w:g}" for w in W_REPORT], rows))
     emit()
 
-    emit("Difference between the rules, p(fix) / p(tie) - 1 and p(free) / p(tie) - 1 in %: "
-         "how fast the choice stops mattering.")
+    emit(
+        "Difference between the rules, p(fix) / p(tie) - 1 and p(free) / p(tie) - 1 in %: "
+        "how fast the choice stops mattering."
+    )
     emit()
     rows = []
     for nt, nr in all_meshes:
@@ -359,12 +406,14 @@ def main() -> int:
     cref = cylinder("q8", cyl_ref)
     try:
         from oracles import RadialBVP
+
         p_bvp = RadialBVP(MATERIAL, A, B, tol=1e-8).pressures(A_REPORT)
     except Exception as exc:  # the oracle is a bonus; the Q8 reference is the study's
         p_bvp = None
         emit(f"(1D oracle unavailable: {exc})")
-    emit(f"A = {A}, B = {B}, slice height {H}, {NZ} element rows; reference Q8 nr = {cyl_ref} "
-         f"({cref['dofs']} unknowns).")
+    emit(
+        f"A = {A}, B = {B}, slice height {H}, {NZ} element rows; reference Q8 nr = {cyl_ref} ({cref['dofs']} unknowns)."
+    )
     emit()
     rows = [[f"p Q8 nr={cyl_ref}"] + [f"{x:.7g}" for x in cref["p_at"]]]
     if p_bvp is not None:
@@ -379,10 +428,12 @@ def main() -> int:
             crun[(nr, rule)] = cylinder("sfr", nr, rule)
         crun[(nr, "q4")] = cylinder("q4", nr)
         crun[(nr, "q8")] = cylinder("q8", nr)
-    emit(f"Relative error of p in % vs Q8 nr = {cyl_ref}.  theta: max |theta| (B - A) / max |ur| "
-         "over the path (0: the rotations stay at rest); bow: largest bow of the faces z = 0, H "
-         "between nodes / (a - A), max over the path (the faces of a plane-strain slice must "
-         "stay flat).")
+    emit(
+        f"Relative error of p in % vs Q8 nr = {cyl_ref}.  theta: max |theta| (B - A) / max |ur| "
+        "over the path (0: the rotations stay at rest); bow: largest bow of the faces z = 0, H "
+        "between nodes / (a - A), max over the path (the faces of a plane-strain slice must "
+        "stay flat)."
+    )
     emit()
     rows = []
     for nr in cyl_meshes:
@@ -393,31 +444,38 @@ def main() -> int:
                 rows.append([str(nr), name, "stopped"] + [""] * 6)
                 continue
             e = run["p_at"] / p_cref - 1
-            rows.append([f"{nr}x{NZ}", name] + [pct(x) for x in e]
-                        + [f"{run['theta']:.1e}", f"{run['bow']:.1e}", str(run["iterations"])])
-    emit(table(["mesh (r x z)", "element / rule"] + [f"a/A={x / A:g}" for x in A_REPORT]
-               + ["theta", "bow", "its"], rows))
+            rows.append(
+                [f"{nr}x{NZ}", name]
+                + [pct(x) for x in e]
+                + [f"{run['theta']:.1e}", f"{run['bow']:.1e}", str(run["iterations"])]
+            )
+    emit(
+        table(["mesh (r x z)", "element / rule"] + [f"a/A={x / A:g}" for x in A_REPORT] + ["theta", "bow", "its"], rows)
+    )
     emit()
 
     # ---- locking: why the small-w errors are large
     emit("## 3. Why the errors at small w are large: volumetric locking, not the edge rule")
     emit()
-    emit("Same plate, one step to w = 0.05 (linear range), p relative to Q8 8x80 at the same "
-         "kappa, in %, for three kappa / mu (mu = 2 (C1 + C2) = 200; the study uses 50):")
+    emit(
+        "Same plate, one step to w = 0.05 (linear range), p relative to Q8 8x80 at the same "
+        "kappa, in %, for three kappa / mu (mu = 2 (C1 + C2) = 200; the study uses 50):"
+    )
     emit()
     rows = []
     lock_meshes = [("sfr", 2, 20), ("sfr", 4, 40), ("sfr", 2, 80), ("q4", 2, 20), ("q8", 2, 20)]
     for ratio in (1.0, 5.0, 50.0):
         kappa = ratio * 2.0 * (C1 + C2)
         pr = small_deflection("q8", 8, 80, kappa)
-        rows.append([f"{ratio:g}"] + [pct(small_deflection(el, nt, nr, kappa) / pr - 1)
-                                      for el, nt, nr in lock_meshes])
+        rows.append([f"{ratio:g}"] + [pct(small_deflection(el, nt, nr, kappa) / pr - 1) for el, nt, nr in lock_meshes])
     emit(table(["kappa/mu"] + [f"{el.upper()} {nt}x{nr}" for el, nt, nr in lock_meshes], rows))
     emit()
-    emit("At kappa/mu = 1 SFR is within 1 % of Q8 on 2x20 where Q4 is 15 % too stiff (the shear "
-         "locking that the fibre rotations cure); at kappa/mu = 50 every fully integrated "
-         "element locks volumetrically, SFR about as much as Q4, and refining in r alone (2x80) "
-         "does not help.  The edge rules differ in p by at most 1.5 % on any mesh.")
+    emit(
+        "At kappa/mu = 1 SFR is within 1 % of Q8 on 2x20 where Q4 is 15 % too stiff (the shear "
+        "locking that the fibre rotations cure); at kappa/mu = 50 every fully integrated "
+        "element locks volumetrically, SFR about as much as Q4, and refining in r alone (2x80) "
+        "does not help.  The edge rules differ in p by at most 1.5 % on any mesh."
+    )
     emit()
 
     # ---- verdict, computed
@@ -425,20 +483,32 @@ def main() -> int:
     emit()
     rows = []
     for rule in RULES:
-        rows.append([rule] + [f"{np.abs(runs[('sfr', nt, rule, False)]['p_at'] / p_ref - 1).max() * 100:.2f}"
-                              for nt, _ in all_meshes])
-    rows.append(["Q4"] + [f"{np.abs(runs[('q4', nt, '-', False)]['p_at'] / p_ref - 1).max() * 100:.2f}"
-                          for nt, _ in plate_meshes] + ([""] if extra_mesh else []))
-    emit("Plate, max |error of p| in % over w = 0.5 ... 8 (dominated by w = 0.5: bending, where "
-         "all fully integrated elements lock at kappa/mu = 50):")
+        rows.append(
+            [rule]
+            + [f"{np.abs(runs[('sfr', nt, rule, False)]['p_at'] / p_ref - 1).max() * 100:.2f}" for nt, _ in all_meshes]
+        )
+    rows.append(
+        ["Q4"]
+        + [f"{np.abs(runs[('q4', nt, '-', False)]['p_at'] / p_ref - 1).max() * 100:.2f}" for nt, _ in plate_meshes]
+        + ([""] if extra_mesh else [])
+    )
+    emit(
+        "Plate, max |error of p| in % over w = 0.5 ... 8 (dominated by w = 0.5: bending, where "
+        "all fully integrated elements lock at kappa/mu = 50):"
+    )
     emit()
     emit(table(["rule"] + [f"{nt}x{nr}" for nt, nr in all_meshes], rows))
     emit()
     for what, idx in (("p, w >= 2 (membrane range)", slice(2, None)),):
         rows = []
         for rule in RULES:
-            rows.append([rule] + [f"{np.abs(runs[('sfr', nt, rule, False)]['p_at'][idx] / p_ref[idx] - 1).max() * 100:.2f}"
-                                  for nt, _ in all_meshes])
+            rows.append(
+                [rule]
+                + [
+                    f"{np.abs(runs[('sfr', nt, rule, False)]['p_at'][idx] / p_ref[idx] - 1).max() * 100:.2f}"
+                    for nt, _ in all_meshes
+                ]
+            )
         emit(f"Plate, max |error| in % of {what}:")
         emit()
         emit(table(["rule"] + [f"{nt}x{nr}" for nt, nr in all_meshes], rows))
@@ -453,16 +523,20 @@ def main() -> int:
     emit()
     rows = []
     for rule in RULES:
-        rows.append([rule] + [f"{np.abs(runs[('sfr', nt, rule, False)]['t_at'] / t_ref - 1).max() * 100:.2f}"
-                              for nt, _ in all_meshes])
+        rows.append(
+            [rule]
+            + [f"{np.abs(runs[('sfr', nt, rule, False)]['t_at'] / t_ref - 1).max() * 100:.2f}" for nt, _ in all_meshes]
+        )
     emit("Plate, max |error| in % of the centre thickness over w = 0.5 ... 8:")
     emit()
     emit(table(["rule"] + [f"{nt}x{nr}" for nt, nr in all_meshes], rows))
     emit()
     rows = []
     for rule in RULES + ("q4",):
-        rows.append([rule if rule != "q4" else "Q4"]
-                    + [f"{np.abs(crun[(nr, rule)]['p_at'] / p_cref - 1).max() * 100:.3f}" for nr in cyl_meshes])
+        rows.append(
+            [rule if rule != "q4" else "Q4"]
+            + [f"{np.abs(crun[(nr, rule)]['p_at'] / p_cref - 1).max() * 100:.3f}" for nr in cyl_meshes]
+        )
     emit("Cylinder, max |error of p| in % over a/A = 1.125 ... 1.5:")
     emit()
     emit(table(["rule"] + [f"{nr}x{NZ}" for nr in cyl_meshes], rows))

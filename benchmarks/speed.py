@@ -45,7 +45,7 @@ PLATE = ROOT / "examples" / "hughes_carnoy_plate.toml"
 Q8_4X40 = ["--set", 'mesh.element="q8"', "--set", "mesh.divisions=[40,4]"]
 ONE_THREAD = {v: "1" for v in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")}
 
-FELUPE_SCRIPT = r'''
+FELUPE_SCRIPT = r"""
 import sys, time, warnings
 import numpy as np
 import felupe as fem
@@ -76,20 +76,22 @@ for p in np.loadtxt(sys.argv[2]):
     field.link(res.x)
     its += int(res.iterations)
 print(f"FELUPE w {field[0].values[centre, 0]:.6f} iterations {its}")
-'''
+"""
 
 # the opening of the scripts run in a subprocess on a given source tree (argv[1]): the
 # imports (axiform sets no allocator option any more: solve/malloc.py is gone)
-SCRIPT_PRELUDE = r'''
+SCRIPT_PRELUDE = r"""
 import json, resource, sys, time
 sys.path.insert(0, sys.argv[1])
 import numpy as np
 import axiform as af
 from axiform.fem.mesh import edges_on_nodes
-'''
+"""
 
 # one Newton iteration (works on both APIs)
-NEWTON_SCRIPT = SCRIPT_PRELUDE + r'''
+NEWTON_SCRIPT = (
+    SCRIPT_PRELUDE
+    + r"""
 from axiform.solve.linsolve import factorize
 element, formulation, n = sys.argv[2], sys.argv[3], int(sys.argv[4])
 mesh = af.rectangle((1.0, 2.0), (0.0, 1.0), (n, n), element)
@@ -125,10 +127,13 @@ out["dofs"] = int(model.n_free)
 out["nnz"] = int(ev.K.nnz)
 out["residual"] = float(np.linalg.norm(ev.K @ x[:, 0] + ev.r) / np.linalg.norm(ev.r))
 print("NEWTON " + json.dumps(out))
-'''
+"""
+)
 
 # the resident memory of `steps` load steps of the SFR ring
-MEMORY_SCRIPT = SCRIPT_PRELUDE + r'''
+MEMORY_SCRIPT = (
+    SCRIPT_PRELUDE
+    + r"""
 def rss():
     with open("/proc/self/statm") as f:
         return int(f.read().split()[1]) * resource.getpagesize() / 2**20
@@ -144,7 +149,8 @@ res = af.solve(model, af.LoadControl(1.0, steps), af.NewtonOptions(growth=1.0), 
                **kw)
 print("MEMORY " + json.dumps({"dofs": int(model.n_free), "rss": rows, "steps": len(rows) - 1,
                               "peak": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
-'''
+"""
+)
 
 
 def machine() -> str:
@@ -152,8 +158,10 @@ def machine() -> str:
         cpu = next(line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name"))
     except (OSError, StopIteration):
         cpu = platform.processor()
-    return (f"{cpu}, {os.cpu_count()} cores, load average {', '.join(f'{v:.1f}' for v in os.getloadavg())}; "
-            f"Python {platform.python_version()}")
+    return (
+        f"{cpu}, {os.cpu_count()} cores, load average {', '.join(f'{v:.1f}' for v in os.getloadavg())}; "
+        f"Python {platform.python_version()}"
+    )
 
 
 def timed(cmd: list[str], env: dict | None = None, cwd: Path | None = None) -> tuple[float, float, str]:
@@ -182,7 +190,10 @@ def env_for(src: Path, threads_one: bool = True) -> dict:
 
 
 def md_table(header: list[str], rows: list[list]) -> str:
-    out = ["| " + " | ".join(header) + " |", "|" + "|".join("---" if i == 0 else "---:" for i in range(len(header))) + "|"]
+    out = [
+        "| " + " | ".join(header) + " |",
+        "|" + "|".join("---" if i == 0 else "---:" for i in range(len(header))) + "|",
+    ]
     out += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
     return "\n".join(out)
 
@@ -196,17 +207,18 @@ def section_process(trees: dict[str, Path], repeat: int, tmp: Path) -> str:
         jobs[f"axiform run ({name})"] = (run + ["--out", str(tmp / f"plate-{name}")], env_for(src))
         jobs[f"axiform run, no VTU, no plots ({name})"] = (
             run + ["--set", "output.vtu=false", "--set", "output.plots=false", "--out", str(tmp / f"plain-{name}")],
-            env_for(src))
+            env_for(src),
+        )
         jobs[f"axiform run, no VTU, no plots, MKL's default threads ({name})"] = (
             run + ["--set", "output.vtu=false", "--set", "output.plots=false", "--out", str(tmp / f"threads-{name}")],
-            env_for(src, threads_one=False))
+            env_for(src, threads_one=False),
+        )
         jobs[f"import axiform.cli ({name})"] = ([py, "-c", "import axiform.cli"], env_for(src))
     jobs["python -c pass"] = ([py, "-c", "pass"], env_for(SRC))
     # the peers' 44 pressures: where axiform's load curve reaches w = 8 k / 44 (as benchmarks/peers.py)
     sys.path.insert(0, str(HERE))
     sys.path.insert(0, str(SRC))
     import numpy as np
-
     from peers import curve, run_axiform
 
     ref = run_axiform("q8", 40, 4)
@@ -219,22 +231,30 @@ def section_process(trees: dict[str, Path], repeat: int, tmp: Path) -> str:
         felupe = felupe.__version__
         script = tmp / "felupe_plate.py"
         script.write_text(FELUPE_SCRIPT)
-        jobs["FElupe (quad8, 44 pressure steps)"] = ([py, str(script), str(SRC), str(tmp / "pressures.txt")],
-                                                      env_for(SRC))
+        jobs["FElupe (quad8, 44 pressure steps)"] = (
+            [py, str(script), str(SRC), str(tmp / "pressures.txt")],
+            env_for(SRC),
+        )
     except ImportError:
         pass
     ccx = shutil.which("ccx")
     if ccx:
-        import axiform as af
         from peers import ccx_deck
+
+        import axiform as af
 
         mesh = af.rectangle((0.0, 7.5), (0.0, 0.5), (40, 4), "q8")
         for tight in (False, True):
             d = tmp / f"ccx-{'tight' if tight else 'default'}"
             d.mkdir(exist_ok=True)
             (d / "plate.inp").write_text(ccx_deck(mesh, "CAX8", pressures, "plate 4x40", tight))
-            env = dict(os.environ, OMP_NUM_THREADS="1", CCX_NPROC_EQUATION_SOLVER="1", CCX_NPROC_STIFFNESS="1",
-                       CCX_NPROC_RESULTS="1")
+            env = dict(
+                os.environ,
+                OMP_NUM_THREADS="1",
+                CCX_NPROC_EQUATION_SOLVER="1",
+                CCX_NPROC_STIFFNESS="1",
+                CCX_NPROC_RESULTS="1",
+            )
             label = "CalculiX CAX8, " + ("tight tolerances" if tight else "default tolerances")
             jobs[label] = ([ccx, "-i", "plate"], env, d)
     best: dict[str, tuple[float, float]] = {}
@@ -246,18 +266,28 @@ def section_process(trees: dict[str, Path], repeat: int, tmp: Path) -> str:
             if label not in best or wall < best[label][0]:
                 best[label] = (wall, cpu)
             if "FELUPE" in out:
-                notes[label] = out[out.index("FELUPE"):].split("\n")[0]
+                notes[label] = out[out.index("FELUPE") :].split("\n")[0]
             if label.startswith("CalculiX") and "Job finished" not in out:
                 notes[label] = "did not finish"
     felupe_wall = best.get("FElupe (quad8, 44 pressure steps)", (None,))[0]
     ccx_wall = best.get("CalculiX CAX8, default tolerances", (None,))[0]
     rows = []
     for label, (wall, cpu) in best.items():
-        rows.append([label, f"{wall:.2f}", f"{cpu:.2f}",
-                     f"{wall / felupe_wall:.2f}" if felupe_wall else "–",
-                     f"{wall / ccx_wall:.3f}" if ccx_wall else "–", notes.get(label, "")])
-    text = [f"FElupe {felupe or 'not installed'}; CalculiX {'at ' + ccx if ccx else 'not installed'}.",
-            "", md_table(["process", "wall s (min)", "CPU s", "/ FElupe", "/ CalculiX (default tol.)", "note"], rows)]
+        rows.append(
+            [
+                label,
+                f"{wall:.2f}",
+                f"{cpu:.2f}",
+                f"{wall / felupe_wall:.2f}" if felupe_wall else "–",
+                f"{wall / ccx_wall:.3f}" if ccx_wall else "–",
+                notes.get(label, ""),
+            ]
+        )
+    text = [
+        f"FElupe {felupe or 'not installed'}; CalculiX {'at ' + ccx if ccx else 'not installed'}.",
+        "",
+        md_table(["process", "wall s (min)", "CPU s", "/ FElupe", "/ CalculiX (default tol.)", "note"], rows),
+    ]
     return "\n".join(text)
 
 
@@ -272,9 +302,10 @@ def section_newton(trees: dict[str, Path], sizes: dict[str, list[int]], repeat: 
                 res = {}
                 for name, src in trees.items():
                     reps = repeat if n < 100 else max(3, repeat // 20)
-                    _, _, out = timed([sys.executable, str(script), str(src), element, formulation, str(n), str(reps)],
-                                      env_for(src))
-                    res[name] = json.loads(out[out.index("NEWTON ") + 7:].split("\n")[0])
+                    _, _, out = timed(
+                        [sys.executable, str(script), str(src), element, formulation, str(n), str(reps)], env_for(src)
+                    )
+                    res[name] = json.loads(out[out.index("NEWTON ") + 7 :].split("\n")[0])
                 after = res["after"]
                 row = [element, formulation, after["dofs"], after["nnz"]]
                 for key in ("evaluate", "factorize_solve", "iteration"):
@@ -303,14 +334,32 @@ def section_memory(trees: dict[str, Path], n: int, steps: int, tmp: Path) -> str
     rows = []
     for name, src in trees.items():
         _, _, out = timed([sys.executable, str(script), str(src), str(n), str(steps)], env_for(src))
-        r = json.loads(out[out.index("MEMORY ") + 7:].split("\n")[0])
+        r = json.loads(out[out.index("MEMORY ") + 7 :].split("\n")[0])
         rss = r["rss"]
         since = 50 if steps > 50 else 1
-        rows.append([name, r["dofs"], f"{rss[0]:.0f}", *(f"{rss[k]:.0f}" for k in marks), f"{r['peak']:.0f}",
-                     f"{(rss[-1] - rss[since]) / (steps - since):.2f}",
-                     f"{100 * (rss[-1] - rss[since]) / rss[since]:.1f}"])
-    return md_table(["code", "free dofs", "RSS MB after finalize", *(f"after step {k}" for k in marks), "peak RSS MB",
-                     f"growth MB / step ({since + 1}-{steps})", f"growth % (step {since} to {steps})"], rows)
+        rows.append(
+            [
+                name,
+                r["dofs"],
+                f"{rss[0]:.0f}",
+                *(f"{rss[k]:.0f}" for k in marks),
+                f"{r['peak']:.0f}",
+                f"{(rss[-1] - rss[since]) / (steps - since):.2f}",
+                f"{100 * (rss[-1] - rss[since]) / rss[since]:.1f}",
+            ]
+        )
+    return md_table(
+        [
+            "code",
+            "free dofs",
+            "RSS MB after finalize",
+            *(f"after step {k}" for k in marks),
+            "peak RSS MB",
+            f"growth MB / step ({since + 1}-{steps})",
+            f"growth % (step {since} to {steps})",
+        ],
+        rows,
+    )
 
 
 # ---- sweep --------------------------------------------------------------------------------
@@ -321,24 +370,65 @@ def section_sweep(tmp: Path) -> str:
     shutil.copy(PLATE, sweep / "plate.toml")
     (sweep / "plate_sweep.toml").write_text(
         'case = "plate.toml"\n[vary]\n"material.C1" = [60.0, 70.0, 80.0, 90.0]\n"solver.target" = [6.0, 8.0]\n'
-        '"mesh.element" = ["q8"]\n"mesh.divisions" = [[40, 4]]\n[report]\nmonitor = "w_center"\n')
+        '"mesh.element" = ["q8"]\n"mesh.divisions" = [[40, 4]]\n[report]\nmonitor = "w_center"\n'
+    )
     from itertools import product
 
     env = env_for(SRC)
     t0 = time.perf_counter()
     for k, (c1, target) in enumerate(product((60.0, 70.0, 80.0, 90.0), (6.0, 8.0))):
-        timed([py, "-m", "axiform.cli", "run", str(sweep / "plate.toml"), *Q8_4X40, "--set", f"material.C1={c1}",
-               "--set", f"solver.target={target}", "-q", "--out", str(sweep / f"serial-{k}")], env)
+        timed(
+            [
+                py,
+                "-m",
+                "axiform.cli",
+                "run",
+                str(sweep / "plate.toml"),
+                *Q8_4X40,
+                "--set",
+                f"material.C1={c1}",
+                "--set",
+                f"solver.target={target}",
+                "-q",
+                "--out",
+                str(sweep / f"serial-{k}"),
+            ],
+            env,
+        )
     serial = time.perf_counter() - t0
     rows = [["8 × `axiform run`, one after another", f"{serial:.1f}", "1.00"]]
     for workers in (1, 2):
         out = sweep / f"out-{workers}"
         shutil.rmtree(out, ignore_errors=True)
-        wall, _, _ = timed([py, "-m", "axiform.cli", "sweep", str(sweep / "plate_sweep.toml"), "--out", str(out),
-                            "--workers", str(workers)], env)
+        wall, _, _ = timed(
+            [
+                py,
+                "-m",
+                "axiform.cli",
+                "sweep",
+                str(sweep / "plate_sweep.toml"),
+                "--out",
+                str(out),
+                "--workers",
+                str(workers),
+            ],
+            env,
+        )
         rows.append([f"`axiform sweep --workers {workers}`", f"{wall:.1f}", f"{wall / serial:.2f}"])
-    wall, _, _ = timed([py, "-m", "axiform.cli", "sweep", str(sweep / "plate_sweep.toml"), "--out",
-                        str(sweep / "out-2"), "--workers", "2"], env)
+    wall, _, _ = timed(
+        [
+            py,
+            "-m",
+            "axiform.cli",
+            "sweep",
+            str(sweep / "plate_sweep.toml"),
+            "--out",
+            str(sweep / "out-2"),
+            "--workers",
+            "2",
+        ],
+        env,
+    )
     rows.append(["the same sweep again (resume: all 8 skipped)", f"{wall:.1f}", f"{wall / serial:.2f}"])
     return md_table(["8 plate cases (Q8 4x40, C1 × target)", "wall s", "/ serial"], rows)
 
@@ -354,8 +444,10 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     trees = {"before": Path(args.before).resolve()} if args.before else {}
     trees["after"] = SRC
-    parts = [f"# Speed, memory, sweeps (issue 9)\n\nWritten by `benchmarks/speed.py` on "
-             f"{time.strftime('%Y-%m-%d %H:%M')}; {machine()}.  before: {trees.get('before', '–')}, after: {SRC}.\n"]
+    parts = [
+        f"# Speed, memory, sweeps (issue 9)\n\nWritten by `benchmarks/speed.py` on "
+        f"{time.strftime('%Y-%m-%d %H:%M')}; {machine()}.  before: {trees.get('before', '–')}, after: {SRC}.\n"
+    ]
     with tempfile.TemporaryDirectory(prefix="axiform-speed-") as tmpdir:
         tmp = Path(tmpdir)
         if "process" in args.only:
@@ -366,8 +458,11 @@ def main(argv=None) -> int:
             parts += ["## One Newton iteration (CPU ms, one thread)\n", section_newton(trees, sizes, 200, tmp), ""]
             print(parts[-2], flush=True)
         if "memory" in args.only:
-            parts += [f"## Memory: SFR ring at 1e5 dofs, {args.memory_steps} load steps\n",
-                      section_memory(trees, 182, args.memory_steps, tmp), ""]
+            parts += [
+                f"## Memory: SFR ring at 1e5 dofs, {args.memory_steps} load steps\n",
+                section_memory(trees, 182, args.memory_steps, tmp),
+                "",
+            ]
             print(parts[-2], flush=True)
         if "sweep" in args.only:
             parts += ["## Sweep: 8 plate cases on this machine\n", section_sweep(tmp), ""]

@@ -99,13 +99,19 @@ def main_study() -> None:
     fig.suptitle("Plug-assisted thermoforming of a HIPS cup: the sheet's temperature profile and its wall")
     fig.tight_layout()
     fig.savefig(RESULTS / "temperature_study.png", dpi=110)
-    lines = ["| profile | thinnest wall (mm) at s | " + " | ".join(f"wall at {k} (s = {s:g})" for k, s in S_REPORT.items())
-             + " | steps | Newton iterations |", "|---" * (4 + len(S_REPORT)) + "|"]
+    lines = [
+        "| profile | thinnest wall (mm) at s | "
+        + " | ".join(f"wall at {k} (s = {s:g})" for k, s in S_REPORT.items())
+        + " | steps | Newton iterations |",
+        "|---" * (4 + len(S_REPORT)) + "|",
+    ]
     for name, (t, summary) in results.items():
         i = int(np.nanargmin(t["thickness"]))
         walls = " | ".join(f"{np.interp(s, t['s'], t['thickness']):.3f}" for s in S_REPORT.values())
-        lines.append(f"| {name} | {t['thickness'][i]:.3f} at {t['s'][i]:.1f} | {walls} | {summary['steps']} | "
-                     f"{summary['newton_iterations']} |")
+        lines.append(
+            f"| {name} | {t['thickness'][i]:.3f} at {t['s'][i]:.1f} | {walls} | {summary['steps']} | "
+            f"{summary['newton_iterations']} |"
+        )
     (RESULTS / "temperature_study.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 

@@ -35,8 +35,14 @@ WORK = RESULTS / "toric_ccx"
 CASE = ROOT / "examples" / "toric_plate.toml"
 E = 9 * 1e4 * 200 / (3e4 + 200)
 K = 10 * E / 0.125
-SETS = ["mesh.element=q8", "mesh.divisions=[40,4]", "contact[0].sticky=false", "contact[0].friction=1.0",
-        f"contact[0].penalty={K!r}", f"contact[0].tangential_penalty={K!r}"]
+SETS = [
+    "mesh.element=q8",
+    "mesh.divisions=[40,4]",
+    "contact[0].sticky=false",
+    "contact[0].friction=1.0",
+    f"contact[0].penalty={K!r}",
+    f"contact[0].tangential_penalty={K!r}",
+]
 
 
 def run_axiform(src: Path) -> dict:
@@ -71,36 +77,67 @@ def deck(p_steps: np.ndarray) -> str:
     P, C = mesh.points, mesh.cells
     tol = 1e-9
     out = ["*HEADING", "toric plate", "*NODE"] + [f"{i + 1}, {x:.15g}, {y:.15g}" for i, (x, y) in enumerate(P)]
-    out += ["*ELEMENT, TYPE=CAX8, ELSET=PLATE"] + [f"{e + 1}, " + ", ".join(str(k + 1) for k in c) for e, c in enumerate(C)]
+    out += ["*ELEMENT, TYPE=CAX8, ELSET=PLATE"] + [
+        f"{e + 1}, " + ", ".join(str(k + 1) for k in c) for e, c in enumerate(C)
+    ]
     phi = np.radians(np.arange(0.0, -180.0 - 1e-9, -1.0))  # clockwise: the body to the left, outside
     ring = np.column_stack([4.5 + 1.5 * np.cos(phi), 3.0 + 1.5 * np.sin(phi)])
     nodes, cells = tool_strip(ring, 0.2)
     n0, e0 = len(P), len(C)
     out += ["*NODE, NSET=TORUS"] + [f"{n0 + i + 1}, {x:.15g}, {y:.15g}" for i, (x, y) in enumerate(nodes)]
-    out += ["*ELEMENT, TYPE=CAX4, ELSET=ETORUS"] + [f"{e0 + e + 1}, " + ", ".join(str(n0 + k + 1) for k in c)
-                                                    for e, c in enumerate(cells)]
+    out += ["*ELEMENT, TYPE=CAX4, ELSET=ETORUS"] + [
+        f"{e0 + e + 1}, " + ", ".join(str(n0 + k + 1) for k in c) for e, c in enumerate(cells)
+    ]
     out += ["*SURFACE, NAME=MTORUS"] + [f"{e0 + e + 1}, S3" for e in range(len(cells))]
     ends = np.array([[0, 1], [1, 2], [2, 3], [3, 0]])
     on = np.abs(P[C[:, :4][:, ends], 1] - 0.5).max(axis=2) < tol
     on &= P[C[:, :4][:, ends], 0].min(axis=2) > tol
-    out += ["*SURFACE, NAME=STOP"] + [f"{e + 1}, S{f + 1}" for e, f in zip(*np.nonzero(on))]
+    out += ["*SURFACE, NAME=STOP"] + [f"{e + 1}, S{f + 1}" for e, f in zip(*np.nonzero(on), strict=False)]
     bottom = [e + 1 for e, c in enumerate(C) if abs(P[c[0], 1]) < tol and abs(P[c[1], 1]) < tol]
     rim = np.flatnonzero(np.abs(P[:, 0] - 7.5) < tol) + 1
     axis = np.flatnonzero(np.abs(P[:, 0]) < tol) + 1
     centre = np.flatnonzero((np.abs(P[:, 0]) < tol) & (np.abs(P[:, 1] - 0.5) < tol)) + 1
-    out += ["*NSET, NSET=RIM"] + _lines(rim) + ["*NSET, NSET=AXIS"] + _lines(axis) + ["*NSET, NSET=CENTRE"] + _lines(centre)
-    out += ["*MATERIAL, NAME=MR", "*HYPERELASTIC, MOONEY-RIVLIN", f"80, 20, {2.0 / 1e4:.15g}",
-            "*SOLID SECTION, ELSET=PLATE, MATERIAL=MR", "*MATERIAL, NAME=STEEL", "*ELASTIC", "1e8, 0.3",
-            "*SOLID SECTION, ELSET=ETORUS, MATERIAL=STEEL",
-            "*CONTACT PAIR, INTERACTION=I, TYPE=NODE TO SURFACE", "STOP, MTORUS", "*SURFACE INTERACTION, NAME=I",
-            "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR", f"{K:.15g}, 1e-3, 1e-3", "*FRICTION", f"1.0, {K:.15g}"]
+    out += (
+        ["*NSET, NSET=RIM"]
+        + _lines(rim)
+        + ["*NSET, NSET=AXIS"]
+        + _lines(axis)
+        + ["*NSET, NSET=CENTRE"]
+        + _lines(centre)
+    )
+    out += [
+        "*MATERIAL, NAME=MR",
+        "*HYPERELASTIC, MOONEY-RIVLIN",
+        f"80, 20, {2.0 / 1e4:.15g}",
+        "*SOLID SECTION, ELSET=PLATE, MATERIAL=MR",
+        "*MATERIAL, NAME=STEEL",
+        "*ELASTIC",
+        "1e8, 0.3",
+        "*SOLID SECTION, ELSET=ETORUS, MATERIAL=STEEL",
+        "*CONTACT PAIR, INTERACTION=I, TYPE=NODE TO SURFACE",
+        "STOP, MTORUS",
+        "*SURFACE INTERACTION, NAME=I",
+        "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR",
+        f"{K:.15g}, 1e-3, 1e-3",
+        "*FRICTION",
+        f"1.0, {K:.15g}",
+    ]
     n = len(p_steps)
     pmax = float(p_steps[-1])
-    amp = [f"{t:.15g}, {a:.15g}" for t, a in zip(np.arange(n + 1) / n, np.r_[0.0, p_steps / pmax])]
-    out += ["*AMPLITUDE, NAME=RAMP"] + [", ".join(amp[k:k + 4]) for k in range(0, len(amp), 4)]
-    out += ["*BOUNDARY", "RIM, 1, 2", "AXIS, 1, 1", "TORUS, 1, 2", "*STEP, NLGEOM, INC=100000", "*STATIC",
-            f"{1.0 / n:.15g}, 1.0, 1e-7, {1.0 / n:.15g}", "*CONTROLS, PARAMETERS=FIELD, FIELD=DISPLACEMENT",
-            "1.e-7, 1.e-6, , , 1.e-7, 1.e-5, 1.e-3, 1.e-8", "*DLOAD, AMPLITUDE=RAMP"]
+    amp = [f"{t:.15g}, {a:.15g}" for t, a in zip(np.arange(n + 1) / n, np.r_[0.0, p_steps / pmax], strict=False)]
+    out += ["*AMPLITUDE, NAME=RAMP"] + [", ".join(amp[k : k + 4]) for k in range(0, len(amp), 4)]
+    out += [
+        "*BOUNDARY",
+        "RIM, 1, 2",
+        "AXIS, 1, 1",
+        "TORUS, 1, 2",
+        "*STEP, NLGEOM, INC=100000",
+        "*STATIC",
+        f"{1.0 / n:.15g}, 1.0, 1e-7, {1.0 / n:.15g}",
+        "*CONTROLS, PARAMETERS=FIELD, FIELD=DISPLACEMENT",
+        "1.e-7, 1.e-6, , , 1.e-7, 1.e-5, 1.e-3, 1.e-8",
+        "*DLOAD, AMPLITUDE=RAMP",
+    ]
     out += [f"{e}, P1, {pmax:.15g}" for e in bottom]
     out += ["*NODE PRINT, NSET=CENTRE", "U", "*END STEP", ""]
     return "\n".join(out)
@@ -134,11 +171,17 @@ def main(argv=None) -> int:
     now = run_axiform(ROOT / "src")
     before = run_axiform(args.before) if args.before else None
     ccx = run_ccx(np.array(now["p"]))
-    L = ["# Toric plate Q8 4x40 against CalculiX CAX8, node-to-surface", "",
-         (f"Penalty K = {K:.5g} per unit area, friction mu = 1 (stick slope K) in both codes; "
-          f"ccx {'finished' if ccx['ok'] else 'stopped'} after {len(ccx['w'])} increments."), "",
-         "| w | p CalculiX | p axiform now | diff | " + ("p axiform before | diff |" if before else ""),
-         "|---:|---:|---:|---:|" + ("---:|---:|" if before else "")]
+    L = [
+        "# Toric plate Q8 4x40 against CalculiX CAX8, node-to-surface",
+        "",
+        (
+            f"Penalty K = {K:.5g} per unit area, friction mu = 1 (stick slope K) in both codes; "
+            f"ccx {'finished' if ccx['ok'] else 'stopped'} after {len(ccx['w'])} increments."
+        ),
+        "",
+        "| w | p CalculiX | p axiform now | diff | " + ("p axiform before | diff |" if before else ""),
+        "|---:|---:|---:|---:|" + ("---:|---:|" if before else ""),
+    ]
     for w in (1.0, 2.0, 3.0, 4.0, 5.0, 6.0):
         if not len(ccx["w"]) or ccx["w"].max() < w:
             continue

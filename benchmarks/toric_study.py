@@ -50,8 +50,8 @@ from __future__ import annotations
 
 import argparse
 import csv
-import os
 import datetime
+import os
 import statistics
 import sys
 import tempfile
@@ -64,17 +64,17 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 from _common import RESULTS, machine, table  # noqa: E402
+from scipy.sparse.linalg import splu  # noqa: E402
 
 import axiform.solve.arc_length as _arc  # noqa: E402
 import axiform.solve.newton as solver_mod  # noqa: E402
 import axiform.solve.paths as _paths  # noqa: E402
-from axiform.solve.solver import solve  # noqa: E402
 from axiform.case.schema import build, load  # noqa: E402
 from axiform.contact.pair import ContactPair  # noqa: E402
+from axiform.io.results import ResultsWriter  # noqa: E402
 from axiform.model.model import Model  # noqa: E402
 from axiform.solve.linsolve import SingularTangentError  # noqa: E402
-from axiform.io.results import ResultsWriter  # noqa: E402
-from scipy.sparse.linalg import splu  # noqa: E402
+from axiform.solve.solver import solve  # noqa: E402
 
 CASE = ROOT / "examples" / "toric_plate.toml"
 ELEMENTS = ("q4", "q8", "sfr")
@@ -102,6 +102,7 @@ class Timers:
             finally:
                 self.wall[key] += time.perf_counter() - w
                 self.cpu[key] += time.process_time() - c
+
         return wrapped
 
 
@@ -136,8 +137,7 @@ def symmetric_factorize(K):
     mode) instead of axiform.solve.linsolve's partial pivoting, which discards it and fills L + U
     far more (see benchmarks/sfr_edge_study.py)."""
     try:
-        lu = splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.01,
-                  options=dict(SymmetricMode=True))
+        lu = splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.01, options=dict(SymmetricMode=True))
     except RuntimeError as exc:
         raise SingularTangentError(str(exc)) from exc
 
@@ -154,13 +154,26 @@ def symmetric_factorize(K):
 def run_case(element: str, layers: int, radial: int, out: Path, lu: str = "stock") -> dict:
     """One run of the case, as `axiform run` does it; returns its measurements.  lu="symmetric"
     swaps the library's factorization for symmetric_factorize during the solve."""
-    overrides = [f'mesh.element="{element}"', f"mesh.divisions=[{radial},{layers}]",
-                 "output.vtu=false", "output.plots=false"]
+    overrides = [
+        f'mesh.element="{element}"',
+        f"mesh.divisions=[{radial},{layers}]",
+        "output.vtu=false",
+        "output.plots=false",
+    ]
     case = load(CASE, overrides)
     built = build(case, CASE.parent)
     o = case.output
-    writer = ResultsWriter(out, built.model, built.monitors, case.title, every=o.every, vtu=o.vtu,
-                           gid_files=o.gid, revolved=o.revolved, plots=o.plots)
+    writer = ResultsWriter(
+        out,
+        built.model,
+        built.monitors,
+        case.title,
+        every=o.every,
+        vtu=o.vtu,
+        gid_files=o.gid,
+        revolved=o.revolved,
+        plots=o.plots,
+    )
     TIMERS.reset()
     on_step = TIMERS.wrap("writer", writer.step)
     solver_mod.factorize = symmetric_factorize if lu == "symmetric" else _stock_factorize
@@ -174,15 +187,27 @@ def run_case(element: str, layers: int, radial: int, out: Path, lu: str = "stock
     model = built.model
     contact_eval = TIMERS.wall["contact"]
     rec = {
-        "element": element, "mesh": f"{layers}x{radial}", "layers": layers, "radial": radial,
-        "status": result.status, "message": result.message,
-        "steps": len(result.steps), "newton": result.newton_iterations,
-        "evaluations": TIMERS.calls["evaluate"], "factorizations": TIMERS.calls["factorize"],
-        "elements": model.mesh.n_cells, "nodes": model.mesh.n_nodes,
-        "dofs": int(model.dofmap.n_eq), "free_dofs": int(model.n_free),
-        "wall": wall - TIMERS.wall["writer"], "cpu": cpu - TIMERS.cpu["writer"],
-        "t_assembly": TIMERS.wall["evaluate"] - contact_eval, "t_contact": contact_eval,
-        "t_linear": TIMERS.wall["linear"], "out": str(out), "lu": lu,
+        "element": element,
+        "mesh": f"{layers}x{radial}",
+        "layers": layers,
+        "radial": radial,
+        "status": result.status,
+        "message": result.message,
+        "steps": len(result.steps),
+        "newton": result.newton_iterations,
+        "evaluations": TIMERS.calls["evaluate"],
+        "factorizations": TIMERS.calls["factorize"],
+        "elements": model.mesh.n_cells,
+        "nodes": model.mesh.n_nodes,
+        "dofs": int(model.dofmap.n_eq),
+        "free_dofs": int(model.n_free),
+        "wall": wall - TIMERS.wall["writer"],
+        "cpu": cpu - TIMERS.cpu["writer"],
+        "t_assembly": TIMERS.wall["evaluate"] - contact_eval,
+        "t_contact": contact_eval,
+        "t_linear": TIMERS.wall["linear"],
+        "out": str(out),
+        "lu": lu,
     }
     # how far the upper face gets inside the torus between its slave (corner) nodes, with
     # each element's own edge interpolation: straight for Q4, quadratic through the mid-side
@@ -215,8 +240,10 @@ def edge_penetration(model, u_full) -> dict:
     else:
         x = X + (1 - t) * ui + t * uj
     depth = TORUS_R - np.linalg.norm(x - TORUS_C, axis=-1)  # > 0: inside the torus
-    return {"edge_penetration": float(max(0.0, depth.max())),
-            "node_penetration": float(max(0.0, depth[:, [0, -1]].max()))}
+    return {
+        "edge_penetration": float(max(0.0, depth.max())),
+        "node_penetration": float(max(0.0, depth[:, [0, -1]].max())),
+    }
 
 
 def read_history(folder: Path) -> dict[str, np.ndarray]:
@@ -248,13 +275,19 @@ def plan(quick: bool):
 # --------------------------------------------------------------------------- main
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="2x20, 4x40, same dofs as Q8 2x20; reference Q8 4x40; 1 repeat")
+    ap.add_argument(
+        "--quick", action="store_true", help="2x20, 4x40, same dofs as Q8 2x20; reference Q8 4x40; 1 repeat"
+    )
     ap.add_argument("--repeat", type=int, default=None, help="runs per configuration (median; default 3, quick 1)")
-    ap.add_argument("--no-symmetric", action="store_true",
-                    help="skip the same-element runs with SuperLU in symmetric mode")
-    ap.add_argument("--skip-stock-fine", action="store_true",
-                    help="run the 8x80 meshes with the symmetric-mode factorization only (with the "
-                         "library's, SFR 8x80 takes ~1 min and Q8 8x80 ~70 s, one sample each)")
+    ap.add_argument(
+        "--no-symmetric", action="store_true", help="skip the same-element runs with SuperLU in symmetric mode"
+    )
+    ap.add_argument(
+        "--skip-stock-fine",
+        action="store_true",
+        help="run the 8x80 meshes with the symmetric-mode factorization only (with the "
+        "library's, SFR 8x80 takes ~1 min and Q8 8x80 ~70 s, one sample each)",
+    )
     ap.add_argument("--runs", default=None, help="folder for the run folders (default: a temporary one)")
     ap.add_argument("--out", default=str(RESULTS), help="folder for toric_study.md and the PNGs")
     args = ap.parse_args(argv)
@@ -280,10 +313,13 @@ def main(argv=None):
             folder = runs_dir / (f"{e}_{l}x{r}" + ("_symmetric" if lu == "symmetric" else ""))
             rec = run_case(e, l, r, folder, lu)
             results.setdefault(key, []).append(rec)
-            print(f"{e:3s} {l}x{r:<4d} {lu:9s} dofs {rec['dofs']:5d}  {rec['status']}  steps {rec['steps']}  "
-                  f"its {rec['newton']}  wall {rec['wall']:.2f} s  cpu {rec['cpu']:.2f} s  "
-                  f"(assembly {rec['t_assembly']:.2f}, contact {rec['t_contact']:.2f}, "
-                  f"linear {rec['t_linear']:.2f})", flush=True)
+            print(
+                f"{e:3s} {l}x{r:<4d} {lu:9s} dofs {rec['dofs']:5d}  {rec['status']}  steps {rec['steps']}  "
+                f"its {rec['newton']}  wall {rec['wall']:.2f} s  cpu {rec['cpu']:.2f} s  "
+                f"(assembly {rec['t_assembly']:.2f}, contact {rec['t_contact']:.2f}, "
+                f"linear {rec['t_linear']:.2f})",
+                flush=True,
+            )
     total = time.perf_counter() - t_start
     summary, symmetric = {}, {}
     for (e, l, r, lu), recs in results.items():
@@ -373,21 +409,49 @@ def report(summary, symmetric, runs, ref_key, repeat, total, args, runs_dir):
         "and law), linear (axiform.solve.linsolve: SuperLU factorization + solves).  Steps: 60 nominal, "
         "more means cut-backs.  CPU / Q8: against Q8 on the same mesh (same elements) or on the "
         "mesh whose dof count was matched."
-        + ("  The 8x80 meshes were not run with the library's factorization (`--skip-stock-fine`): "
-           "see the next table." if args.skip_stock_fine and not args.quick else ""),
+        + (
+            "  The 8x80 meshes were not run with the library's factorization (`--skip-stock-fine`): see the next table."
+            if args.skip_stock_fine and not args.quick
+            else ""
+        ),
         "",
     ]
     groups = list(dict.fromkeys(g for g, *_ in runs))
 
     def cost_row(g, k, s, q8):
-        return [g, k[0].upper(), s["mesh"], s["elements"], s["dofs"], s["steps"], s["newton"],
-                f"{s['wall']:.2f}", f"{s['cpu']:.2f}", f"{s['cpu'] / q8['cpu']:.2f}" if q8 else "—",
-                f"{1e3 * s['wall'] / max(s['newton'], 1):.1f}",
-                f"{100 * s['t_assembly'] / s['wall']:.0f} %", f"{100 * s['t_contact'] / s['wall']:.0f} %",
-                f"{100 * s['t_linear'] / s['wall']:.0f} %"]
+        return [
+            g,
+            k[0].upper(),
+            s["mesh"],
+            s["elements"],
+            s["dofs"],
+            s["steps"],
+            s["newton"],
+            f"{s['wall']:.2f}",
+            f"{s['cpu']:.2f}",
+            f"{s['cpu'] / q8['cpu']:.2f}" if q8 else "—",
+            f"{1e3 * s['wall'] / max(s['newton'], 1):.1f}",
+            f"{100 * s['t_assembly'] / s['wall']:.0f} %",
+            f"{100 * s['t_contact'] / s['wall']:.0f} %",
+            f"{100 * s['t_linear'] / s['wall']:.0f} %",
+        ]
 
-    hdr = ["group", "element", "mesh", "elements", "dofs", "steps", "Newton its", "wall [s]", "CPU [s]",
-           "CPU / Q8", "ms / iteration", "assembly", "contact", "linear"]
+    hdr = [
+        "group",
+        "element",
+        "mesh",
+        "elements",
+        "dofs",
+        "steps",
+        "Newton its",
+        "wall [s]",
+        "CPU [s]",
+        "CPU / Q8",
+        "ms / iteration",
+        "assembly",
+        "contact",
+        "linear",
+    ]
     body = []
     for g in groups:
         for gg, e, l, r in runs:
@@ -403,15 +467,28 @@ def report(summary, symmetric, runs, ref_key, repeat, total, args, runs_dir):
         lines += [f"Largest CPU-time spread over the repeats, (max - min) / median: {100 * spread:.0f} %.", ""]
 
     if symmetric:
-        lines += ["## Cost with a better-ordered factorization", "",
-                  "axiform.solve.linsolve factorizes with SuperLU, MMD_AT_PLUS_A ordering and the default "
-                  "partial pivoting (diag_pivot_thresh = 1), which throws away the fill-reducing "
-                  "symmetric ordering; on the finer meshes the linear solver then dominates (table "
-                  "above).  The same-element runs again with SuperLU in symmetric mode "
-                  "(diag_pivot_thresh = 0.01, SymmetricMode = True, same ordering), swapped in for "
-                  "the solve only; max |dp|: largest difference of the load curve from the stock run.", ""]
-        hdr = ["element", "mesh", "Newton its", "wall [s]", "CPU [s]", "CPU / Q8 same mesh", "linear",
-               "speed-up vs stock", "max abs(dp) vs stock"]
+        lines += [
+            "## Cost with a better-ordered factorization",
+            "",
+            "axiform.solve.linsolve factorizes with SuperLU, MMD_AT_PLUS_A ordering and the default "
+            "partial pivoting (diag_pivot_thresh = 1), which throws away the fill-reducing "
+            "symmetric ordering; on the finer meshes the linear solver then dominates (table "
+            "above).  The same-element runs again with SuperLU in symmetric mode "
+            "(diag_pivot_thresh = 0.01, SymmetricMode = True, same ordering), swapped in for "
+            "the solve only; max |dp|: largest difference of the load curve from the stock run.",
+            "",
+        ]
+        hdr = [
+            "element",
+            "mesh",
+            "Newton its",
+            "wall [s]",
+            "CPU [s]",
+            "CPU / Q8 same mesh",
+            "linear",
+            "speed-up vs stock",
+            "max abs(dp) vs stock",
+        ]
         body = []
         for g, e, l, r in runs:
             k = (e, l, r)
@@ -420,60 +497,115 @@ def report(summary, symmetric, runs, ref_key, repeat, total, args, runs_dir):
             s, q8 = symmetric[k], symmetric.get(("q8", l, r))
             if k in summary:
                 hs = read_history(Path(s["out"]))
-                dp = float(np.max(np.abs(np.interp(hist[k]["w_center"], hs["w_center"], hs["load_factor"])
-                                         - hist[k]["load_factor"])))
+                dp = float(
+                    np.max(
+                        np.abs(
+                            np.interp(hist[k]["w_center"], hs["w_center"], hs["load_factor"]) - hist[k]["load_factor"]
+                        )
+                    )
+                )
                 vs = (f"{summary[k]['cpu'] / s['cpu']:.1f}x", f"{dp:.1e}")
             else:
                 vs = ("not run", "—")
-            body.append([e.upper(), s["mesh"], s["newton"], f"{s['wall']:.2f}", f"{s['cpu']:.2f}",
-                         f"{s['cpu'] / q8['cpu']:.2f}" if q8 else "—", f"{100 * s['t_linear'] / s['wall']:.0f} %",
-                         *vs])
+            body.append(
+                [
+                    e.upper(),
+                    s["mesh"],
+                    s["newton"],
+                    f"{s['wall']:.2f}",
+                    f"{s['cpu']:.2f}",
+                    f"{s['cpu'] / q8['cpu']:.2f}" if q8 else "—",
+                    f"{100 * s['t_linear'] / s['wall']:.0f} %",
+                    *vs,
+                ]
+            )
         lines.append(table(hdr, body))
 
     # accuracy
-    lines += ["## Load curve p(w) and accuracy", "",
-              f"Pressure p (psi) at centre deflection w (in); errors relative to {ref_name} at the same w: "
-              "at w = 0.5 and 1 (plate bending, before the first contact at w ≈ 1.6: up to there the "
-              "case is the section 4.1 plate), the largest over the contact phase w in [2, 6], and at w = 6.", ""]
-    hdr = ["element", "mesh", "dofs"] + [f"p(w={w:g})" for w in W_TABLE] + ["err w=0.5 %", "err w=1 %",
-                                                                            "max abs err, w in [2, 6] %", "err w=6 %"]
+    lines += [
+        "## Load curve p(w) and accuracy",
+        "",
+        f"Pressure p (psi) at centre deflection w (in); errors relative to {ref_name} at the same w: "
+        "at w = 0.5 and 1 (plate bending, before the first contact at w ≈ 1.6: up to there the "
+        "case is the section 4.1 plate), the largest over the contact phase w in [2, 6], and at w = 6.",
+        "",
+    ]
+    hdr = (
+        ["element", "mesh", "dofs"]
+        + [f"p(w={w:g})" for w in W_TABLE]
+        + ["err w=0.5 %", "err w=1 %", "max abs err, w in [2, 6] %", "err w=6 %"]
+    )
     body = []
     for k in keys:
         s = acc[k]
         e05, e1, ec, e6 = err.p(k)
-        body.append([k[0].upper(), s["mesh"], s["dofs"]] + [f"{p_at(hist[k], w):.3f}" for w in W_TABLE]
-                    + [f"{e05:+.1f}", f"{e1:+.1f}", f"{ec:.2f}", f"{e6:+.2f}"])
+        body.append(
+            [k[0].upper(), s["mesh"], s["dofs"]]
+            + [f"{p_at(hist[k], w):.3f}" for w in W_TABLE]
+            + [f"{e05:+.1f}", f"{e1:+.1f}", f"{ec:.2f}", f"{e6:+.2f}"]
+        )
     lines.append(table(hdr, body))
 
-    lines += ["## Thickness, contact area, penetration (at w = 6)", "",
-              "Thickness from each run's thickness.csv (fibre chord on the mid-surface normal; "
-              f"initial 0.5).  max abs(dt): largest difference from {ref_name} over r ≤ {S_RIM:g} "
-              "(reference interpolated at the run's stations; the last stations at the clamped rim "
-              "are left out: sheared fibres at a stress singularity).  Contact area: reference ring "
-              "area of the slave nodes in contact (it moves in steps of one node's ring, so it is "
-              "the same for every element on the same radial division).  Penetration: the contact "
-              "monitor (largest of the slave nodes, i.e. the corner nodes of the upper face), and the "
-              "largest depth of the upper face inside the torus between them, along each edge as the "
-              "element interpolates it (straight for Q4, through the mid-side node for Q8, with the "
-              "theta bubble for SFR).", ""]
-    hdr = ["element", "mesh", "t centre", "t min", "t max", "r of t max", "t at rim", "max abs(dt) vs ref",
-           "contact area [in²]", "contact force z [lbf]", "penetration (nodes)", "penetration (edges)"]
+    lines += [
+        "## Thickness, contact area, penetration (at w = 6)",
+        "",
+        "Thickness from each run's thickness.csv (fibre chord on the mid-surface normal; "
+        f"initial 0.5).  max abs(dt): largest difference from {ref_name} over r ≤ {S_RIM:g} "
+        "(reference interpolated at the run's stations; the last stations at the clamped rim "
+        "are left out: sheared fibres at a stress singularity).  Contact area: reference ring "
+        "area of the slave nodes in contact (it moves in steps of one node's ring, so it is "
+        "the same for every element on the same radial division).  Penetration: the contact "
+        "monitor (largest of the slave nodes, i.e. the corner nodes of the upper face), and the "
+        "largest depth of the upper face inside the torus between them, along each edge as the "
+        "element interpolates it (straight for Q4, through the mid-side node for Q8, with the "
+        "theta bubble for SFR).",
+        "",
+    ]
+    hdr = [
+        "element",
+        "mesh",
+        "t centre",
+        "t min",
+        "t max",
+        "r of t max",
+        "t at rim",
+        "max abs(dt) vs ref",
+        "contact area [in²]",
+        "contact force z [lbf]",
+        "penetration (nodes)",
+        "penetration (edges)",
+    ]
     body = []
     for k in keys:
         s, t, h = acc[k], thick[k], hist[k]
         dt, _ = err.t(k)
-        body.append([k[0].upper(), s["mesh"], f"{t['thickness'][0]:.4f}", f"{t['thickness'].min():.4f}",
-                     f"{t['thickness'].max():.4f}", f"{t['s'][np.argmax(t['thickness'])]:.2f}",
-                     f"{t['thickness'][-1]:.3f}", f"{dt:.4f}",
-                     f"{h['contact_area'][-1]:.2f}", f"{h['contact_force_z'][-1]:.0f}",
-                     f"{h['penetration'][-1]:.4f}", f"{s.get('edge_penetration', float('nan')):.4f}"])
+        body.append(
+            [
+                k[0].upper(),
+                s["mesh"],
+                f"{t['thickness'][0]:.4f}",
+                f"{t['thickness'].min():.4f}",
+                f"{t['thickness'].max():.4f}",
+                f"{t['s'][np.argmax(t['thickness'])]:.2f}",
+                f"{t['thickness'][-1]:.3f}",
+                f"{dt:.4f}",
+                f"{h['contact_area'][-1]:.2f}",
+                f"{h['contact_force_z'][-1]:.0f}",
+                f"{h['penetration'][-1]:.4f}",
+                f"{s.get('edge_penetration', float('nan')):.4f}",
+            ]
+        )
     lines.append(table(hdr, body))
 
     lines += conclusions(summary, symmetric, acc, runs, ref_key, err)
-    lines += ["", f"Figures: `toric_load_curves.png` (p(w), error against {ref_name}, contact area), "
-              "`toric_thickness.png` (final thickness along the plate and deformed mid-surfaces), "
-              "`toric_cpu.png` (CPU time and Newton iterations, the analogue of Figure 16).  Run folders "
-              f"(history.csv, thickness.csv, contact.csv, summary.json): `{runs_dir}`, not kept.", ""]
+    lines += [
+        "",
+        f"Figures: `toric_load_curves.png` (p(w), error against {ref_name}, contact area), "
+        "`toric_thickness.png` (final thickness along the plate and deformed mid-surfaces), "
+        "`toric_cpu.png` (CPU time and Newton iterations, the analogue of Figure 16).  Run folders "
+        f"(history.csv, thickness.csv, contact.csv, summary.json): `{runs_dir}`, not kept.",
+        "",
+    ]
     (out / "toric_study.md").write_text("\n".join(lines) + "\n")
     plots(summary, symmetric, acc, keys, runs, ref_key, hist, thick, out)
     print("wrote", out / "toric_study.md")
@@ -484,31 +616,58 @@ def conclusions(summary, symmetric, acc, runs, ref_key, err):
     sizes = sorted({(l, r) for g, e, l, r in runs if g == "same elements"})
 
     def ratios(table_):
-        return [(f"{l}x{r}", table_[("sfr", l, r)]["cpu"] / table_[("q8", l, r)]["cpu"],
-                 table_[("sfr", l, r)]["newton"], table_[("q8", l, r)]["newton"])
-                for l, r in sizes if ("sfr", l, r) in table_ and ("q8", l, r) in table_]
+        return [
+            (
+                f"{l}x{r}",
+                table_[("sfr", l, r)]["cpu"] / table_[("q8", l, r)]["cpu"],
+                table_[("sfr", l, r)]["newton"],
+                table_[("q8", l, r)]["newton"],
+            )
+            for l, r in sizes
+            if ("sfr", l, r) in table_ and ("q8", l, r) in table_
+        ]
 
     st = ratios(summary)
     txt = ", ".join(f"{m}: {x:.2f} ({a} vs {b} Newton iterations)" for m, x, a, b in st)
     sy = ratios(symmetric) if symmetric else []
-    txt2 = (" With the symmetric-mode factorization: " + ", ".join(f"{m}: {x:.2f}" for m, x, _, _ in sy) + ".") if sy else ""
+    txt2 = (
+        (" With the symmetric-mode factorization: " + ", ".join(f"{m}: {x:.2f}" for m, x, _, _ in sy) + ".")
+        if sy
+        else ""
+    )
     tenth = any(x <= 0.2 for _, x, _, _ in st + sy)
-    lines.append(f"1. *\"SFR needs about a tenth of Q8's CPU time with contact for the same number of "
-                 f"elements.\"*  CPU(SFR) / CPU(Q8) on the same mesh: {txt}.{txt2}  "
-                 + ("Reproduced on at least one mesh (see the tables)." if tenth else
-                    "**Not reproduced**: SFR is cheaper than Q8 on the same mesh, but by a factor of "
-                    f"{1 / max(x for _, x, _, _ in st + sy):.1f} to {1 / min(x for _, x, _, _ in st + sy):.1f}, "
-                    "not 10.  Newton needs about the same number of iterations with every "
-                    "element (the contact does not slow Q8's convergence here, and Q8's mid-side nodes "
-                    "are not even contact slaves in axiform), so the gain is only the cheaper iteration "
-                    "(about half the dofs, 2x2 instead of 3x3 Gauss points)."))
+    lines.append(
+        f"1. *\"SFR needs about a tenth of Q8's CPU time with contact for the same number of "
+        f'elements."*  CPU(SFR) / CPU(Q8) on the same mesh: {txt}.{txt2}  '
+        + (
+            "Reproduced on at least one mesh (see the tables)."
+            if tenth
+            else "**Not reproduced**: SFR is cheaper than Q8 on the same mesh, but by a factor of "
+            f"{1 / max(x for _, x, _, _ in st + sy):.1f} to {1 / min(x for _, x, _, _ in st + sy):.1f}, "
+            "not 10.  Newton needs about the same number of iterations with every "
+            "element (the contact does not slow Q8's convergence here, and Q8's mid-side nodes "
+            "are not even contact slaves in axiform), so the gain is only the cheaper iteration "
+            "(about half the dofs, 2x2 instead of 3x3 Gauss points)."
+        )
+    )
     lines.append("")
-    lines.append("2. *\"SFR close to Q8, better than Q4\"* (same mesh), and 3. the same number of dofs.  "
-                 f"Errors against {label(ref_key)}: load curve at w = 1 (bending), largest over the contact "
-                 "phase w in [2, 6], thickness (largest difference over r ≤ 7, and at the centre).")
+    lines.append(
+        '2. *"SFR close to Q8, better than Q4"* (same mesh), and 3. the same number of dofs.  '
+        f"Errors against {label(ref_key)}: load curve at w = 1 (bending), largest over the contact "
+        "phase w in [2, 6], thickness (largest difference over r ≤ 7, and at the centre)."
+    )
     lines.append("")
-    hdr = ["comparison", "element", "mesh", "dofs", "CPU [s]", "p err w=1 %", "p max err w in [2,6] %",
-           "max abs(dt) [in]", "dt centre [in]"]
+    hdr = [
+        "comparison",
+        "element",
+        "mesh",
+        "dofs",
+        "CPU [s]",
+        "p err w=1 %",
+        "p max err w in [2,6] %",
+        "max abs(dt) [in]",
+        "dt centre [in]",
+    ]
     body = []
     groups = [("same elements", [(e, l, r) for l, r in sizes for e in ELEMENTS])]
     for g in dict.fromkeys(g for g, *_ in runs if g.startswith("same dofs")):
@@ -524,8 +683,19 @@ def conclusions(summary, symmetric, acc, runs, ref_key, err):
                 continue
             _, e1, ec, _ = err.p(k)
             dt, dc = err.t(k)
-            body.append([g, k[0].upper(), f"{k[1]}x{k[2]}", acc[k]["dofs"], cpu,
-                         f"{e1:+.1f}", f"{ec:.2f}", f"{dt:.4f}", f"{dc:+.4f}"])
+            body.append(
+                [
+                    g,
+                    k[0].upper(),
+                    f"{k[1]}x{k[2]}",
+                    acc[k]["dofs"],
+                    cpu,
+                    f"{e1:+.1f}",
+                    f"{ec:.2f}",
+                    f"{dt:.4f}",
+                    f"{dc:+.4f}",
+                ]
+            )
     lines.append(table(hdr, body))
     verdict = []
     for l, r in sizes:
@@ -534,9 +704,11 @@ def conclusions(summary, symmetric, acc, runs, ref_key, err):
             b4, bs, b8 = (abs(err.p(k)[1]) for k in (k4, ks, k8))
             c4, cs, c8 = (err.p(k)[2] for k in (k4, ks, k8))
             t4, ts, t8 = (err.t(k)[0] for k in (k4, ks, k8))
-            verdict.append(f"{l}x{r}: bending error SFR {bs:.1f} % vs Q4 {b4:.1f} % vs Q8 {b8:.1f} %; "
-                           f"contact phase SFR {cs:.2f} % vs Q4 {c4:.2f} % vs Q8 {c8:.2f} %; "
-                           f"thickness SFR {ts:.3f} vs Q4 {t4:.3f} vs Q8 {t8:.3f} in")
+            verdict.append(
+                f"{l}x{r}: bending error SFR {bs:.1f} % vs Q4 {b4:.1f} % vs Q8 {b8:.1f} %; "
+                f"contact phase SFR {cs:.2f} % vs Q4 {c4:.2f} % vs Q8 {c8:.2f} %; "
+                f"thickness SFR {ts:.3f} vs Q4 {t4:.3f} vs Q8 {t8:.3f} in"
+            )
     if verdict:
         lines.append("Side by side: " + "; ".join(verdict) + ".")
     return lines
@@ -562,11 +734,14 @@ def plots(summary, symmetric, acc, keys, runs, ref_key, hist, thick, out):
         if k != ref_key:
             sel = h["w_center"] >= 0.5 - 1e-9
             pr = np.interp(h["w_center"][sel], rh["w_center"], rh["load_factor"])
-            ax[1].plot(h["w_center"][sel], 100 * (h["load_factor"][sel] / pr - 1), style[k], color=color[k[0]],
-                       label=label(k))
+            ax[1].plot(
+                h["w_center"][sel], 100 * (h["load_factor"][sel] / pr - 1), style[k], color=color[k[0]], label=label(k)
+            )
         ax[2].plot(h["w_center"], h["contact_area"], style[k], color=color[k[0]], lw=lw, label=label(k, ref_key))
     ax[0].set_yscale("log")
-    ax[0].set(xlabel="centre deflection w [in]", ylabel="pressure p [psi] (log scale)", title="load curve (cf. Figure 15)")
+    ax[0].set(
+        xlabel="centre deflection w [in]", ylabel="pressure p [psi] (log scale)", title="load curve (cf. Figure 15)"
+    )
     ax[1].set_yscale("symlog", linthresh=1.0)
     ax[1].set(xlabel="w [in]", ylabel="p / p_ref - 1 [%] (symlog)", title=f"relative error vs {label(ref_key)}")
     ax[2].set(xlabel="w [in]", ylabel="contact area (reference) [in²]", title="contact area")
@@ -597,12 +772,23 @@ def plots(summary, symmetric, acc, keys, runs, ref_key, hist, thick, out):
 
     fig, ax = plt.subplots(1, 2, figsize=(14, 4.8))
     xs = np.arange(len(keys))
-    ax[0].bar([i - 0.2 for i, k in enumerate(keys) if k in summary], [summary[k]["cpu"] for k in keys if k in summary],
-              0.4, color=[color[k[0]] for k in keys if k in summary], label="axiform.solve.linsolve (stock)")
+    ax[0].bar(
+        [i - 0.2 for i, k in enumerate(keys) if k in summary],
+        [summary[k]["cpu"] for k in keys if k in summary],
+        0.4,
+        color=[color[k[0]] for k in keys if k in summary],
+        label="axiform.solve.linsolve (stock)",
+    )
     if symmetric:
-        ax[0].bar([i + 0.2 for i, k in enumerate(keys) if k in symmetric], [symmetric[k]["cpu"] for k in keys if k in symmetric],
-                  0.4, color=[color[k[0]] for k in keys if k in symmetric], alpha=0.45, hatch="//",
-                  label="SuperLU symmetric mode")
+        ax[0].bar(
+            [i + 0.2 for i, k in enumerate(keys) if k in symmetric],
+            [symmetric[k]["cpu"] for k in keys if k in symmetric],
+            0.4,
+            color=[color[k[0]] for k in keys if k in symmetric],
+            alpha=0.45,
+            hatch="//",
+            label="SuperLU symmetric mode",
+        )
         ax[0].legend(fontsize=8)
     ax[0].set_xticks(xs, [f"{k[0].upper()}\n{k[1]}x{k[2]}" for k in keys], fontsize=7)
     ax[0].set(ylabel="CPU time of the solve [s]", title="CPU time (cf. Figure 16)")

@@ -42,11 +42,16 @@ from _perf_common import MATERIAL, deformed_state, load_average, machine, table,
 
 from axiform import Model, rectangle  # noqa: E402
 from axiform.fem.mesh import edges_on_nodes  # noqa: E402
+from axiform.materials.base import add_volumetric  # noqa: E402
 from axiform.materials.kinematics import from_rows, to_rows  # noqa: E402
 from axiform.materials.temperature import WLF  # noqa: E402
-from axiform.materials.base import add_volumetric  # noqa: E402
-from axiform.materials.viscoelastic import (Memory, Prony, Viscoelastic, second_piola_rows,  # noqa: E402
-                                            viscous_rows)
+from axiform.materials.viscoelastic import (
+    Memory,
+    Prony,
+    Viscoelastic,
+    second_piola_rows,  # noqa: E402
+    viscous_rows,
+)
 
 SERIES = {"1 term": Prony((0.5,), (0.1,)), "3 terms": Prony((0.3, 0.2, 0.1), (0.01, 0.1, 1.0))}
 # the 3 terms again with their relaxation times shifted per point: 150 on the inner face to
@@ -155,39 +160,54 @@ def pieces(n_points: int, repeats: int) -> list[list[str]]:
     branch = {  # the displacement assembly's memory branch, call by call
         "`stress_rows(xt, 0.0, True)` (the law's isochoric part)": lambda: law.stress_rows(xt, 0.0, True),
         "`Memory.add_rows` (`viscous_rows`, the history to rows and back)": lambda: memory.add_rows(
-            slice(None), xt, P.copy(), A.copy()),
-        "`add_volumetric` (kappa's part, a second pass over A)": lambda: add_volumetric(xt, law.kappa, P.copy(),
-                                                                                       A.copy()),
+            slice(None), xt, P.copy(), A.copy()
+        ),
+        "`add_volumetric` (kappa's part, a second pass over A)": lambda: add_volumetric(
+            xt, law.kappa, P.copy(), A.copy()
+        ),
         "`from_rows` of P, A": lambda: from_rows(P, A, shape),
     }
     inside = {  # what Memory.add_rows spends it on (the copies of P and A it is handed, apart)
         "· copies of P, A (this benchmark's, to keep them unchanged)": lambda: (P.copy(), A.copy()),
         "· `second_piola_rows` (S_iso)": lambda: second_piola_rows(xt, P),
-        "· H0 = sum(e h) + sum(a) S_n, h a (m, 4, n) view of (n, m, 4)": lambda: (e[:, None] * h_rows).sum(0)
-        + a.sum(0) * S_rows,
-        "· trial h_i = e h + a S_n + b S, the same view": lambda: e[:, None] * h_rows + a[:, None] * S_rows
-        + b[:, None] * S,
+        "· H0 = sum(e h) + sum(a) S_n, h a (m, 4, n) view of (n, m, 4)": lambda: (
+            (e[:, None] * h_rows).sum(0) + a.sum(0) * S_rows
+        ),
+        "· trial h_i = e h + a S_n + b S, the same view": lambda: (
+            e[:, None] * h_rows + a[:, None] * S_rows + b[:, None] * S
+        ),
         "· the same two on a contiguous (m, 4, n) h": lambda: (
             (e[:, None] * h_contiguous).sum(0) + a.sum(0) * S_rows,
-            e[:, None] * h_contiguous + a[:, None] * S_rows + b[:, None] * S),
+            e[:, None] * h_contiguous + a[:, None] * S_rows + b[:, None] * S,
+        ),
         "· the trial written back to (e, q, m, 4)": lambda: memory.trial["h"].__setitem__(
-            slice(None), trial.transpose(2, 0, 1).reshape(history["h"].shape)),
-        "· `viscous_rows` as a whole": lambda: viscous_rows(xt, P.copy(), A.copy(), h_rows,
-                                                                            S_rows, column),
+            slice(None), trial.transpose(2, 0, 1).reshape(history["h"].shape)
+        ),
+        "· `viscous_rows` as a whole": lambda: viscous_rows(xt, P.copy(), A.copy(), h_rows, S_rows, column),
     }
     h_contiguous = np.ascontiguousarray(h_rows)
     elastic = best(lambda: law.stress_tangent(x), repeats)
     times = {name: best(f, repeats) for name, f in (branch | inside).items()}
     copies = times["· copies of P, A (this benchmark's, to keep them unchanged)"]
-    for name in ("`Memory.add_rows` (`viscous_rows`, the history to rows and back)",
-                 "`add_volumetric` (kappa's part, a second pass over A)", "· `viscous_rows` as a whole"):
+    for name in (
+        "`Memory.add_rows` (`viscous_rows`, the history to rows and back)",
+        "`add_volumetric` (kappa's part, a second pass over A)",
+        "· `viscous_rows` as a whole",
+    ):
         times[name] -= copies
     total = sum(times[name] for name in branch)
-    rows = [["the elastic law: `stress_tangent` (`stress_rows` with kappa, `from_rows`)", f"{1e6 * elastic:.0f}",
-             "1.00"]]
+    rows = [
+        ["the elastic law: `stress_tangent` (`stress_rows` with kappa, `from_rows`)", f"{1e6 * elastic:.0f}", "1.00"]
+    ]
     rows += [[name, f"{1e6 * t:.0f}", f"{t / elastic:.2f}"] for name, t in times.items()]
-    rows.insert(len(branch) + 1, ["**the displacement form's memory branch** (the four above)",
-                                  f"**{1e6 * total:.0f}**", f"**{total / elastic:.2f}**"])
+    rows.insert(
+        len(branch) + 1,
+        [
+            "**the displacement form's memory branch** (the four above)",
+            f"**{1e6 * total:.0f}**",
+            f"**{total / elastic:.2f}**",
+        ],
+    )
     return rows
 
 
@@ -204,20 +224,23 @@ def main() -> None:
     part2 = table(["piece (3 terms, 8192 points)", "CPU us", "x the elastic law's P, A"], pieces(n_points, repeats))
     series = "; ".join(f"{k}: g = {p.g}, tau = {p.tau}" for k, p in SERIES.items()) + (
         f"; {SHIFTED}: the 3 terms with a temperature from 150 (inner face) to 120 (outer), WLF C1 = "
-        f"{WLF_SHIFT.C1:g}, C2 = {WLF_SHIFT.C2:g} about {WLF_SHIFT.reference:g}")
-    text = (f"# The cost of a Prony series in a Newton iteration\n\n"
-            f"`python benchmarks/viscoelastic_cost.py{' --quick' if args.quick else ''}`; {machine()}; load "
-            f"average {load_average()}; GLIBC_TUNABLES {os.environ.get('GLIBC_TUNABLES', 'unset')}.\n\n"
-            f"## 1. `Model.evaluate` with and without the series\n\nThe ring of `_perf_common.py` on a {n} x {n} "
-            f"mesh, Mooney-Rivlin (80, 20, 1e4), the state a homogeneous stretch plus 1 % noise; the series "
-            f"({series}) from a committed state with history at t = {T_COMMITTED} to t = {T_TRIAL}.  Median of "
-            f"{repeats} interleaved repeats of the process CPU time, one thread; in brackets the ratio to the "
-            f"elastic law in the same run.  R + K: `tangent=True` (a Newton iteration's evaluation); R: the "
-            f"residual alone.\n\n{part1}\n"
-            f"## 2. The pieces of the memory branch\n\n{n_points} points (F = I + 5 % random), the displacement "
-            f"assembly's calls on component rows, 3 terms; minimum of {repeats} repeats of the CPU time (less the "
-            f"copies of P and A that keep them unchanged from call to call); the ratio to the elastic law's one "
-            f"call `stress_tangent` on the same points.\n\n{part2}")
+        f"{WLF_SHIFT.C1:g}, C2 = {WLF_SHIFT.C2:g} about {WLF_SHIFT.reference:g}"
+    )
+    text = (
+        f"# The cost of a Prony series in a Newton iteration\n\n"
+        f"`python benchmarks/viscoelastic_cost.py{' --quick' if args.quick else ''}`; {machine()}; load "
+        f"average {load_average()}; GLIBC_TUNABLES {os.environ.get('GLIBC_TUNABLES', 'unset')}.\n\n"
+        f"## 1. `Model.evaluate` with and without the series\n\nThe ring of `_perf_common.py` on a {n} x {n} "
+        f"mesh, Mooney-Rivlin (80, 20, 1e4), the state a homogeneous stretch plus 1 % noise; the series "
+        f"({series}) from a committed state with history at t = {T_COMMITTED} to t = {T_TRIAL}.  Median of "
+        f"{repeats} interleaved repeats of the process CPU time, one thread; in brackets the ratio to the "
+        f"elastic law in the same run.  R + K: `tangent=True` (a Newton iteration's evaluation); R: the "
+        f"residual alone.\n\n{part1}\n"
+        f"## 2. The pieces of the memory branch\n\n{n_points} points (F = I + 5 % random), the displacement "
+        f"assembly's calls on component rows, 3 terms; minimum of {repeats} repeats of the CPU time (less the "
+        f"copies of P and A that keep them unchanged from call to call); the ratio to the elastic law's one "
+        f"call `stress_tangent` on the same points.\n\n{part2}"
+    )
     print(text)
     path = write_result(args.out or ("viscoelastic_cost_quick" if args.quick else "viscoelastic_cost"), text)
     print(f"wrote {path}", file=sys.stderr)

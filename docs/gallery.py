@@ -18,8 +18,18 @@ from axiform.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 IMG = ROOT / "docs" / "img"
-EXAMPLES = ["hughes_carnoy_plate", "plate_arc_length", "thick_cylinder", "balloon", "toric_plate", "die_drawing",
-            "bottle_blow_moulding", "parison_bottle", "cup_thermoforming", "stretch_blow_moulding"]
+EXAMPLES = [
+    "hughes_carnoy_plate",
+    "plate_arc_length",
+    "thick_cylinder",
+    "balloon",
+    "toric_plate",
+    "die_drawing",
+    "bottle_blow_moulding",
+    "parison_bottle",
+    "cup_thermoforming",
+    "stretch_blow_moulding",
+]
 ANIMATED = ["toric_plate", "bottle_blow_moulding", "cup_thermoforming", "stretch_blow_moulding"]
 
 

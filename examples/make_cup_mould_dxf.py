@@ -28,12 +28,14 @@ def main(path: Path = DRAWING) -> None:
     msp = doc.modelspace()
     mould = {"layer": "MOULD"}
     msp.add_line((0.0, -30.0), (32.0, -30.0), dxfattribs=mould)
-    msp.add_lwpolyline([(40.0, -5.0, QUARTER_CW), (45.0, 0.0, 0.0), (60.0, 0.0, 0.0)], format="xyb",
-                       dxfattribs=mould)
+    msp.add_lwpolyline([(40.0, -5.0, QUARTER_CW), (45.0, 0.0, 0.0), (60.0, 0.0, 0.0)], format="xyb", dxfattribs=mould)
     msp.add_line((40.0, -5.0), (40.0, -22.0), dxfattribs=mould)
     msp.add_arc((32.0, -22.0), 8.0, -90.0, 0.0, dxfattribs=mould)
-    msp.add_lwpolyline([(28.0, 60.0, 0.0), (28.0, 10.0, QUARTER_CW), (22.0, 4.0, 0.0), (-1.0, 4.0, 0.0)],
-                       format="xyb", dxfattribs={"layer": "PLUG"})
+    msp.add_lwpolyline(
+        [(28.0, 60.0, 0.0), (28.0, 10.0, QUARTER_CW), (22.0, 4.0, 0.0), (-1.0, 4.0, 0.0)],
+        format="xyb",
+        dxfattribs={"layer": "PLUG"},
+    )
     msp.add_text("cup mould and plug, mm", dxfattribs={"layer": "NOTES", "height": 2.0}).set_placement((0.0, 70.0))
     doc.saveas(path)
 

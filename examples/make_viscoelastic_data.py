@@ -24,27 +24,42 @@ E_INF, E_G = 1.5, 30.0
 
 
 def write(path: Path, comment: str, header: str, columns: list[np.ndarray], digits: int = 5) -> None:
-    rows = [",".join(f"{v:.{digits}g}" for v in row) for row in zip(*columns)]
-    path.write_text(f"# {comment}\n# written by examples/make_viscoelastic_data.py\n{header}\n" + "\n".join(rows) + "\n")
+    rows = [",".join(f"{v:.{digits}g}" for v in row) for row in zip(*columns, strict=False)]
+    path.write_text(
+        f"# {comment}\n# written by examples/make_viscoelastic_data.py\n{header}\n" + "\n".join(rows) + "\n"
+    )
 
 
 def main(folder: Path = DATA) -> None:
     rng = np.random.default_rng(1)
     t = np.geomspace(0.01, 1e4, 31)
     E = E_INF + (E_G - E_INF) * np.exp(-((t / 2.0) ** 0.45))
-    write(folder / "relaxation.csv", "synthetic tensile relaxation modulus (MPa) against time (s), KWW form + 1 % noise",
-          "time,modulus", [t, E * (1 + 0.01 * rng.standard_normal(t.size))])
+    write(
+        folder / "relaxation.csv",
+        "synthetic tensile relaxation modulus (MPa) against time (s), KWW form + 1 % noise",
+        "time,modulus",
+        [t, E * (1 + 0.01 * rng.standard_normal(t.size))],
+    )
     f = np.geomspace(0.01, 100.0, 21)
     iwt = 2j * np.pi * f * 0.3
     Es = E_INF + (E_G - E_INF) * (1 - 1 / (1 + iwt**0.5) ** 0.5)
     noise = 1 + 0.01 * rng.standard_normal((2, f.size))
-    write(folder / "dma.csv", "synthetic storage and loss moduli (MPa) against frequency (Hz), Havriliak-Negami "
-          "form + 1 % noise", "frequency,storage,loss", [f, Es.real * noise[0], Es.imag * noise[1]])
+    write(
+        folder / "dma.csv",
+        "synthetic storage and loss moduli (MPa) against frequency (Hz), Havriliak-Negami form + 1 % noise",
+        "frequency,storage,loss",
+        [f, Es.real * noise[0], Es.imag * noise[1]],
+    )
     T = np.arange(105.0, 166.0, 5.0)
     dT = T - 105.0
     shift = -17.44 * dT / (51.6 + dT) + 0.05 * rng.standard_normal(T.size) * (dT > 0)
-    write(folder / "wlf_shift.csv", "synthetic log10 a_T against temperature (deg C), universal WLF at Tg = 105 "
-          "+ 0.05 decades of noise", "temperature,log10_shift", [T, shift], digits=4)
+    write(
+        folder / "wlf_shift.csv",
+        "synthetic log10 a_T against temperature (deg C), universal WLF at Tg = 105 + 0.05 decades of noise",
+        "temperature,log10_shift",
+        [T, shift],
+        digits=4,
+    )
 
 
 if __name__ == "__main__":

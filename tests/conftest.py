@@ -46,7 +46,7 @@ def distorted_rectangle(r, z, divisions, element, amount=0.25, seed=0):
     mesh.points[corners] += amount * h * rng.uniform(-1, 1, size=(len(corners), 2))
     if element == "q8":
         ends = np.array([[0, 1], [1, 2], [2, 3], [3, 0]])
-        for k, (a, b) in zip(range(4, 8), ends):
+        for k, (a, b) in zip(range(4, 8), ends, strict=False):
             mids = mesh.cells[:, k]
             mesh.points[mids] = 0.5 * (mesh.points[mesh.cells[:, a]] + mesh.points[mesh.cells[:, b]])
     mesh.check()
@@ -66,9 +66,12 @@ def difference_tangent(model, u_f, lam, h, state=None):
     for j in range(n):
         e = np.zeros(n)
         e[j] = h
-        num[:, j] = (model.evaluate(u_f + e, lam, state, tangent=False).r
-                     - model.evaluate(u_f - e, lam, state, tangent=False).r) / (2 * h)
-    dl = (model.evaluate(u_f, lam + h, state, tangent=False).r - model.evaluate(u_f, lam - h, state, tangent=False).r) / (2 * h)
+        num[:, j] = (
+            model.evaluate(u_f + e, lam, state, tangent=False).r - model.evaluate(u_f - e, lam, state, tangent=False).r
+        ) / (2 * h)
+    dl = (
+        model.evaluate(u_f, lam + h, state, tangent=False).r - model.evaluate(u_f, lam - h, state, tangent=False).r
+    ) / (2 * h)
     return num, dl
 
 

@@ -26,8 +26,11 @@ def piece_local(self, k: np.ndarray, x: np.ndarray):
         alpha = ((phi - self.phi0[ka]) * sgn) % (2 * np.pi)
         after = alpha - sweep
         before = 2 * np.pi - alpha
-        xa_frac = np.where(alpha <= sweep, alpha / np.where(sweep > 0, sweep, 1.0),
-                           np.where(after < before, 1.0 + after / sweep, -before / sweep))
+        xa_frac = np.where(
+            alpha <= sweep,
+            alpha / np.where(sweep > 0, sweep, 1.0),
+            np.where(after < before, 1.0 + after / sweep, -before / sweep),
+        )
         ta = sgn[:, None] * np.column_stack([-np.sin(phi), np.cos(phi)])
         na = np.column_stack([-ta[:, 1], ta[:, 0]])
         xi[arc] = xa_frac
@@ -83,8 +86,8 @@ def local(self, x, x_prev, depth, method="buckets") -> Projection:
     if free.any() and len(self.a) > 1:
         beyond = (xi > 1 + tol) & (g < 0) & (g > -depth) & free[i]
         before = (xi < -tol) & (g < 0) & (g > -depth) & free[i]
-        key_end = set(zip(i[beyond].tolist(), k[beyond].tolist()))
-        for node, seg in zip(i[before].tolist(), k[before].tolist()):
+        key_end = set(zip(i[beyond].tolist(), k[beyond].tolist(), strict=False))
+        for node, seg in zip(i[before].tolist(), k[before].tolist(), strict=False):
             if seg >= 1 and (node, seg - 1) in key_end and not out.active[node]:
                 prev = seg - 1
                 t1, t2 = self.tan_b[prev], self.tan_a[seg]

@@ -214,11 +214,12 @@ def uniaxial_prony(stretch, times, C1: float, C2: float, kappa: float, g, tau, r
         iso = state(t, h)[1]
         return ((np.outer(iso[:2], g) - h.reshape(2, -1)) / tau).ravel()
 
-    sol = solve_ivp(rate, (0.0, float(np.max(times))), np.zeros(2 * len(g)), method="DOP853", t_eval=times,
-                    rtol=rtol, atol=1e-14)
+    sol = solve_ivp(
+        rate, (0.0, float(np.max(times))), np.zeros(2 * len(g)), method="DOP853", t_eval=times, rtol=rtol, atol=1e-14
+    )
     if not sol.success:
         raise RuntimeError(sol.message)
-    out = [state(t, h) for t, h in zip(sol.t, sol.y.T)]
+    out = [state(t, h) for t, h in zip(sol.t, sol.y.T, strict=False)]
     return np.array([o[2] for o in out]), np.array([o[0] for o in out])
 
 
@@ -266,10 +267,17 @@ class PronySphere:
         """p (n,) at times (n,) with the bore radius a prescribed as bore(t), bore(0) = A."""
         from scipy.integrate import solve_ivp
 
-        sol = solve_ivp(lambda t, h: self._rate(self._iso(bore(t))[2], h), (0.0, float(np.max(times))),
-                        np.zeros(2 * len(self.R) * len(self.g)), method="DOP853", t_eval=times, rtol=rtol,
-                        atol=1e-14, max_step=np.min(self.tau) / 4)
-        return np.array([self.pressure(bore(t), self._summed(h)) for t, h in zip(sol.t, sol.y.T)])
+        sol = solve_ivp(
+            lambda t, h: self._rate(self._iso(bore(t))[2], h),
+            (0.0, float(np.max(times))),
+            np.zeros(2 * len(self.R) * len(self.g)),
+            method="DOP853",
+            t_eval=times,
+            rtol=rtol,
+            atol=1e-14,
+            max_step=np.min(self.tau) / 4,
+        )
+        return np.array([self.pressure(bore(t), self._summed(h)) for t, h in zip(sol.t, sol.y.T, strict=False)])
 
     def bore(self, p: float, h: np.ndarray | None = None, scale: float = 1.0, bracket=None) -> float:
         """The bore radius a of the rising branch where scale x pressure(a, h) = p (scale: the
@@ -300,6 +308,13 @@ class PronySphere:
         def rate(t, h):
             return self._rate(self._iso(self.bore(p, self._summed(h), bracket=bracket))[2], h)
 
-        sol = solve_ivp(rate, (0.0, float(np.max(times))), np.zeros(2 * len(self.R) * len(self.g)),
-                        method="DOP853", t_eval=times, rtol=rtol, atol=1e-14)
+        sol = solve_ivp(
+            rate,
+            (0.0, float(np.max(times))),
+            np.zeros(2 * len(self.R) * len(self.g)),
+            method="DOP853",
+            t_eval=times,
+            rtol=rtol,
+            atol=1e-14,
+        )
         return np.array([self.bore(p, self._summed(h), bracket=bracket) for h in sol.y.T])

@@ -83,8 +83,10 @@ def plate_centre(model):
 
 
 @pytest.mark.parametrize("steps", [20, 80, 400])
-@pytest.mark.parametrize("element, formulation, grading", [("q4", "mixed", 1.0), ("q8", "mixed", 1.0),
-                                                           ("sfr", "mixed", 0.5), ("sfr", "displacement", 1.0)])
+@pytest.mark.parametrize(
+    "element, formulation, grading",
+    [("q4", "mixed", 1.0), ("q8", "mixed", 1.0), ("sfr", "mixed", 0.5), ("sfr", "displacement", 1.0)],
+)
 def test_arc_length_carries_the_papers_plate_past_its_pressure_maximum(element, formulation, grading, steps):
     """The clamped plate (2 x 20) under arc length with the default settings, stopped at a
     mid-thickness centre deflection of 21 in: the pressure rises to its maximum (measured
@@ -121,9 +123,10 @@ def test_the_uniform_mixed_sfr_plate_turns_back_at_its_clamp():
     and on to the stop: every point of the path is an equilibrium, the same for 20, 80 or 400
     steps (measured: the turn at 20.46, 20.45, 20.45), and det K changes sign only at the
     maxima and the minimum of the pressure along it (limit points, no bifurcation)."""
+    from conftest import clamped_plate
+
     from axiform import select_nodes
     from axiform.solve.solver import DisplacementControl
-    from conftest import clamped_plate
 
     model = clamped_plate("sfr")
     w = plate_centre(model)
@@ -143,7 +146,6 @@ def test_the_uniform_mixed_sfr_plate_turns_back_at_its_clamp():
     next_to_clamp = int(model.dof(select_nodes(model.mesh, {"r": 7.125, "z": 0.25})[0], "rot"))
     assert res.steps[k].u[next_to_clamp] < 0
     assert res.last.u[next_to_clamp] > 3.0
-
 
 
 def test_a_given_arc_length_is_the_arc_of_every_step():
@@ -175,8 +177,14 @@ def test_a_tube_blown_onto_a_mould_takes_about_the_steps_asked_for():
     model.fix(select_nodes(mesh, {"z": 0.0}), ["uz"])
     model.fix(select_nodes(mesh, {"z": 0.02}), ["uz"])
     model.pressure(select_edges(mesh, {"r": 0.2}), 2.0)
-    model.contact(ContactPair(mesh, Polyline(points=[[1.0, -1.0], [1.0, 1.0]]), select_nodes(mesh, {"r": 0.22}),
-                              modulus=9 * 100.0 / (3 * 100.0 + 1.0)))
+    model.contact(
+        ContactPair(
+            mesh,
+            Polyline(points=[[1.0, -1.0], [1.0, 1.0]]),
+            select_nodes(mesh, {"r": 0.22}),
+            modulus=9 * 100.0 / (3 * 100.0 + 1.0),
+        )
+    )
     res = solve(model.finalize(), ArcLengthControl(1.0, 80))
     assert res.status == "finished", res.message
     lam = np.array([0.0] + [s.lam for s in res.steps])
@@ -213,8 +221,9 @@ def test_a_path_run_back_to_zero_load_ends_the_run(monkeypatch):
     """The same plate with 400 steps and the two checks of a step's end turned off: a step
     lands on the loaded branch near the snap-back at w = 11.8 and the path runs back down it;
     the run ends where lambda would cross zero, saying so (before: 1000 steps, to w = -3.6)."""
-    from axiform.solve import arc_length
     from conftest import clamped_plate
+
+    from axiform.solve import arc_length
 
     monkeypatch.setattr(arc_length, "MAX_TURN", np.pi)
     monkeypatch.setattr(arc_length.ArcLengthPath, "_check_branch", lambda self, u_new, ev: None)
@@ -229,9 +238,10 @@ def test_a_path_run_back_to_zero_load_ends_the_run(monkeypatch):
 def test_the_branch_check_is_left_to_systems_superlu_factorizes_cheaply(monkeypatch):
     """The sign of det K comes from SuperLU, 8 to 13 times PARDISO's time at 1e5 unknowns: the
     branch check runs on systems of up to BRANCH_CHECK_MAX unknowns only."""
+    from conftest import clamped_plate
+
     from axiform.solve import arc_length
     from axiform.solve.controls import NewtonOptions
-    from conftest import clamped_plate
 
     model = clamped_plate("q8", "displacement")
     control = ArcLengthControl(target=100.0, steps=400, stop_dof=plate_centre(model), stop_value=23.0)

@@ -11,12 +11,12 @@ import ezdxf
 import meshio
 import numpy as np
 import pytest
+from test_fuzz import BASE, CONTACT, toml
+from test_fuzz_files import call
 
 from axiform.case.mesh import MeshSpec, check_size, physical_memory
 from axiform.case.schema import CaseError
 from axiform.io.checkpoint import check_like, load, save
-from test_fuzz import BASE, CONTACT, toml
-from test_fuzz_files import call
 
 
 def write_case(tmp_path, case, name="case.toml"):
@@ -38,9 +38,17 @@ def refused(argv, *expected, bound=20.0):
 # ---- magnitudes whose products overflow ------------------------------------------------------
 
 
-@pytest.mark.parametrize("key, value", [("mesh.r", "[0.0, 1e308]"), ("mesh.z", "[0.0, 1e-308]"),
-                                        ("material.C1", "1e308"), ("material.kappa", "1e300"),
-                                        ("pressure[0].value", "-1e308"), ("solver.target", "1e40")])
+@pytest.mark.parametrize(
+    "key, value",
+    [
+        ("mesh.r", "[0.0, 1e308]"),
+        ("mesh.z", "[0.0, 1e-308]"),
+        ("material.C1", "1e308"),
+        ("material.kappa", "1e300"),
+        ("pressure[0].value", "-1e308"),
+        ("solver.target", "1e40"),
+    ],
+)
 def test_magnitudes_that_overflow_are_refused_naming_the_key(tmp_path, key, value):
     path = write_case(tmp_path, BASE)
     err = refused(["check", path, "--set", f"{key}={value}"], f"{key}")
@@ -70,8 +78,12 @@ def test_ordinary_magnitudes_pass(tmp_path):
 def test_a_mesh_too_large_for_memory_is_refused_before_allocating(tmp_path):
     case = copy.deepcopy(BASE)
     case["mesh"]["divisions"] = [100000, 100000]
-    err = refused(["run", write_case(tmp_path, case), "--out", tmp_path / "out", "-q"], "mesh.divisions: 100000 x 100000",
-                  "GiB", bound=5.0)
+    err = refused(
+        ["run", write_case(tmp_path, case), "--out", tmp_path / "out", "-q"],
+        "mesh.divisions: 100000 x 100000",
+        "GiB",
+        bound=5.0,
+    )
     assert "MemoryError" not in err
 
 
@@ -81,11 +93,19 @@ def test_the_size_check_counts_nodes_and_dofs_of_each_element():
     check_size(spec, memory=10**9)
     with pytest.raises(CaseError, match=r"mesh.divisions: 10 x 2 q8 elements make 85 nodes, 170 dofs"):
         check_size(spec, memory=1000)
-    layered = MeshSpec(kind="layered", element="sfr", start=(1.0, 0.0), thickness=0.1, layers=3,
-                       profile=[{"line": {"to": (1.0, 1.0), "divisions": 4}}, {"line": {"to": (2.0, 1.0),
-                                                                                      "divisions": 5}}])
-    with pytest.raises(CaseError, match=r"mesh.layers: 9 profile divisions x 3 layers of sfr elements make 40 nodes, "
-                                        r"120 dofs"):
+    layered = MeshSpec(
+        kind="layered",
+        element="sfr",
+        start=(1.0, 0.0),
+        thickness=0.1,
+        layers=3,
+        profile=[{"line": {"to": (1.0, 1.0), "divisions": 4}}, {"line": {"to": (2.0, 1.0), "divisions": 5}}],
+    )
+    with pytest.raises(
+        CaseError,
+        match=r"mesh.layers: 9 profile divisions x 3 layers of sfr elements make 40 nodes, "
+        r"120 dofs",
+    ):
         check_size(layered, memory=1000)
 
 
@@ -103,7 +123,9 @@ def gmsh_case(tmp_path, points, cells):
 
 
 def test_triangles_among_the_quads_are_refused_with_their_count_and_how_to_recombine(tmp_path):
-    path = gmsh_case(tmp_path, PTS, [("quad", np.array([[0, 1, 2, 3]])), ("triangle", np.array([[1, 4, 5], [1, 5, 2]]))])
+    path = gmsh_case(
+        tmp_path, PTS, [("quad", np.array([[0, 1, 2, 3]])), ("triangle", np.array([[1, 4, 5], [1, 5, 2]]))]
+    )
     refused(["check", path], "mesh.file:", "m.msh: holds 2 triangle cells beside 1 quadrilaterals", "Recombine")
 
 
@@ -135,8 +157,9 @@ def test_a_monitor_name_with_blanks_and_units_passes(tmp_path):
     assert call(["check", str(write_case(tmp_path, case))])[0] == 0
 
 
-@pytest.mark.parametrize("sectors, text", [(10**9, "output.revolved: Input should be less than or equal to 3600"),
-                                           (3600, None)])
+@pytest.mark.parametrize(
+    "sectors, text", [(10**9, "output.revolved: Input should be less than or equal to 3600"), (3600, None)]
+)
 def test_a_revolved_copy_is_bounded(tmp_path, sectors, text):
     case = copy.deepcopy(BASE)
     case["output"]["revolved"] = sectors
@@ -156,8 +179,12 @@ def test_a_dxf_coordinate_that_is_not_finite_is_refused_naming_the_file(tmp_path
     doc.modelspace().add_line((1.0, 0.5), (2.5, 1e308))
     doc.saveas(tmp_path / "m.dxf")
     case = dict(copy.deepcopy(BASE), contact=[dict(copy.deepcopy(CONTACT), surface={"dxf": "m.dxf"})])
-    refused(["check", write_case(tmp_path, case)], "contact[0].surface.dxf:", str(tmp_path / "m.dxf"),
-            "not a finite number or is beyond 1e+30")
+    refused(
+        ["check", write_case(tmp_path, case)],
+        "contact[0].surface.dxf:",
+        str(tmp_path / "m.dxf"),
+        "not a finite number or is beyond 1e+30",
+    )
 
 
 # ---- checkpoints -------------------------------------------------------------------------------
@@ -313,8 +340,16 @@ def test_fit_out_below_a_file_is_refused(tmp_path):
 def test_a_sweep_of_too_many_cases_is_refused_at_once(tmp_path):
     write_case(tmp_path, BASE)
     values = "[" + ", ".join(str(80.0 + k) for k in range(10)) + "]"
-    keys = ["material.C1", "material.C2", "material.kappa", "pressure[0].value", "mesh.r[1]", "mesh.z[1]",
-            "solver.steps", "contact"]
+    keys = [
+        "material.C1",
+        "material.C2",
+        "material.kappa",
+        "pressure[0].value",
+        "mesh.r[1]",
+        "mesh.z[1]",
+        "solver.steps",
+        "contact",
+    ]
     sweep = tmp_path / "sweep.toml"
     sweep.write_text('case = "case.toml"\n[vary]\n' + "".join(f'"{k}" = {values}\n' for k in keys))
     refused(["sweep", sweep, "--out", tmp_path / "out"], "vary:", bound=1.0)
@@ -327,12 +362,15 @@ def test_a_sweep_value_that_is_a_date_is_refused(tmp_path):
     refused(["sweep", sweep, "--out", tmp_path / "out"], "vary.material.C1")
 
 
-
 def test_a_mould_file_of_huge_coordinates_is_refused_naming_the_row(tmp_path):
     (tmp_path / "m.csv").write_text("0.0, 0.5\n1.0, 1e308\n")
     case = dict(copy.deepcopy(BASE), contact=[dict(copy.deepcopy(CONTACT), surface={"file": "m.csv"})])
-    refused(["check", write_case(tmp_path, case)], "contact[0].surface.file:", "row 2 of the data is not two finite",
-            "at most 1e+30")
+    refused(
+        ["check", write_case(tmp_path, case)],
+        "contact[0].surface.file:",
+        "row 2 of the data is not two finite",
+        "at most 1e+30",
+    )
 
 
 def test_a_target_of_absurd_magnitude_is_refused_naming_the_line(tmp_path):
@@ -342,5 +380,7 @@ def test_a_target_of_absurd_magnitude_is_refused_naming_the_line(tmp_path):
     target = tmp_path / "t.csv"
     target.write_text("s,thickness\n0,1e-300\n20,1e-300\n")
     (tmp_path / "blocker").write_text("")  # no optimization starts while the target is accepted
-    refused(["optimize", case, "--target", target, "--out", tmp_path / "blocker" / "out", "-q"],
-            f"--target: {target}: line 2")
+    refused(
+        ["optimize", case, "--target", target, "--out", tmp_path / "blocker" / "out", "-q"],
+        f"--target: {target}: line 2",
+    )

@@ -89,23 +89,51 @@ def test_examples_are_valid():
 
 
 BAD = [
-    ("unknown key", lambda t: t.replace('kappa = 1.0e4', 'kappa = 1.0e4\nkapa = 3.0'), r"material\.kapa: unknown key"),
-    ("wrong type", lambda t: t.replace("divisions = [10, 2]", 'divisions = [10, "two"]'), r"mesh\.divisions\[1\]: Input should be a valid integer"),
+    ("unknown key", lambda t: t.replace("kappa = 1.0e4", "kappa = 1.0e4\nkapa = 3.0"), r"material\.kapa: unknown key"),
+    (
+        "wrong type",
+        lambda t: t.replace("divisions = [10, 2]", 'divisions = [10, "two"]'),
+        r"mesh\.divisions\[1\]: Input should be a valid integer",
+    ),
     ("missing constant", lambda t: t.replace("C2 = 20.0\n", ""), r"material: missing material constant: C2"),
     ("missing kappa", lambda t: t.replace("kappa = 1.0e4\n", ""), r"material: missing material constant: kappa"),
-    ("selector matches nothing", lambda t: t.replace("at = { r = 7.5 }", "at = { r = 7.7 }"),
-     r"fix\[0\]\.at: selector \{r = 7.7\} matches no node"),
-    ("monitor not one node", lambda t: t.replace('at = { r = 0.0, z = 0.5 }\ndof = "uz"', 'at = { r = 0.0 }\ndof = "uz"'),
-     r"monitor\[0\]\.at: selector must match exactly one node, it matches 3"),
-    ("bad element", lambda t: t.replace('element = "q4"', 'element = "q9"'), r"mesh\.element: Input should be 'q4', 'q8' or 'sfr'"),
+    (
+        "selector matches nothing",
+        lambda t: t.replace("at = { r = 7.5 }", "at = { r = 7.7 }"),
+        r"fix\[0\]\.at: selector \{r = 7.7\} matches no node",
+    ),
+    (
+        "monitor not one node",
+        lambda t: t.replace('at = { r = 0.0, z = 0.5 }\ndof = "uz"', 'at = { r = 0.0 }\ndof = "uz"'),
+        r"monitor\[0\]\.at: selector must match exactly one node, it matches 3",
+    ),
+    (
+        "bad element",
+        lambda t: t.replace('element = "q4"', 'element = "q9"'),
+        r"mesh\.element: Input should be 'q4', 'q8' or 'sfr'",
+    ),
     ("bad dof", lambda t: t.replace('dofs = ["ur"]', 'dofs = ["ux"]'), r"fix\[1\]\.dofs\[0\]: Input should be"),
-    ("reversed range", lambda t: t.replace("r = [0.0, 7.5]", "r = [7.5, 0.0]"), r"mesh: r and z must be given as \[min, max\]"),
-    ("displacement without dof", lambda t: t.replace('dof = { at = { r = 0.0, z = 0.5 }, dof = "uz" }\n', ""),
-     r"solver: displacement control needs 'dof' and 'target'"),
-    ("negative steps", lambda t: t.replace("steps = 6", "steps = -1"), r"solver\.steps: Input should be greater than or equal to 1"),
+    (
+        "reversed range",
+        lambda t: t.replace("r = [0.0, 7.5]", "r = [7.5, 0.0]"),
+        r"mesh: r and z must be given as \[min, max\]",
+    ),
+    (
+        "displacement without dof",
+        lambda t: t.replace('dof = { at = { r = 0.0, z = 0.5 }, dof = "uz" }\n', ""),
+        r"solver: displacement control needs 'dof' and 'target'",
+    ),
+    (
+        "negative steps",
+        lambda t: t.replace("steps = 6", "steps = -1"),
+        r"solver\.steps: Input should be greater than or equal to 1",
+    ),
     ("not toml", lambda t: t + "\n[[[", r"not valid TOML"),
-    ("zero grading", lambda t: t.replace("divisions = [10, 2]", "divisions = [10, 2]\ngrading = [0.0, 1.0]"),
-     r"mesh\.grading\[0\]: Input should be greater than 0"),
+    (
+        "zero grading",
+        lambda t: t.replace("divisions = [10, 2]", "divisions = [10, 2]\ngrading = [0.0, 1.0]"),
+        r"mesh\.grading\[0\]: Input should be greater than 0",
+    ),
 ]
 
 
@@ -142,7 +170,8 @@ $EndElements
 def test_inverted_mesh_is_refused(tmp_path, capsys):
     write(tmp_path, GMSH_INVERTED, "bad.msh")
     text = PLATE.format(element="q4").replace(
-        'kind = "rectangle"\nr = [0.0, 7.5]\nz = [0.0, 0.5]\ndivisions = [10, 2]', 'kind = "gmsh"\nfile = "bad.msh"')
+        'kind = "rectangle"\nr = [0.0, 7.5]\nz = [0.0, 0.5]\ndivisions = [10, 2]', 'kind = "gmsh"\nfile = "bad.msh"'
+    )
     assert run(tmp_path, text) == 2
     err = capsys.readouterr().err
     assert re.search(r"mesh: inverted or degenerate element\(s\) \[1\]", err), err
@@ -150,11 +179,28 @@ def test_inverted_mesh_is_refused(tmp_path, capsys):
 
 def test_overrides_from_the_command_line(tmp_path):
     case = write(tmp_path, PLATE.format(element="q4"))
-    assert main(["run", str(case), "--out", str(tmp_path / "o"), "-q", "--set", "mesh.element=q8",
-                 "--set", "solver.target=1.0", "--set", "solver.steps=2"]) == 0
+    assert (
+        main(
+            [
+                "run",
+                str(case),
+                "--out",
+                str(tmp_path / "o"),
+                "-q",
+                "--set",
+                "mesh.element=q8",
+                "--set",
+                "solver.target=1.0",
+                "--set",
+                "solver.steps=2",
+            ]
+        )
+        == 0
+    )
     summary = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert summary["element"] == "q8" and summary["steps"] == 2
     from axiform.case.schema import CaseError, override
+
     data = {"contact": [{"friction": 0.1}, {"friction": 0.3}]}
     override(data, "contact[1].friction=0.0")
     assert data["contact"][1]["friction"] == 0.0
@@ -241,9 +287,26 @@ steps = 2
 
 def test_toric_plate_case_with_sticky_contact(tmp_path):
     out = tmp_path / "toric"
-    assert main(["run", str(EXAMPLES / "toric_plate.toml"), "--out", str(out), "-q",
-                 "--set", "mesh.divisions=[20,2]", "--set", "solver.target=3.0", "--set", "solver.steps=15",
-                 "--set", "output.plots=false"]) == 0
+    assert (
+        main(
+            [
+                "run",
+                str(EXAMPLES / "toric_plate.toml"),
+                "--out",
+                str(out),
+                "-q",
+                "--set",
+                "mesh.divisions=[20,2]",
+                "--set",
+                "solver.target=3.0",
+                "--set",
+                "solver.steps=15",
+                "--set",
+                "output.plots=false",
+            ]
+        )
+        == 0
+    )
     rows = list(csv.DictReader(open(out / "history.csv")))
     area = np.array([float(r["contact_area"]) for r in rows])
     assert area[0] == 0 and area[-1] > 0 and (np.diff(area) >= 0).all()  # sticky: never lets go
@@ -254,18 +317,31 @@ def test_toric_plate_case_with_sticky_contact(tmp_path):
     assert 0 <= pen < 0.01 * 0.5  # the default penalty leaves < 1 % of the thickness
     assert float(rows[-1]["penetration"]) == pytest.approx(pen)
     import meshio
+
     last = meshio.read(sorted((out / "fields").glob("*.vtu"))[-1])
     p = last.point_data["contact_pressure"]
     assert p.max() > 0 and (p >= 0).all()
 
 
 CONTACT_BAD = [
-    ("slaves match nothing", 'slaves = { z = 0.5 }', 'slaves = { z = 0.6 }', r"contact\[0\]\.slaves: selector \{z = 0.6\} matches no node"),
-    ("two surfaces", 'surface = { circle = { center = [4.5, 3.0], radius = 1.5 } }',
-     'surface = { circle = { center = [4.5, 3.0], radius = 1.5 }, polyline = [[0, 1], [1, 1]] }',
-     r"contact\[0\]\.surface: a surface is exactly one of"),
-    ("monitor index", "contact = 0\nquantity = \"area\"", "contact = 3\nquantity = \"area\"",
-     r"monitor\[2\]\.contact: there are 1 \[\[contact\]\] tables"),
+    (
+        "slaves match nothing",
+        "slaves = { z = 0.5 }",
+        "slaves = { z = 0.6 }",
+        r"contact\[0\]\.slaves: selector \{z = 0.6\} matches no node",
+    ),
+    (
+        "two surfaces",
+        "surface = { circle = { center = [4.5, 3.0], radius = 1.5 } }",
+        "surface = { circle = { center = [4.5, 3.0], radius = 1.5 }, polyline = [[0, 1], [1, 1]] }",
+        r"contact\[0\]\.surface: a surface is exactly one of",
+    ),
+    (
+        "monitor index",
+        'contact = 0\nquantity = "area"',
+        'contact = 3\nquantity = "area"',
+        r"monitor\[2\]\.contact: there are 1 \[\[contact\]\] tables",
+    ),
     ("sticky and friction", "sticky = true", "sticky = true\nfriction = 0.2", r"contact\[0\]: give friction or sticky"),
 ]
 

@@ -12,7 +12,6 @@ from axiform.case.preflight import curves_past_target, inverting_loads, mould_ch
 from axiform.case.schema import CaseError, build, parse, read
 from axiform.post.check_plot import check_figure, plot_check
 
-
 PLATE = """
 [mesh]
 kind = "rectangle"
@@ -45,18 +44,24 @@ def refused(text: str) -> str:
     return str(exc.value)
 
 
-@pytest.mark.parametrize("old, new, message", [
-    ("steps = 10", "stesp = 10", 'solver.stesp: unknown key; did you mean "steps"?'),
-    ("kappa = 1.0e4", "kapa = 1.0e4", 'material.kapa: unknown key; did you mean "kappa"?'),
-    ("[solver]", "[solvr]", 'solvr: unknown key; did you mean "solver"?'),
-    ("[[pressure]]", "[[presure]]", 'presure: unknown key; did you mean "pressure"?'),
-    ("on = { z = 0.0 }", "on = { zz = 0.0 }", 'pressure[0].on.zz: unknown key; did you mean "z"?'),
-    ('dofs = ["ur"]\n', 'dofs = ["ur"]\ncurv = [[0.0, 0.0], [1.0, 1.0]]\n',
-     'fix[1].curv: unknown key; did you mean "curve"?'),
-    ('"mooney-rivlin"', '"mooney-rivlen"', 'material.model: Input should be .*; did you mean "mooney-rivlin"?'),
-    ("steps = 10", 'steps = 10\ncontrol = "arclength"', 'solver.control: .*; did you mean "arc-length"?'),
-    ('element = "q4"', 'element = "Q4"', 'mesh.element: .*; did you mean "q4"?'),
-])
+@pytest.mark.parametrize(
+    "old, new, message",
+    [
+        ("steps = 10", "stesp = 10", 'solver.stesp: unknown key; did you mean "steps"?'),
+        ("kappa = 1.0e4", "kapa = 1.0e4", 'material.kapa: unknown key; did you mean "kappa"?'),
+        ("[solver]", "[solvr]", 'solvr: unknown key; did you mean "solver"?'),
+        ("[[pressure]]", "[[presure]]", 'presure: unknown key; did you mean "pressure"?'),
+        ("on = { z = 0.0 }", "on = { zz = 0.0 }", 'pressure[0].on.zz: unknown key; did you mean "z"?'),
+        (
+            'dofs = ["ur"]\n',
+            'dofs = ["ur"]\ncurv = [[0.0, 0.0], [1.0, 1.0]]\n',
+            'fix[1].curv: unknown key; did you mean "curve"?',
+        ),
+        ('"mooney-rivlin"', '"mooney-rivlen"', 'material.model: Input should be .*; did you mean "mooney-rivlin"?'),
+        ("steps = 10", 'steps = 10\ncontrol = "arclength"', 'solver.control: .*; did you mean "arc-length"?'),
+        ('element = "q4"', 'element = "Q4"', 'mesh.element: .*; did you mean "q4"?'),
+    ],
+)
 def test_a_misspelt_key_or_word_gets_the_nearest_valid_one(old, new, message):
     assert re.search(re.escape(message).replace(r"\.\*", ".*"), refused(PLATE.replace(old, new)))
 
@@ -68,11 +73,14 @@ def test_no_guess_where_nothing_is_close():
 
 
 def test_a_union_of_tables_offers_the_keys_of_its_members():
-    text = PLATE + """
+    text = (
+        PLATE
+        + """
 [[contact]]
 surface = { profile = { start = [0.0, 1.0], pieces = [{ lin = { to = [8.0, 1.0] } }] } }
 slaves = { z = 0.5 }
 """
+    )
     assert 'contact[0].surface.profile.pieces[0].lin: unknown key; did you mean "line"?' in refused(text)
 
 
@@ -97,8 +105,9 @@ def test_a_curve_beyond_the_target_warns():
     warnings = preflight(built(cup, drop=[("solver", "target")]))
     # the vacuum rises from t = 1 to 1.5; the plug's motion is constant after t = 1: not cut short
     assert len(warnings) == 1
-    assert warnings[0].startswith("pressure[0].curve: the curve runs to t = 1.5, but the run ends at [solver] "
-                                  "target (default 1) = 1")
+    assert warnings[0].startswith(
+        "pressure[0].curve: the curve runs to t = 1.5, but the run ends at [solver] target (default 1) = 1"
+    )
     assert "contact[0]" not in warnings[0]
     assert curves_past_target(built(cup, ["solver.target=1.2"]))[0].startswith("pressure[0].curve:")
 
@@ -108,15 +117,24 @@ def test_no_curve_check_under_displacement_control():
     assert curves_past_target(built(plate, ["pressure[0].curve=[[0.0, 0.0], [10.0, 1.0]]"])) == []
 
 
-@pytest.mark.parametrize("path, index", [
-    ("die_drawing.toml", 0), ("die_drawing.toml", 1), ("cup_thermoforming.toml", 0), ("cup_thermoforming.toml", 1),
-    ("parison_bottle.toml", 0), ("stretch_blow_moulding.toml", 1), ("bottle_blow_moulding.toml", 0),
-])
+@pytest.mark.parametrize(
+    "path, index",
+    [
+        ("die_drawing.toml", 0),
+        ("die_drawing.toml", 1),
+        ("cup_thermoforming.toml", 0),
+        ("cup_thermoforming.toml", 1),
+        ("parison_bottle.toml", 0),
+        ("stretch_blow_moulding.toml", 1),
+        ("bottle_blow_moulding.toml", 0),
+    ],
+)
 def test_a_mould_walked_the_wrong_way_warns(path, index):
     warnings = preflight(built(EXAMPLES / path, [f"contact[{index}].surface.reverse=true"]))
     assert len(warnings) == 1, warnings
-    assert re.match(rf'contact\[{index}\]( \("\w+"\))?\.surface: faces away from its slaves: .*try reverse = false$',
-                    warnings[0]), warnings[0]
+    assert re.match(
+        rf'contact\[{index}\]( \("\w+"\))?\.surface: faces away from its slaves: .*try reverse = false$', warnings[0]
+    ), warnings[0]
 
 
 def test_a_circle_on_the_wrong_side_warns():
@@ -129,18 +147,22 @@ def test_a_circle_on_the_wrong_side_warns():
 def test_slaves_inside_a_mould_at_the_start_warn():
     torus = EXAMPLES / "toric_plate.toml"
     warnings = mould_checks(built(torus, ["contact[0].surface.circle.center=[4.5, 1.8]"]))
-    assert warnings == ["contact[0].slaves: 7 slave node(s) lie inside the mould at t = 0, up to 0.2 deep "
-                        "(at r, z = 4.5, 0.5)"]
+    assert warnings == [
+        "contact[0].slaves: 7 slave node(s) lie inside the mould at t = 0, up to 0.2 deep (at r, z = 4.5, 0.5)"
+    ]
     # touching (the circle's lowest point on the top face, g = 0): no warning
     assert mould_checks(built(torus, ["contact[0].surface.circle.center=[4.5, 2.0]"])) == []
 
 
-@pytest.mark.parametrize("path, override, message", [
-    ("cup_thermoforming.toml", "pressure[0].value=90000.0", "pressure[0].value: 90000 MPa would invert elements"),
-    ("balloon.toml", "pressure[0].value=1.0e5", "pressure[0].value: 100000 MPa would invert elements"),
-    ("plate_arc_length.toml", "pressure[0].value=6895.0", "pressure[0].value: 6895 psi would invert elements"),
-    ("parison_bottle.toml", "fix[1].value=3000.0", "fix[1].value: 3000 mm would invert elements"),
-])
+@pytest.mark.parametrize(
+    "path, override, message",
+    [
+        ("cup_thermoforming.toml", "pressure[0].value=90000.0", "pressure[0].value: 90000 MPa would invert elements"),
+        ("balloon.toml", "pressure[0].value=1.0e5", "pressure[0].value: 100000 MPa would invert elements"),
+        ("plate_arc_length.toml", "pressure[0].value=6895.0", "pressure[0].value: 6895 psi would invert elements"),
+        ("parison_bottle.toml", "fix[1].value=3000.0", "fix[1].value: 3000 mm would invert elements"),
+    ],
+)
 def test_a_load_in_other_units_warns(path, override, message):
     warnings = inverting_loads(built(EXAMPLES / path, [override]))
     assert len(warnings) == 1 and warnings[0].startswith(message), warnings
@@ -155,12 +177,15 @@ def test_a_driven_displacement_in_other_units_warns():
 
 
 def test_a_point_load_in_newtons_for_meganewtons_warns():
-    text = (EXAMPLES / "balloon.toml").read_text() + """
+    text = (
+        (EXAMPLES / "balloon.toml").read_text()
+        + """
 [[point_load]]
 at = { r = 1.005, z = 0.0 }
 dof = "ur"
 value = {value}
 """
+    )
     for value, warns in (("2.0e-3", False), ("2.0e3", True)):
         path = EXAMPLES / "balloon.toml"
         data = tomllib.loads(text.replace("{value}", value))
@@ -185,8 +210,15 @@ def test_the_check_picture_of_the_die_shows_supports_moulds_and_monitors(tmp_pat
     fig = check_figure(b)
     labels = legend_of(fig)
     assert labels[0] == "mesh: 80 q4 cells, 123 nodes"
-    for label in ("ur held", "uz held", "contact[0] punch, ticks towards its body", "contact[0] punch at t = 1",
-                  "contact[1] die, ticks towards its body", "monitor punch_travel (uz)", "monitor rim_draw_in (ur)"):
+    for label in (
+        "ur held",
+        "uz held",
+        "contact[0] punch, ticks towards its body",
+        "contact[0] punch at t = 1",
+        "contact[1] die, ticks towards its body",
+        "monitor punch_travel (uz)",
+        "monitor rim_draw_in (ur)",
+    ):
         assert label in labels, labels
     ax = fig.axes[0]
     # the moulds' normal ticks point to the body's side: the die's top face (z = 0, r > 4.5) upwards
@@ -198,14 +230,24 @@ def test_the_check_picture_of_the_die_shows_supports_moulds_and_monitors(tmp_pat
     assert held["ur held"] == 3 and held["uz held"] == 9  # the axis; the blank holder's box
 
 
-@pytest.mark.parametrize("name, expected", [
-    ("cup_thermoforming.toml", ["pressure[0] = 0.0900 MPa × f(t)", "ur and uz held", "contact[1] mould, ticks towards "
-                                "its body", "contact[0] plug at t = 1.5"]),
-    ("toric_plate.toml", ["pressure[0] = 1.00 psi × λ", "ur and uz held (and the fibre rotation)"]),
-    ("balloon.toml", ["pressure[0] = 1.00 MPa × λ", "monitor u_equator (ur)"]),
-    ("bottle_blow_moulding.toml", ['cavity "bottle" (gas control)', "contact[0] mould, ticks towards its body"]),
-    ("hughes_carnoy_plate.toml", ["reaction monitor rim_force_z (uz)"]),
-])
+@pytest.mark.parametrize(
+    "name, expected",
+    [
+        (
+            "cup_thermoforming.toml",
+            [
+                "pressure[0] = 0.0900 MPa × f(t)",
+                "ur and uz held",
+                "contact[1] mould, ticks towards its body",
+                "contact[0] plug at t = 1.5",
+            ],
+        ),
+        ("toric_plate.toml", ["pressure[0] = 1.00 psi × λ", "ur and uz held (and the fibre rotation)"]),
+        ("balloon.toml", ["pressure[0] = 1.00 MPa × λ", "monitor u_equator (ur)"]),
+        ("bottle_blow_moulding.toml", ['cavity "bottle" (gas control)', "contact[0] mould, ticks towards its body"]),
+        ("hughes_carnoy_plate.toml", ["reaction monitor rim_force_z (uz)"]),
+    ],
+)
 def test_the_check_picture_names_what_the_case_sets_up(tmp_path, name, expected):
     b = built(EXAMPLES / name)
     labels = legend_of(check_figure(b))

@@ -7,13 +7,13 @@ import json
 
 import numpy as np
 import pytest
+from conftest import difference_tangent, distorted_rectangle
 
 from axiform import LoadControl, Model, MooneyRivlin, rectangle, select_edges, select_nodes, solve
 from axiform.cli import main
 from axiform.fem.curves import Curve
 from axiform.fem.mesh import layered
 from axiform.fem.profile import Arc, Profile
-from conftest import difference_tangent, distorted_rectangle
 
 R0, H0, C1, C2 = 1.0, 0.01, 1.0, 0.1
 A_IN = R0 - H0 / 2  # inner radius of the balloon
@@ -39,7 +39,7 @@ def test_balloon_under_volume_control_through_maximum_and_minimum(element, layer
     its knots.  Measured: pressure within 0.6 % of the membrane formula along the whole path
     (Q8 1x8, Q4 4x16, SFR 2x16), V/V0 = l_inner^3 to 1e-5 (Q8) and 2e-3 (Q4: chords)."""
     l_knots = np.linspace(1.0, 4.0, 25)
-    curve = [[t, (l**3 - 1) / 63] for t, l in zip(np.linspace(0, 1, 25), l_knots)]
+    curve = [[t, (l**3 - 1) / 63] for t, l in zip(np.linspace(0, 1, 25), l_knots, strict=False)]
     V_ring = 2 / 3 * np.pi * A_IN**3
     mesh, model, cav = balloon(element, layers, divisions, value=64 * V_ring, curve=Curve(curve))
     res = solve(model, LoadControl(1.0, 24))
@@ -106,8 +106,9 @@ def test_cavity_volume_of_a_deformed_mesh_against_polygon_sums(element):
     assert abs(V / np.pi - 1) > 1e-3  # the displacement did change it
 
 
-@pytest.mark.parametrize("control, kw", [("volume", {"value": 3.0}), ("gas", {"value": 5.0, "ambient": 1.2}),
-                                         ("pressure", {"value": 0.3})])
+@pytest.mark.parametrize(
+    "control, kw", [("volume", {"value": 3.0}), ("gas", {"value": 5.0, "ambient": 1.2}), ("pressure", {"value": 0.3})]
+)
 def test_cavity_tangent_matches_difference_of_residual(element, control, kw):
     """The bordered tangent (gas stiffness -p d2V/du2, dC/du, dC/dp) and dR/dt."""
     mesh, model = bore(element)
@@ -227,11 +228,14 @@ def test_cavity_case_file_monitors_and_summary(tmp_path):
     assert cav["pressure"] == pytest.approx(hist["p"][-1])
 
 
-@pytest.mark.parametrize("edit, message", [
-    ('control = "volume"\nvolume = 16.5', None),
-    ('control = "gas"\ncontent = 3.0', "cavity[0]: control = \"gas\" needs 'ambient'"),
-    ('control = "volume"\npressure = 1.0', "cavity[0]: control = \"volume\" needs 'volume'"),
-])
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        ('control = "volume"\nvolume = 16.5', None),
+        ('control = "gas"\ncontent = 3.0', "cavity[0]: control = \"gas\" needs 'ambient'"),
+        ('control = "volume"\npressure = 1.0', "cavity[0]: control = \"volume\" needs 'volume'"),
+    ],
+)
 def test_invalid_cavity_tables(tmp_path, capsys, edit, message):
     text = BALLOON_CASE.replace('control = "volume"\nvolume = 16.5', edit)
     if message is None:  # an open end neither on the axis nor held on a plane
@@ -257,8 +261,9 @@ def test_the_bordered_pattern_gives_the_block_matrix(element, zero):
     model.finalize()
     K = model.evaluate(0.03 * np.random.default_rng(2).standard_normal(model.n_free), 0.5).K
     nf = model.dofmap.nf
-    wall = model.dofmap.eq[model.mesh.element.dofs_per_node * select_nodes(mesh, {"r": 1.0})[:, None]
-                           + np.arange(2)].ravel()
+    wall = model.dofmap.eq[
+        model.mesh.element.dofs_per_node * select_nodes(mesh, {"r": 1.0})[:, None] + np.arange(2)
+    ].ravel()
     wall = np.unique(wall[wall < nf])
     border = BorderedPattern(model.pattern, [wall, wall[::2]], [True, False])
     G = np.zeros((nf, 2))
@@ -269,8 +274,9 @@ def test_the_bordered_pattern_gives_the_block_matrix(element, zero):
         G[border.supports[0][0], 0] = 0.0
     c_u, c_p = np.array([6.2, 1.0]), np.array([2.5, 0.0])
     got = border.matrix(K, G, c_u, c_p)
-    want = sp.bmat([[K, sp.csr_matrix(-G)], [sp.csr_matrix(c_u[:, None] * G.T), sp.csr_matrix(np.diag(c_p))]],
-                   format="csr")
+    want = sp.bmat(
+        [[K, sp.csr_matrix(-G)], [sp.csr_matrix(c_u[:, None] * G.T), sp.csr_matrix(np.diag(c_p))]], format="csr"
+    )
     want.sort_indices()
     for name in ("indptr", "indices", "data"):
         assert np.array_equal(getattr(got, name), getattr(want, name)), name

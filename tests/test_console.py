@@ -28,8 +28,9 @@ RESULTS = ("history.csv", "summary.json", "fields.pvd", "thickness.csv", "load_c
 
 def axiform(*args: str, **kw) -> subprocess.Popen:
     env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
-    return subprocess.Popen([sys.executable, "-m", "axiform.cli", *args], env=env, stdout=subprocess.PIPE,
-                            text=True, **kw)
+    return subprocess.Popen(
+        [sys.executable, "-m", "axiform.cli", *args], env=env, stdout=subprocess.PIPE, text=True, **kw
+    )
 
 
 def read_one_line_and_close(proc: subprocess.Popen) -> str:
@@ -88,8 +89,7 @@ def test_the_streams_are_put_back_after_a_command():
 @pytest.mark.parametrize("merged", [False, True])  # `axiform run X | head -1`, `... 2>&1 | head -1`
 def test_a_run_whose_reader_closes_goes_on_and_writes_everything(tmp_path, merged):
     out = tmp_path / "plate"
-    proc = axiform("run", str(PLATE), "--out", str(out),
-                   stderr=subprocess.STDOUT if merged else subprocess.PIPE)
+    proc = axiform("run", str(PLATE), "--out", str(out), stderr=subprocess.STDOUT if merged else subprocess.PIPE)
     assert read_one_line_and_close(proc).startswith("axiform ")  # the header
     err = "" if merged else proc.stderr.read()
     assert proc.wait(timeout=300) == 0, err
@@ -114,8 +114,9 @@ def test_a_stopped_run_whose_reader_closes_keeps_its_own_exit_code(tmp_path):
 
 def test_fit_whose_reader_closes_writes_its_files(tmp_path):
     out = tmp_path / "fit"
-    proc = axiform("fit", str(EXAMPLES / "data" / "treloar.csv"), "--model", "neo-hooke", "--out", str(out),
-                   stderr=subprocess.PIPE)
+    proc = axiform(
+        "fit", str(EXAMPLES / "data" / "treloar.csv"), "--model", "neo-hooke", "--out", str(out), stderr=subprocess.PIPE
+    )
     assert read_one_line_and_close(proc).startswith("neo-hooke fitted to")
     err = proc.stderr.read()
     assert proc.wait(timeout=300) == 0 and "Traceback" not in err, err
@@ -159,7 +160,9 @@ def test_a_stop_names_the_pre_run_warning_first(tmp_path, capsys):
     summary = json.loads((tmp_path / "b" / "summary.json").read_text())
     solver = summary["message"]  # the solver's own: 'step 1: ...', the warnings beside it
     assert solver.startswith("step 1: ")
-    assert status.endswith(f": likely cause: {warning.removeprefix('warning: ')}; then {solver.removeprefix('step 1: ')}")
+    assert status.endswith(
+        f": likely cause: {warning.removeprefix('warning: ')}; then {solver.removeprefix('step 1: ')}"
+    )
 
 
 def test_quiet_keeps_the_status_line_and_the_warnings(tmp_path, capsys):
@@ -171,10 +174,13 @@ def test_quiet_keeps_the_status_line_and_the_warnings(tmp_path, capsys):
 
 def test_status_line_without_warnings_or_step_is_the_solvers_message():
     out = Path("results/x")
-    assert status_line("stopped", "step 3: no convergence", [], 2, 9, 1.0, out) == \
-        "axiform: stopped after 2 steps, 9 Newton iterations, 1.00 s -> results/x: step 3: no convergence"
+    assert (
+        status_line("stopped", "step 3: no convergence", [], 2, 9, 1.0, out)
+        == "axiform: stopped after 2 steps, 9 Newton iterations, 1.00 s -> results/x: step 3: no convergence"
+    )
     assert status_line("stopped", "the end was not reached in 5 steps", ["a", "b"], 5, 9, 1.0, out).endswith(
-        ": likely cause: a; b; then the end was not reached in 5 steps")
+        ": likely cause: a; b; then the end was not reached in 5 steps"
+    )
     assert status_line("finished", "", ["a"], 5, 9, 1.0, out).endswith("-> results/x")
 
 

@@ -3,6 +3,7 @@ consistent tangents, Coulomb friction, sticky contact, Hertz."""
 
 import numpy as np
 import pytest
+from conftest import difference_tangent, distorted_rectangle
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
@@ -11,16 +12,18 @@ from axiform import LoadControl, Model, NeoHooke, rectangle, select_nodes, solve
 from axiform.contact import search
 from axiform.contact.pair import ContactPair, pole_rows
 from axiform.contact.surfaces import Circle, Polyline
-from conftest import difference_tangent, distorted_rectangle
 
 coords = st.floats(-10, 10, allow_nan=False, allow_infinity=False)
 
 
 @settings(max_examples=80, deadline=None)
-@given(arrays(float, st.tuples(st.integers(1, 300), st.just(2)), elements=coords),
-       arrays(float, st.tuples(st.integers(1, 40), st.just(2)), elements=coords),
-       arrays(float, st.tuples(st.integers(1, 40), st.just(2)), elements=st.floats(-3, 3)),
-       st.floats(0, 2), st.floats(0.05, 5))
+@given(
+    arrays(float, st.tuples(st.integers(1, 300), st.just(2)), elements=coords),
+    arrays(float, st.tuples(st.integers(1, 40), st.just(2)), elements=coords),
+    arrays(float, st.tuples(st.integers(1, 40), st.just(2)), elements=st.floats(-3, 3)),
+    st.floats(0, 2),
+    st.floats(0.05, 5),
+)
 def test_buckets_and_binary_sort_find_exactly_what_brute_force_finds(x, a, d, widen, bs):
     b = a[: len(d)] + d[: len(a)]
     a = a[: len(b)]
@@ -99,11 +102,19 @@ SURFACES = {
 }
 
 
-@pytest.mark.parametrize("law", [{}, {"friction": 0.05}, {"friction": 50.0}, {"sticky": True},
-                                 {"penalty": None, "modulus": 4.0, "friction": 0.05},
-                                 {"stabilization": 0.05}, {"stabilization": 0.05, "friction": 0.05}],
-                         ids=["frictionless", "slip", "stick", "sticky", "default penalty", "stabilized",
-                              "stabilized slip"])
+@pytest.mark.parametrize(
+    "law",
+    [
+        {},
+        {"friction": 0.05},
+        {"friction": 50.0},
+        {"sticky": True},
+        {"penalty": None, "modulus": 4.0, "friction": 0.05},
+        {"stabilization": 0.05},
+        {"stabilization": 0.05, "friction": 0.05},
+    ],
+    ids=["frictionless", "slip", "stick", "sticky", "default penalty", "stabilized", "stabilized slip"],
+)
 @pytest.mark.parametrize("surface", list(SURFACES))
 def test_contact_tangent_matches_difference_of_residual(element, surface, law):
     model, pair = _contact_model(element, SURFACES[surface](), **law)
@@ -126,14 +137,19 @@ def test_contact_tangent_matches_difference_of_residual(element, surface, law):
     assert np.allclose(ev.dr_dlam, dl, atol=1e-6 * np.abs(dl).max())
 
 
-@pytest.mark.parametrize("law", [{}, {"friction": 0.05}, {"sticky": True}, {"penalty": None, "modulus": 4.0}],
-                         ids=["frictionless", "slip", "sticky", "default penalty"])
+@pytest.mark.parametrize(
+    "law",
+    [{}, {"friction": 0.05}, {"sticky": True}, {"penalty": None, "modulus": 4.0}],
+    ids=["frictionless", "slip", "sticky", "default penalty"],
+)
 @pytest.mark.parametrize("surface", ["plane", "circle"])
 def test_contact_tangent_with_a_pole_matches_difference_of_residual(surface, law):
     """A Q8 body from the axis: the pole's force is the consistent integral of the
     interpolated traction (ContactPair, pole_rows), coupled to its edge's other nodes."""
-    surfaces = {"plane": Polyline(motion=(0.05, 0.1), points=[[-1.0, 0.0], [2.0, -0.02]]),
-                "circle": Circle(motion=(0.05, 0.1), center=(0.3, -3.0), radius=3.0)}
+    surfaces = {
+        "plane": Polyline(motion=(0.05, 0.1), points=[[-1.0, 0.0], [2.0, -0.02]]),
+        "circle": Circle(motion=(0.05, 0.1), center=(0.3, -3.0), radius=3.0),
+    }
     model, pair = _contact_model("q8", surfaces[surface], inner=0.0, **law)
     assert pair.pole_edge.size == 1
     history = model.evaluate(np.zeros(model.n_free), 0.3).trial
@@ -163,7 +179,9 @@ def test_contact_tangent_with_a_guarded_mid_point_matches_difference_of_residual
     mid = 0.5 * (x[pair.edges[:, 0]] + x[pair.edges[:, 1]])
     if element == "sfr":  # eq. 3 at the edge's mid-point
         dX = pair.X[pair.edges[:, 1]] - pair.X[pair.edges[:, 0]]
-        mid += 0.25 * (u[pair.edges[:, 0], 2] - u[pair.edges[:, 1], 2])[:, None] * np.column_stack([-dX[:, 1], dX[:, 0]])
+        mid += (
+            0.25 * (u[pair.edges[:, 0], 2] - u[pair.edges[:, 1], 2])[:, None] * np.column_stack([-dX[:, 1], dX[:, 0]])
+        )
     gap = np.linalg.norm(mid - punch.center, axis=1) - punch.radius
     assert (gap < -pair.guard_allowance).sum() == 1  # the guard of one edge acts
     K = ev.K.toarray()
@@ -185,7 +203,10 @@ def test_pole_force_is_the_consistent_integral_of_the_traction():
             xp, xm = x.copy(), x.copy()
             xp[l, d] += h
             xm[l, d] -= h
-            num = (pole_rows(xp, np.array([[0, 1, 2]]), np.array([0])) - pole_rows(xm, np.array([[0, 1, 2]]), np.array([0]))) / (2 * h)
+            num = (
+                pole_rows(xp, np.array([[0, 1, 2]]), np.array([0]))
+                - pole_rows(xm, np.array([[0, 1, 2]]), np.array([0]))
+            ) / (2 * h)
             assert np.allclose(dM[0, :, l, d], num[0], atol=1e-8)
 
 
@@ -238,6 +259,7 @@ def test_sticky_nodes_stay_where_they_touched():
     model.fix(select_nodes(mesh, {"r": 2.0}), ["ur", "uz"])
     model.fix(select_nodes(mesh, {"r": 0.0}), ["ur"])
     from axiform import select_edges
+
     model.pressure(select_edges(mesh, {"z": 0.0}), 0.05)
     mould = Polyline(points=[[2.5, 0.6], [-0.5, 0.6]])  # a flat lid above the sheet, facing down
     pair = ContactPair(mesh, mould, select_nodes(mesh, {"z": 0.2}), penalty=1e4, sticky=True)
@@ -254,7 +276,7 @@ def test_sticky_nodes_stay_where_they_touched():
     res = solve(model, LoadControl(1.0, 10), on_step=record)
     assert res.status == "finished"
     assert len(seen) >= 3
-    for k, xs in seen.items():
+    for _k, xs in seen.items():
         xs = np.array(xs)
         assert np.abs(xs - xs[0]).max() < 1e-3 * 0.4  # stays put (penalty give only)
         assert abs(xs[0, 1] - 0.6) < 1e-3
@@ -291,10 +313,14 @@ def test_no_node_ends_a_step_deeper_than_the_reported_penetration(element, tmp_p
     """The toric plate (paper 4.2): at every converged step, every slave node's exact signed
     distance to the torus (Q8: mid-side nodes too) is above minus the penetration reported
     for that step."""
-    from axiform.case.schema import build, load
     from pathlib import Path
-    case = load(Path(__file__).resolve().parents[1] / "examples" / "toric_plate.toml",
-                [f"mesh.element={element}", "mesh.divisions=[20,2]", "solver.target=4.0", "solver.steps=16"])
+
+    from axiform.case.schema import build, load
+
+    case = load(
+        Path(__file__).resolve().parents[1] / "examples" / "toric_plate.toml",
+        [f"mesh.element={element}", "mesh.divisions=[20,2]", "solver.target=4.0", "solver.steps=16"],
+    )
     built = build(case)
     pair = built.model.contacts[0]
     worst = []

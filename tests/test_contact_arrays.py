@@ -3,10 +3,10 @@ tested against every widened box without the bucket search) against the previous
 one (tests/contact_reference.py) on random points: lines and arcs both ways, points on the
 pieces' ends, crossings, cavity corners, depth; and the cached Gauss rules."""
 
+import contact_reference as ref
 import numpy as np
 import pytest
 
-import contact_reference as ref
 from axiform.contact import surfaces
 from axiform.contact.surfaces import Polyline
 from axiform.fem.elements import edge_rule, edge_shape, gauss_1d, gauss_quad
@@ -55,7 +55,7 @@ def near_points(rng, surf, n, spread):
     x = base + rng.normal(0, spread, (n, 2))
     x[: n // 10] = base[: n // 10]  # on the surface, piece ends included
     ends = np.vstack([surf.a, surf.b[-1:]])
-    x[n // 10: n // 5] = ends[rng.integers(0, len(ends), n // 5 - n // 10)]
+    x[n // 10 : n // 5] = ends[rng.integers(0, len(ends), n // 5 - n // 10)]
     return x
 
 
@@ -98,11 +98,15 @@ def test_one_pass_over_several_sets_is_one_call_per_set(seed, dense, monkeypatch
     rng = np.random.default_rng(200 + seed)
     surf = random_polyline(rng, int(rng.integers(2, 9)))
     sets = []
-    for n, spread, depth in ((int(rng.integers(1, 300)), 0.3, 0.05), (int(rng.integers(1, 300)), 0.1, 0.4), (0, 0.1, 0.1)):
+    for n, spread, depth in (
+        (int(rng.integers(1, 300)), 0.3, 0.05),
+        (int(rng.integers(1, 300)), 0.1, 0.4),
+        (0, 0.1, 0.1),
+    ):
         x_prev = near_points(rng, surf, n, spread) if n else np.zeros((0, 2))
         sets.append((x_prev + rng.normal(0, rng.choice([0.01, 0.2]), (n, 2)), x_prev, depth))
     for method in ("buckets", "binary"):
-        for p, (x, x_prev, depth) in zip(surf.local_sets(sets, method), sets):
+        for p, (x, x_prev, depth) in zip(surf.local_sets(sets, method), sets, strict=False):
             same(p, surf.local(x, x_prev, depth, method))
 
 
@@ -111,15 +115,18 @@ def test_the_projection_is_the_reference_on_every_pair():
     surf = random_polyline(rng, 8)
     x = near_points(rng, surf, 500, 1.0)
     k = rng.integers(0, len(surf.a), len(x))
-    for a, b in zip(surf._project(k, x), ref.piece_local(surf, k, x)):
+    for a, b in zip(surf._project(k, x), ref.piece_local(surf, k, x), strict=False):
         assert np.array_equal(a, b)
 
 
 def test_points_on_piece_ends_and_cavity_corners():
     """A cup-like cavity (line, cw arc, line, a sharp cavity corner, line): nodes on every
     vertex, nodes behind the sharp corner (vertex contact, kind 2), nodes crossing a face."""
-    cav = Polyline(points=[[0.0, 0.0], [2.0, 0.0], [3.0, 1.0], [3.0, 3.0], [1.0, 3.0]],
-                   centers=[None, (2.0, 1.0), None, None], ccw=[True, True, True, True])
+    cav = Polyline(
+        points=[[0.0, 0.0], [2.0, 0.0], [3.0, 1.0], [3.0, 3.0], [1.0, 3.0]],
+        centers=[None, (2.0, 1.0), None, None],
+        ccw=[True, True, True, True],
+    )
     x_prev = np.vstack([cav.points, [[3.05, 3.04], [0.5, 0.1], [2.5, 1.5]]])
     x = np.vstack([cav.points, [[3.05, 3.04], [0.5, -0.3], [3.2, 1.5]]])
     p = cav.local(x, x_prev, 0.1)
@@ -162,7 +169,7 @@ def test_many_pairs_path_is_the_reference(seed, monkeypatch):
     for depth in (0.05, 0.5):
         same(surf.local(x, x_prev, depth), ref.local(surf, x, x_prev, depth))
     k = rng.integers(0, len(surf.a), len(x))
-    for a, b in zip(surf._project(k, x), ref.piece_local(surf, k, x)):
+    for a, b in zip(surf._project(k, x), ref.piece_local(surf, k, x), strict=False):
         assert np.array_equal(a, b)
 
 
@@ -192,10 +199,10 @@ def test_pair_cache_returns_what_a_new_search_returns(method):
     rng = np.random.default_rng(11)
     surf = random_polyline(rng, 7)
     cache = search.PairCache()
-    for step in range(4):
+    for _step in range(4):
         x_prev = near_points(rng, surf, 400, 0.3)
         mids = near_points(rng, surf, 399, 0.3)
-        for it, size in enumerate([0.0, 0.02, 0.01, 0.3, 0.05, 0.001]):
+        for _it, size in enumerate([0.0, 0.02, 0.01, 0.3, 0.05, 0.001]):
             for xp in (x_prev, mids):
                 x = xp + rng.normal(0, size, xp.shape)
                 x[::5] = xp[::5] + size  # some exactly the largest move

@@ -8,13 +8,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_run_report import ring_case
 
 from axiform.case.schema import build, parse
 from axiform.contact.pair import STATUS
 from axiform.io.files import contact_table
 from axiform.io.results import NonFiniteResult, ResultsWriter
 from axiform.solve.solver import solve
-from test_run_report import ring_case
 
 FILES = ("contact.csv", "surfaces.csv")
 
@@ -71,10 +71,22 @@ def _rows_by_csv_writer(reports: list[dict], x: np.ndarray) -> str:
     table = csv.writer(text, lineterminator="\n")
     table.writerow(["pair", "node", "r", "z", "gap", "pressure", "status", "first_contact"])
     for k, rep in enumerate(reports):
-        for node, g, p, st, t in zip(rep["node"], rep["gap"], rep["pressure"], rep["status"], rep["first_contact"]):
+        for node, g, p, st, t in zip(
+            rep["node"], rep["gap"], rep["pressure"], rep["status"], rep["first_contact"], strict=False
+        ):
             r, z = x[node]
-            table.writerow([k, node, f"{r:.10g}", f"{z:.10g}", "" if np.isnan(g) else f"{g:.6g}", f"{p:.6g}",
-                            STATUS[int(st)], "" if np.isnan(t) else repr(float(t))])
+            table.writerow(
+                [
+                    k,
+                    node,
+                    f"{r:.10g}",
+                    f"{z:.10g}",
+                    "" if np.isnan(g) else f"{g:.6g}",
+                    f"{p:.6g}",
+                    STATUS[int(st)],
+                    "" if np.isnan(t) else repr(float(t)),
+                ]
+            )
     return text.getvalue()
 
 
@@ -82,13 +94,27 @@ def test_the_table_is_the_rows_of_csv_writer():
     """Gaps and first contacts NaN or not, every status, negative zero, large and tiny numbers."""
     x = np.array([[0.0, 1.0], [-0.0, 1e-300], [123456789.123, -2.5e-7], [1.0 / 3.0, 1e20]])
     reports = [
-        {"node": np.array([0, 1, 2]), "gap": np.array([np.nan, -0.0, 1.23456789e-5]),
-         "pressure": np.array([0.0, 7.5e12, -1e-9]), "status": np.array([0, 1, 2]),
-         "first_contact": np.array([np.nan, 0.1 + 0.2, 1.5])},
-        {"node": np.array([3, 0], dtype=np.int32), "gap": np.array([2.0, np.nan]),
-         "pressure": np.array([np.pi, 0.0]), "status": np.array([3, 0]), "first_contact": np.array([1e-17, np.nan])},
-        {"node": np.array([], dtype=int), "gap": np.array([]), "pressure": np.array([]), "status": np.array([], int),
-         "first_contact": np.array([])},
+        {
+            "node": np.array([0, 1, 2]),
+            "gap": np.array([np.nan, -0.0, 1.23456789e-5]),
+            "pressure": np.array([0.0, 7.5e12, -1e-9]),
+            "status": np.array([0, 1, 2]),
+            "first_contact": np.array([np.nan, 0.1 + 0.2, 1.5]),
+        },
+        {
+            "node": np.array([3, 0], dtype=np.int32),
+            "gap": np.array([2.0, np.nan]),
+            "pressure": np.array([np.pi, 0.0]),
+            "status": np.array([3, 0]),
+            "first_contact": np.array([1e-17, np.nan]),
+        },
+        {
+            "node": np.array([], dtype=int),
+            "gap": np.array([]),
+            "pressure": np.array([]),
+            "status": np.array([], int),
+            "first_contact": np.array([]),
+        },
     ]
     assert contact_table(reports, x, STATUS) == _rows_by_csv_writer(reports, x)
 
@@ -115,8 +141,10 @@ def test_a_failed_run_keeps_the_contact_table_of_its_last_step(tmp_path, monkeyp
     monkeypatch.setattr(model_module.Model, "evaluate", crash_later)
     out = tmp_path / "out"
     toric = Path(__file__).resolve().parents[1] / "examples" / "toric_plate.toml"
-    assert main(["run", str(toric), "--out", str(out), "-q", "--set", "output.plots=false",
-                 "--set", "output.every=1"]) == 3
+    assert (
+        main(["run", str(toric), "--out", str(out), "-q", "--set", "output.plots=false", "--set", "output.every=1"])
+        == 3
+    )
     steps = json.loads((out / "summary.json").read_text())["steps"]
     assert steps >= 2
     vtu = meshio.read(out / "fields" / f"step_{steps:04d}.vtu")

@@ -4,11 +4,11 @@ quadratic convergence of Newton."""
 
 import numpy as np
 import pytest
+from conftest import clamped_plate, difference_tangent, distorted_rectangle
 
 from axiform import DisplacementControl, Model, MooneyRivlin, rectangle, select_edges, select_nodes, solve
 from axiform.materials import InvertedElementError
 from axiform.solve.solver import LoadControl, NewtonOptions
-from conftest import clamped_plate, difference_tangent, distorted_rectangle
 
 LAW = MooneyRivlin(0.4, 0.1, 5.0)
 
@@ -134,6 +134,7 @@ def test_sfr_zero_mode_removed_on_every_body():
     """Two separate SFR bodies: each has its own uniform-theta mode; the model fixes one theta
     on each, and the supported tangent is regular."""
     from axiform.fem.mesh import Mesh
+
     a = rectangle((0.0, 1.0), (0.0, 1.0), (2, 2), "sfr")
     b = rectangle((2.0, 3.0), (0.0, 1.0), (2, 2), "sfr")
     mesh = Mesh(np.vstack([a.points, b.points]), np.vstack([a.cells, b.cells + a.n_nodes]), a.element)

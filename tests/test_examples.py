@@ -15,8 +15,19 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 def run(name, tmp_path):
     out = tmp_path / name
-    code = main(["run", str(EXAMPLES / f"{name}.toml"), "--out", str(out), "-q",
-                 "--set", "output.plots=false", "--set", "output.vtu=false"])
+    code = main(
+        [
+            "run",
+            str(EXAMPLES / f"{name}.toml"),
+            "--out",
+            str(out),
+            "-q",
+            "--set",
+            "output.plots=false",
+            "--set",
+            "output.vtu=false",
+        ]
+    )
     summary = json.loads((out / "summary.json").read_text())
     assert code == 0 and summary["status"] == "finished", summary.get("message")
     return summary
@@ -71,12 +82,15 @@ def test_parison_bottle_reaches_its_volume(tmp_path):
     assert cav["volume"] == pytest.approx(86000.0, rel=1e-8) and cav["pressure"] > 0
 
 
-@pytest.mark.parametrize("name, key, value", [
-    ("toric_plate", "w_center", 6.0),        # driven to 6 in around the torus
-    ("die_drawing", "punch_travel", -3.0),   # the punch's 3, plus the sheet's own sag (0.012)
-    ("dxf_cup_mould", "plug_force", None),
-    ("balloon_rubber", "u_equator", 200.0),
-])
+@pytest.mark.parametrize(
+    "name, key, value",
+    [
+        ("toric_plate", "w_center", 6.0),  # driven to 6 in around the torus
+        ("die_drawing", "punch_travel", -3.0),  # the punch's 3, plus the sheet's own sag (0.012)
+        ("dxf_cup_mould", "plug_force", None),
+        ("balloon_rubber", "u_equator", 200.0),
+    ],
+)
 def test_contact_and_law_examples_finish(tmp_path, name, key, value):
     s = run(name, tmp_path)
     if value is not None:

@@ -11,9 +11,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from axiform.app.fit import (
+    MODES,
+    STABILITY_STRETCHES,
+    Data,
+    drucker_stable,
+    fit,
+    kinematics,
+    nominal_stress,
+    stable_range,
+)
 from axiform.case.material import MaterialSpec
 from axiform.cli import main
-from axiform.app.fit import MODES, STABILITY_STRETCHES, Data, drucker_stable, fit, kinematics, nominal_stress, stable_range
 from axiform.materials import ArrudaBoyce, Gent, MooneyRivlin, Ogden, Yeoh
 from axiform.materials.arruda_boyce import SERIES
 
@@ -36,7 +45,7 @@ def closed_form(law, mode, lam):
     Ogden P = sum 2 mu/alpha (lam^(alpha-1) - lt^alpha / lam)."""
     l2, lt = {"uniaxial": (lam**-0.5, lam**-0.5), "equibiaxial": (lam, lam**-2), "planar": (1.0, 1 / lam)}[mode]
     if isinstance(law, Ogden):
-        return sum(2 * m / a * (lam ** (a - 1) - lt**a / lam) for m, a in zip(law.mu, law.alpha))
+        return sum(2 * m / a * (lam ** (a - 1) - lt**a / lam) for m, a in zip(law.mu, law.alpha, strict=False))
     I1 = lam**2 + l2**2 + lt**2
     W2 = 0.0
     if isinstance(law, MooneyRivlin):
@@ -78,8 +87,16 @@ def hessian_by_differences(law, mode, lam, h=1e-4):
     return D
 
 
-@pytest.mark.parametrize("law", [Yeoh(0.5, -0.05, 0.0, 1.0), Ogden((0.5, -0.3), (2.0, 6.0), 1.0),
-                                 MooneyRivlin(0.4, -0.15, 1.0), Gent(1.0, 30.0, 1.0), ArrudaBoyce(1.0, 3.0, 1.0)])
+@pytest.mark.parametrize(
+    "law",
+    [
+        Yeoh(0.5, -0.05, 0.0, 1.0),
+        Ogden((0.5, -0.3), (2.0, 6.0), 1.0),
+        MooneyRivlin(0.4, -0.15, 1.0),
+        Gent(1.0, 30.0, 1.0),
+        ArrudaBoyce(1.0, 3.0, 1.0),
+    ],
+)
 @pytest.mark.parametrize("mode", MODES)
 def test_drucker_check_against_differences_of_the_energy(law, mode):
     """Stability where the 2x2 Hessian of W_iso in the log strains is positive definite; the
@@ -106,8 +123,11 @@ def test_stable_range_is_the_interval_around_one():
 
 def synthetic(law):
     """Exact test data of a law on the three modes, tension and some compression."""
-    stretches = {"uniaxial": np.r_[0.7, np.linspace(1.1, 6.0, 12)], "equibiaxial": np.linspace(1.1, 4.0, 8),
-                 "planar": np.linspace(1.1, 4.5, 8)}
+    stretches = {
+        "uniaxial": np.r_[0.7, np.linspace(1.1, 6.0, 12)],
+        "equibiaxial": np.linspace(1.1, 4.0, 8),
+        "planar": np.linspace(1.1, 4.5, 8),
+    }
     modes = np.concatenate([np.full(len(v), MODES.index(m)) for m, v in stretches.items()])
     lam = np.concatenate(list(stretches.values()))
     stress = np.concatenate([nominal_stress(law, m, v) for m, v in stretches.items()])
@@ -161,7 +181,11 @@ def test_fit_ogden_with_kappa(tmp_path):
 
 
 BAD_CSV = [
-    ("text in a number", "mode,stretch,stress\nuniaxial,1.5,0.3\nuniaxial,2.0,abc\n", r"line 3: stress 'abc' is not a number"),
+    (
+        "text in a number",
+        "mode,stretch,stress\nuniaxial,1.5,0.3\nuniaxial,2.0,abc\n",
+        r"line 3: stress 'abc' is not a number",
+    ),
     ("unknown mode", "mode,stretch,stress\nuniaxial,1.5,0.3\nshear,2.0,0.5\n", r"line 3: unknown mode 'shear'"),
     ("header", "lambda,stress\n1.5,0.3\n", r"line 1: the header must be mode,stretch,stress"),
     ("columns", "mode,stretch,stress\nuniaxial,1.5\n", r"line 2: expected 3 values"),

@@ -13,14 +13,23 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+from test_fuzz_files import _settings, call, csv_texts, judge, seeded, spoil_text
 
 from axiform.case.material import MaterialSpec
 from axiform.case.temperature import TemperatureSpec
 from axiform.cli import main
 from axiform.materials.viscoelastic import Prony, Viscoelastic
-from test_fuzz_files import _settings, call, csv_texts, judge, seeded, spoil_text
-from axiform.materials.viscoelastic_fit import (decades, dynamic_moduli, fit_dynamic, fit_relaxation, fit_wlf,
-                                                relaxation_modulus, time_grid, wlf_shift, zero_crossing)
+from axiform.materials.viscoelastic_fit import (
+    decades,
+    dynamic_moduli,
+    fit_dynamic,
+    fit_relaxation,
+    fit_wlf,
+    relaxation_modulus,
+    time_grid,
+    wlf_shift,
+    zero_crossing,
+)
 
 E0, G, TAU = 12.0, np.array([0.3, 0.25, 0.2]), np.array([0.02, 0.7, 40.0])
 TIMES = np.geomspace(1e-3, 1e3, 25)
@@ -32,7 +41,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "data"
 
 
 def write_csv(path: Path, header: str, *columns) -> Path:
-    rows = "\n".join(",".join(repr(float(v)) for v in row) for row in zip(*columns))
+    rows = "\n".join(",".join(repr(float(v)) for v in row) for row in zip(*columns, strict=False))
     path.write_text(f"# test data\n{header}\n{rows}\n")
     return path
 
@@ -40,8 +49,9 @@ def write_csv(path: Path, header: str, *columns) -> Path:
 def test_series_moduli_against_the_convention_and_the_complex_modulus():
     """E(t) = E0 g(t) of materials.viscoelastic.Prony; E' + i E'' = E_inf + sum E_i i w tau /
     (1 + i w tau), the Fourier transform of the relaxation modulus."""
-    assert np.allclose(relaxation_modulus(E0, G, TAU, TIMES), E0 * Prony(tuple(G), tuple(TAU)).relaxation(TIMES),
-                       rtol=1e-14)
+    assert np.allclose(
+        relaxation_modulus(E0, G, TAU, TIMES), E0 * Prony(tuple(G), tuple(TAU)).relaxation(TIMES), rtol=1e-14
+    )
     iwt = 2j * np.pi * FREQUENCIES[:, None] * DMA_TAU
     complex_modulus = E0 * (1 - G.sum()) + (E0 * G * iwt / (1 + iwt)).sum(-1)
     storage, loss = dynamic_moduli(E0, G, DMA_TAU, FREQUENCIES)
@@ -108,8 +118,9 @@ def test_prony_command_writes_a_valid_material(tmp_path, capsys, kind):
         data = write_csv(tmp_path / "d.csv", "time,modulus", TIMES, relaxation_modulus(E0, G, TAU, TIMES))
         tau = TAU
     else:
-        data = write_csv(tmp_path / "d.csv", "frequency,storage,loss", FREQUENCIES,
-                         *dynamic_moduli(E0, G, DMA_TAU, FREQUENCIES))
+        data = write_csv(
+            tmp_path / "d.csv", "frequency,storage,loss", FREQUENCIES, *dynamic_moduli(E0, G, DMA_TAU, FREQUENCIES)
+        )
         tau = DMA_TAU
     out = tmp_path / "fit"
     assert main(["fit", str(data), "--model", "prony", "--terms", "3", "--out", str(out)]) == 0
@@ -127,8 +138,9 @@ def test_prony_command_writes_a_valid_material(tmp_path, capsys, kind):
 
 
 def test_wlf_command_writes_the_temperature_table(tmp_path):
-    data = write_csv(tmp_path / "shift.csv", "temperature,log10_shift", TEMPERATURES,
-                     wlf_shift(TEMPERATURES, C1, C2, T_REF))
+    data = write_csv(
+        tmp_path / "shift.csv", "temperature,log10_shift", TEMPERATURES, wlf_shift(TEMPERATURES, C1, C2, T_REF)
+    )
     out = tmp_path / "fit"
     assert main(["fit", str(data), "--model", "wlf", "--out", str(out)]) == 0
     table = tomllib.loads((out / "material.toml").read_text())["temperature"]
@@ -155,37 +167,78 @@ def test_example_data_fit(tmp_path):
 
 RELAX = "time,modulus\n0.1,10\n1,8\n10,6\n100,5\n"
 BAD = [
-    ("header", "time,stress\n0.1,10\n", ["--model", "prony"], r"line 1: the header must be time,modulus or "
-                                                              r"frequency,storage,loss"),
+    (
+        "header",
+        "time,stress\n0.1,10\n",
+        ["--model", "prony"],
+        r"line 1: the header must be time,modulus or "
+        r"frequency,storage,loss",
+    ),
     ("text", "time,modulus\n0.1,10\n1,x\n", ["--model", "prony"], r"line 3: modulus 'x' is not a number"),
-    ("magnitude", "time,modulus\n1e-300,10\n1,8\n10,6\n", ["--model", "prony"],
-     r"line 2: time 1e-300 is beyond the magnitude"),
+    (
+        "magnitude",
+        "time,modulus\n1e-300,10\n1,8\n10,6\n",
+        ["--model", "prony"],
+        r"line 2: time 1e-300 is beyond the magnitude",
+    ),
     ("zero time", "time,modulus\n0,10\n1,8\n10,6\n", ["--model", "prony"], r"line 2: time must be > 0"),
     ("negative modulus", "time,modulus\n0.1,10\n1,-8\n10,6\n", ["--model", "prony"], r"line 3: modulus must be > 0"),
     ("zero loss", "frequency,storage,loss\n1,5,0.1\n2,6,0\n", ["--model", "prony"], r"line 3: loss must be > 0"),
     ("time order", "time,modulus\n0.1,10\n10,8\n1,6\n", ["--model", "prony"], r"line 4: time must increase"),
-    ("frequency order", "frequency,storage,loss\n1,5,1\n1,6,1\n", ["--model", "prony"],
-     r"line 3: frequency must increase"),
-    ("creep compliance", "time,modulus\n0.1,1\n1,2\n10,3\n", ["--model", "prony"],
-     r"line 4: modulus rises from 1 at the first time to 3 at the last"),
-    ("storage falls", "frequency,storage,loss\n1,5,1\n2,4,1\n", ["--model", "prony"],
-     r"line 3: storage falls from 5 at the first frequency to 4 at the last"),
+    (
+        "frequency order",
+        "frequency,storage,loss\n1,5,1\n1,6,1\n",
+        ["--model", "prony"],
+        r"line 3: frequency must increase",
+    ),
+    (
+        "creep compliance",
+        "time,modulus\n0.1,1\n1,2\n10,3\n",
+        ["--model", "prony"],
+        r"line 4: modulus rises from 1 at the first time to 3 at the last",
+    ),
+    (
+        "storage falls",
+        "frequency,storage,loss\n1,5,1\n2,4,1\n",
+        ["--model", "prony"],
+        r"line 3: storage falls from 5 at the first frequency to 4 at the last",
+    ),
     ("too few points", RELAX, ["--model", "prony", "--terms", "2"], r"--terms 2: 5 parameters .* holds 4 values"),
     ("one point", "time,modulus\n0.1,10\n", ["--model", "prony"], r"1 values, fewer than the 3 parameters"),
     ("terms", RELAX, ["--model", "prony", "--terms", "9"], r"--terms must be 1 to 8"),
     ("reference for prony", RELAX, ["--model", "prony", "--reference", "100"], r"--reference is for --model wlf"),
     ("kappa for prony", RELAX, ["--model", "prony", "--kappa", "100"], r"--kappa is for the hyperelastic laws"),
-    ("terms for wlf", "temperature,log10_shift\n100,1\n110,0\n", ["--model", "wlf", "--terms", "2"],
-     r"--terms is for --model prony"),
+    (
+        "terms for wlf",
+        "temperature,log10_shift\n100,1\n110,0\n",
+        ["--model", "wlf", "--terms", "2"],
+        r"--terms is for --model prony",
+    ),
     ("wlf header", "T,log10_shift\n100,1\n", ["--model", "wlf"], r"the header must be temperature,log10_shift"),
-    ("shift order", "temperature,log10_shift\n100,1\n110,0\n120,0.5\n", ["--model", "wlf"],
-     r"line 4: log10_shift must decrease as the temperature rises"),
-    ("temperature order", "temperature,log10_shift\n110,1\n100,0\n", ["--model", "wlf"],
-     r"line 3: temperature must increase"),
-    ("no zero", "temperature,log10_shift\n100,-1\n110,-2\n120,-3\n", ["--model", "wlf"],
-     r"log10_shift does not reach 0 .* --reference"),
-    ("wlf points", "temperature,log10_shift\n100,1\n110,0\n", ["--model", "wlf", "--reference", "105"],
-     r"2 rows, fewer than the 3 parameters"),
+    (
+        "shift order",
+        "temperature,log10_shift\n100,1\n110,0\n120,0.5\n",
+        ["--model", "wlf"],
+        r"line 4: log10_shift must decrease as the temperature rises",
+    ),
+    (
+        "temperature order",
+        "temperature,log10_shift\n110,1\n100,0\n",
+        ["--model", "wlf"],
+        r"line 3: temperature must increase",
+    ),
+    (
+        "no zero",
+        "temperature,log10_shift\n100,-1\n110,-2\n120,-3\n",
+        ["--model", "wlf"],
+        r"log10_shift does not reach 0 .* --reference",
+    ),
+    (
+        "wlf points",
+        "temperature,log10_shift\n100,1\n110,0\n",
+        ["--model", "wlf", "--reference", "105"],
+        r"2 rows, fewer than the 3 parameters",
+    ),
 ]
 
 
@@ -223,11 +276,12 @@ def test_no_admissible_series_or_shift_exits_1(tmp_path, capsys):
     assert "must stay > 0 over the data and at T_ref" in capsys.readouterr().err
 
 
-FUZZ_FILES = [("relaxation", ["time", "modulus"], [["0.1", "10"], ["1", "8"], ["10", "6"], ["100", "5"]], []),
-              ("dma", ["frequency", "storage", "loss"], [["0.1", "5", "1"], ["1", "7", "2"], ["10", "9", "1"]], []),
-              ("wlf", ["temperature", "log10_shift"], [["100", "2"], ["110", "0"], ["120", "-1.5"]], []),
-              ("wlf", ["temperature", "log10_shift"], [["100", "2"], ["110", "0"], ["120", "-1.5"]],
-               ["--reference", "115"])]
+FUZZ_FILES = [
+    ("relaxation", ["time", "modulus"], [["0.1", "10"], ["1", "8"], ["10", "6"], ["100", "5"]], []),
+    ("dma", ["frequency", "storage", "loss"], [["0.1", "5", "1"], ["1", "7", "2"], ["10", "9", "1"]], []),
+    ("wlf", ["temperature", "log10_shift"], [["100", "2"], ["110", "0"], ["120", "-1.5"]], []),
+    ("wlf", ["temperature", "log10_shift"], [["100", "2"], ["110", "0"], ["120", "-1.5"]], ["--reference", "115"]),
+]
 
 
 @_settings

@@ -17,8 +17,9 @@ PLATE = Path(__file__).resolve().parents[1] / "examples" / "hughes_carnoy_plate.
 def _run(out: Path, flush_every_s: float, seen: list) -> None:
     case = load(PLATE, ["solver.steps=6", "solver.target=1.5"])
     built = build(case, PLATE.parent)
-    writer = ResultsWriter(out, built.model, built.monitors, case.title, plots=False, restart_every=4,
-                           flush_every_s=flush_every_s)
+    writer = ResultsWriter(
+        out, built.model, built.monitors, case.title, plots=False, restart_every=4, flush_every_s=flush_every_s
+    )
 
     def on_step(step):
         writer.step(step)
@@ -59,8 +60,11 @@ def test_fields_pvd_lists_only_vtu_files_written(tmp_path):
 
     def on_step(step):
         writer.step(step)
-        names = [line.split('file="')[1].split('"')[0] for line in
-                 (out / "fields.pvd").read_text().replace(">", ">\n").splitlines() if 'file="' in line]
+        names = [
+            line.split('file="')[1].split('"')[0]
+            for line in (out / "fields.pvd").read_text().replace(">", ">\n").splitlines()
+            if 'file="' in line
+        ]
         for name in names:
             assert meshio.read(out / name).points.shape[0] == built.model.mesh.n_nodes
         listed.append(len(names))
@@ -75,8 +79,8 @@ def test_fields_pvd_lists_only_vtu_files_written(tmp_path):
 def test_a_vtu_file_that_cannot_be_written_fails_the_run_keeping_the_steps_before(tmp_path, monkeypatch, capsys, bad):
     """Found at a later step or by `finish` (the thread writes it while the run goes on):
     status "failed", exit 3, the message says why, fields.pvd lists the files written."""
-    from axiform.io import results
     from axiform.cli import main
+    from axiform.io import results
 
     write_vtu = results.write_vtu
 
@@ -87,8 +91,24 @@ def test_a_vtu_file_that_cannot_be_written_fails_the_run_keeping_the_steps_befor
 
     monkeypatch.setattr(results, "write_vtu", full_disk)
     out = tmp_path / "out"
-    assert main(["run", str(PLATE), "--out", str(out), "-q", "--set", "output.plots=false",
-                 "--set", "solver.steps=6", "--set", "solver.target=1.5"]) == 3
+    assert (
+        main(
+            [
+                "run",
+                str(PLATE),
+                "--out",
+                str(out),
+                "-q",
+                "--set",
+                "output.plots=false",
+                "--set",
+                "solver.steps=6",
+                "--set",
+                "solver.target=1.5",
+            ]
+        )
+        == 3
+    )
     err = capsys.readouterr().out  # the status line (stdout) says why
     assert "No space left on device" in err
     summary = json.loads((out / "summary.json").read_text())

@@ -18,7 +18,7 @@ def test_a_corner_pushed_past_the_diagonal_folds_the_element_there(element):
     u = np.zeros(mesh.n_nodes * mesh.element.dofs_per_node)
     corner = int(np.flatnonzero(np.all(mesh.points == [2.0, 2.0], axis=1))[0])
     dpn = mesh.element.dofs_per_node
-    u[corner * dpn: corner * dpn + 2] = [-0.75, -0.75]
+    u[corner * dpn : corner * dpn + 2] = [-0.75, -0.75]
     folds = folded_nodes(mesh, u)
     assert [(e, n) for e, n, _ in folds] == [(0, corner)]
     assert folds[0][2] == pytest.approx(-0.5, rel=1e-12)
@@ -31,9 +31,10 @@ def test_the_q8_plate_stop_names_the_element_folded_at_the_clamp_corner():
     eigenvalue falls from 7.3 to 1.0 over 0.003 in of deflection while the pressure falls
     smoothly); the element at the clamp's upper corner has been folded at that corner node
     since w = 8.5, and the message says so."""
+    from conftest import clamped_plate
+
     from axiform import select_nodes
     from axiform.solve.solver import ArcLengthControl, solve
-    from conftest import clamped_plate
 
     model = clamped_plate("q8", divisions=(40, 4))
     w = int(model.dof(select_nodes(model.mesh, {"r": 0.0, "z": 0.25})[0], "uz"))

@@ -5,12 +5,11 @@ readable deformed plots and the forming animation."""
 import csv
 import json
 import tomllib
+from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
 
 import meshio
-from dataclasses import replace
-
 import numpy as np
 import pytest
 from PIL import Image
@@ -20,8 +19,15 @@ from axiform.case.schema import CaseError, build, load, parse
 from axiform.cli import main
 from axiform.post.fields import point_fields
 from axiform.post.labels import case_labels, short
-from axiform.post.plots import (FolderInfo, deformed_figure, field_values, load_curve_figure, read_history,
-                           thickness_figure, written_steps)
+from axiform.post.plots import (
+    FolderInfo,
+    deformed_figure,
+    field_values,
+    load_curve_figure,
+    read_history,
+    thickness_figure,
+    written_steps,
+)
 from axiform.post.thickness import COLUMNS, thickness_table, write_thickness_csv
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -35,28 +41,41 @@ def test_thick_cylinder_thickness_is_b_minus_a_at_every_written_step(tmp_path):
     """The wall of the thick cylinder is measured through r: b - a = 1 + u_outer - u_inner in
     thickness/step_NNNN.csv and in the VTU field at every node, at every written step."""
     out = tmp_path / "cyl"
-    assert main(["run", str(EXAMPLES / "thick_cylinder.toml"), "--out", str(out), "-q",
-                 "--set", "output.thickness_every=1", "--set", "output.plots=false"]) == 0
+    assert (
+        main(
+            [
+                "run",
+                str(EXAMPLES / "thick_cylinder.toml"),
+                "--out",
+                str(out),
+                "-q",
+                "--set",
+                "output.thickness_every=1",
+                "--set",
+                "output.plots=false",
+            ]
+        )
+        == 0
+    )
     h = history(out)
     wall = 1.0 + h["u_outer"] - h["u_inner"]
     assert wall[-1] == pytest.approx(0.795, abs=1e-3)  # the wall thins from 1.0
     files = sorted((out / "thickness").glob("step_*.csv"))
     assert [int(f.stem[5:]) for f in files] == h["step"].astype(int).tolist()
-    for f, b_minus_a in zip(files, wall):
+    for f, b_minus_a in zip(files, wall, strict=False):
         t = np.genfromtxt(f, delimiter=",", names=True)
         # the CSV keeps 10 significant digits
         assert np.allclose(t["thickness"], b_minus_a, rtol=1e-9, atol=0)
         assert np.allclose(t["initial_thickness"], 1.0, rtol=1e-9)
     vtus = written_steps(out)
     assert len(vtus) == len(h["step"])
-    for vtu, b_minus_a in zip(vtus, wall):
+    for vtu, b_minus_a in zip(vtus, wall, strict=False):
         assert np.allclose(meshio.read(vtu).point_data["thickness"], b_minus_a, rtol=1e-12, atol=0)
     last = np.genfromtxt(out / "thickness.csv", delimiter=",", names=True)
     assert np.allclose(last["thickness"], wall[-1], rtol=1e-9)
 
 
-@pytest.mark.parametrize("example, wall", [("hughes_carnoy_plate", "z"), ("thick_cylinder", "r"),
-                                           ("die_drawing", "z")])
+@pytest.mark.parametrize("example, wall", [("hughes_carnoy_plate", "z"), ("thick_cylinder", "r"), ("die_drawing", "z")])
 def test_wall_direction_by_default_is_normal_to_the_loaded_face(example, wall):
     """The plate loaded on z = 0 is measured through z, the cylinder loaded on its bore through
     r; a case without pressure (the die drawing) through z."""
@@ -78,12 +97,21 @@ def test_wall_through_r_of_a_homogeneous_stretch_is_exact(element):
 
 
 def test_wall_key_is_checked():
-    data = {"mesh": {"kind": "rectangle", "r": [0, 1], "z": [0, 1], "divisions": [1, 1], "element": "q4",
-                     "wall": "x"}, "material": {"model": "neo-hooke", "C1": 1.0, "kappa": 10.0}}
+    data = {
+        "mesh": {"kind": "rectangle", "r": [0, 1], "z": [0, 1], "divisions": [1, 1], "element": "q4", "wall": "x"},
+        "material": {"model": "neo-hooke", "C1": 1.0, "kappa": 10.0},
+    }
     with pytest.raises(CaseError, match="mesh.wall"):
         parse(data)
-    layered = {"kind": "layered", "element": "q4", "start": [1.0, 0.0], "layers": 1, "thickness": 0.1,
-               "profile": [{"line": {"to": [1.0, 1.0], "divisions": 2}}], "wall": "r"}
+    layered = {
+        "kind": "layered",
+        "element": "q4",
+        "start": [1.0, 0.0],
+        "layers": 1,
+        "thickness": 0.1,
+        "profile": [{"line": {"to": [1.0, 1.0], "divisions": 2}}],
+        "wall": "r",
+    }
     with pytest.raises(CaseError, match="mesh: 'wall' belongs to kind"):
         parse({**data, "mesh": layered})
 
@@ -95,9 +123,11 @@ def test_thickness_csv_columns_and_first_contact(tmp_path):
     top = np.flatnonzero(np.isclose(mesh.points[:, 1], 0.5) & np.isin(np.arange(mesh.n_nodes), mesh.fibres))
     bottom = np.flatnonzero(np.isclose(mesh.points[:, 1], 0.0) & np.isin(np.arange(mesh.n_nodes), mesh.fibres))
     top, bottom = top[np.argsort(mesh.points[top, 0])], bottom[np.argsort(mesh.points[bottom, 0])]
-    pairs = [SimpleNamespace(nodes=top, first_contact=np.array([np.nan, 0.5, 0.25, np.nan])),
-             SimpleNamespace(nodes=bottom, first_contact=np.array([np.nan, 0.75, np.nan, np.nan])),
-             SimpleNamespace(nodes=bottom)]  # a pair without contact times
+    pairs = [
+        SimpleNamespace(nodes=top, first_contact=np.array([np.nan, 0.5, 0.25, np.nan])),
+        SimpleNamespace(nodes=bottom, first_contact=np.array([np.nan, 0.75, np.nan, np.nan])),
+        SimpleNamespace(nodes=bottom),
+    ]  # a pair without contact times
     table = thickness_table(mesh, np.zeros((mesh.n_nodes, 2)), pairs)
     assert np.allclose(table["first_contact"], [np.nan, 0.5, 0.25, np.nan], equal_nan=True)
     write_thickness_csv(tmp_path / "t.csv", table)
@@ -136,8 +166,10 @@ def test_vtu_fields_first_contact_per_piece():
     model = built.model
     plug, mould = model.contacts
     start = model.initial_state()
-    held = (replace(start.contacts[0], first_contact=np.where(np.arange(len(plug.nodes)) % 2 == 0, 0.5, np.nan)),
-            replace(start.contacts[1], first_contact=np.where(np.arange(len(mould.nodes)) % 3 == 0, 1.5, np.nan)))
+    held = (
+        replace(start.contacts[0], first_contact=np.where(np.arange(len(plug.nodes)) % 2 == 0, 0.5, np.nan)),
+        replace(start.contacts[1], first_contact=np.where(np.arange(len(mould.nodes)) % 3 == 0, 1.5, np.nan)),
+    )
     fields = point_fields(model, np.zeros(model.n_full), replace(start, contacts=held))
     for k, pair in enumerate(held):
         expect = np.full(model.mesh.n_nodes, -1.0)
@@ -193,8 +225,24 @@ def test_labels_without_units_name_the_quantity(tmp_path):
     out = tmp_path / "plain"
     case = (EXAMPLES / "hughes_carnoy_plate.toml").read_text().split("[units]")[0]
     (tmp_path / "plate.toml").write_text(case)
-    assert main(["run", str(tmp_path / "plate.toml"), "--out", str(out), "-q", "--set", "solver.target=1.0",
-                 "--set", "solver.steps=2", "--set", "output.plots=false"]) == 0
+    assert (
+        main(
+            [
+                "run",
+                str(tmp_path / "plate.toml"),
+                "--out",
+                str(out),
+                "-q",
+                "--set",
+                "solver.target=1.0",
+                "--set",
+                "solver.steps=2",
+                "--set",
+                "output.plots=false",
+            ]
+        )
+        == 0
+    )
     info = FolderInfo.read(out)
     assert info.units == {}
     fig = load_curve_figure(out / "history.csv", info)
@@ -211,18 +259,29 @@ def test_labels_without_units_name_the_quantity(tmp_path):
 
 def test_what_the_load_factor_scales():
     def labels(**tables):
-        base = {"mesh": {"r": [0.0, 1.0], "z": [0.0, 0.1], "divisions": [2, 1], "element": "q4"},
-                "material": {"model": "neo-hooke", "C1": 1.0, "kappa": 10.0}}
+        base = {
+            "mesh": {"r": [0.0, 1.0], "z": [0.0, 0.1], "divisions": [2, 1], "element": "q4"},
+            "material": {"model": "neo-hooke", "C1": 1.0, "kappa": 10.0},
+        }
         return case_labels(parse({**base, **tables}))["load"]
 
     on = {"z": 0.0}
-    assert labels(pressure=[{"on": on, "value": 2.0}, {"on": on, "value": 2.0}]) == \
-        {"quantity": "pressure", "value": 2.0, "name": "pressure"}
-    assert labels(pressure=[{"on": on, "value": 2.0}, {"on": on, "value": -3.0}]) == \
-        {"quantity": "pressure", "value": -3.0, "name": "pressure[1]"}
+    assert labels(pressure=[{"on": on, "value": 2.0}, {"on": on, "value": 2.0}]) == {
+        "quantity": "pressure",
+        "value": 2.0,
+        "name": "pressure",
+    }
+    assert labels(pressure=[{"on": on, "value": 2.0}, {"on": on, "value": -3.0}]) == {
+        "quantity": "pressure",
+        "value": -3.0,
+        "name": "pressure[1]",
+    }
     assert labels(point_load=[{"at": {"r": 0.0}, "dof": "uz", "value": 5.0}])["quantity"] == "force"
-    assert labels(fix=[{"at": {"r": 1.0}, "dofs": ["ur"], "value": 0.5}]) == \
-        {"quantity": "displacement", "value": 0.5, "name": "fix[0] ur"}
+    assert labels(fix=[{"at": {"r": 1.0}, "dofs": ["ur"], "value": 0.5}]) == {
+        "quantity": "displacement",
+        "value": 0.5,
+        "name": "fix[0] ur",
+    }
     die = case_labels(load(EXAMPLES / "die_drawing.toml"))
     assert die["load"] == {"quantity": "displacement", "value": -3.0, "name": "punch displacement uz"}
     tree = tomllib.loads((EXAMPLES / "die_drawing.toml").read_text())
@@ -236,8 +295,26 @@ def test_four_monitors_make_a_grid_and_animation_has_a_frame_per_written_step(tm
     """The toric plate (four monitors: a 2 x 2 grid, not a strip); forming.gif has one frame
     per written step, and the moulds of each frame are those of its step."""
     out = tmp_path / "toric"
-    assert main(["run", str(EXAMPLES / "toric_plate.toml"), "--out", str(out), "-q", "--set", "solver.target=3.5",
-                 "--set", "solver.steps=7", "--set", "output.every=3", "--set", "output.plots=false"]) == 0
+    assert (
+        main(
+            [
+                "run",
+                str(EXAMPLES / "toric_plate.toml"),
+                "--out",
+                str(out),
+                "-q",
+                "--set",
+                "solver.target=3.5",
+                "--set",
+                "solver.steps=7",
+                "--set",
+                "output.every=3",
+                "--set",
+                "output.plots=false",
+            ]
+        )
+        == 0
+    )
     fig = load_curve_figure(out / "history.csv", FolderInfo.read(out))
     width, height = fig.get_size_inches()
     assert len([ax for ax in fig.axes if ax.get_visible()]) == 4 and width / height < 1.5
@@ -257,8 +334,22 @@ def test_thin_wall_and_uniform_field_stay_readable(tmp_path):
     colour; a near-uniform field gets colour limits of at least 1 % of its size and no
     offset over the title."""
     out = tmp_path / "balloon"
-    assert main(["run", str(EXAMPLES / "balloon.toml"), "--out", str(out), "-q", "--set", "output.plots=false",
-                 "--set", "output.revolved=0"]) == 0
+    assert (
+        main(
+            [
+                "run",
+                str(EXAMPLES / "balloon.toml"),
+                "--out",
+                str(out),
+                "-q",
+                "--set",
+                "output.plots=false",
+                "--set",
+                "output.revolved=0",
+            ]
+        )
+        == 0
+    )
     fig = deformed_figure(written_steps(out)[-1], FolderInfo.read(out), "von_mises")
     fig.canvas.draw()
     ax, bar = fig.axes
@@ -281,14 +372,21 @@ def test_cavity_pressure_monitor_is_the_load_axis(tmp_path):
     monitor's panel and has no panel of its own; a volume is in length cubed."""
     monitor = SimpleNamespace(name="p_bottle", cavity="bottle", quantity="pressure", contact=None, reaction=None)
     volume = SimpleNamespace(name="v_bottle", cavity="bottle", quantity="volume", contact=None, reaction=None)
-    case = SimpleNamespace(monitor=[volume, monitor], pressure=[], point_load=[], fix=[], contact=[],
-                           units=SimpleNamespace(model_dump=lambda: {"length": "mm", "pressure": "MPa"}))
+    case = SimpleNamespace(
+        monitor=[volume, monitor],
+        pressure=[],
+        point_load=[],
+        fix=[],
+        contact=[],
+        units=SimpleNamespace(model_dump=lambda: {"length": "mm", "pressure": "MPa"}),
+    )
     labels = case_labels(case)
     assert labels["load"] == {"quantity": "pressure", "monitor": "p_bottle", "name": "bottle pressure"}
     assert labels["monitor_quantities"] == {"v_bottle": "volume", "p_bottle": "pressure"}
     (tmp_path / "summary.json").write_text(json.dumps({"title": "", **labels}))
-    (tmp_path / "history.csv").write_text("step,load_factor,iterations,v_bottle,p_bottle\n"
-                                          "1,0.5,3,12.0,0.2\n2,1.0,3,20.0,0.3\n")
+    (tmp_path / "history.csv").write_text(
+        "step,load_factor,iterations,v_bottle,p_bottle\n1,0.5,3,12.0,0.2\n2,1.0,3,20.0,0.3\n"
+    )
     fig = load_curve_figure(tmp_path / "history.csv", FolderInfo.read(tmp_path))
     (ax,) = fig.axes
     assert (ax.get_xlabel(), ax.get_ylabel()) == ("v_bottle (mm³)", "bottle pressure (MPa)")
@@ -301,18 +399,28 @@ def test_mould_pieces_are_named_in_summary_and_thickness_plot(tmp_path):
     """A [[contact]] piece is named by its `name`, else by its DXF layer in lower case (the
     cup: "plug", "mould"), else "contact[k]"; summary.json and the thickness plot's legend of
     first contact times say those names."""
-    assert [p.name for p in build(load(EXAMPLES / "cup_thermoforming.toml"), EXAMPLES).model.contacts] == \
-        ["plug", "mould"]
+    assert [p.name for p in build(load(EXAMPLES / "cup_thermoforming.toml"), EXAMPLES).model.contacts] == [
+        "plug",
+        "mould",
+    ]
     named = load(EXAMPLES / "cup_thermoforming.toml", ['contact[1].name="cold mould"'])
     assert [p.name for p in build(named, EXAMPLES).model.contacts] == ["plug", "cold mould"]
     assert build(load(EXAMPLES / "toric_plate.toml"), EXAMPLES).model.contacts[0].name is None
     with pytest.raises(CaseError, match=r"contact\[0\]\.name"):
         load(EXAMPLES / "cup_thermoforming.toml", ['contact[0].name=""'])
 
-    table = {"s": np.array([0.0, 1.0]), "s_current": np.array([0.0, 1.2]), "r": np.zeros(2), "z": np.zeros(2),
-             "thickness": np.ones(2), "initial_thickness": np.ones(2), "ratio": np.ones(2),
-             "first_contact": np.array([0.5, 0.25]), "first_contact_0": np.array([0.5, np.nan]),
-             "first_contact_1": np.array([np.nan, 0.25])}
+    table = {
+        "s": np.array([0.0, 1.0]),
+        "s_current": np.array([0.0, 1.2]),
+        "r": np.zeros(2),
+        "z": np.zeros(2),
+        "thickness": np.ones(2),
+        "initial_thickness": np.ones(2),
+        "ratio": np.ones(2),
+        "first_contact": np.array([0.5, 0.25]),
+        "first_contact_0": np.array([0.5, np.nan]),
+        "first_contact_1": np.array([np.nan, 0.25]),
+    }
     write_thickness_csv(tmp_path / "thickness.csv", table)
     (tmp_path / "summary.json").write_text(json.dumps({"contact": [{"name": "plug"}, {"name": "mould"}]}))
     fig = thickness_figure(tmp_path / "thickness.csv", FolderInfo.read(tmp_path))

@@ -16,9 +16,15 @@ SHEET = {
     "material": {"model": "neo-hooke", "C1": 0.1, "kappa": 200.0},
     "fix": [{"at": {"r": 50.0}, "dofs": ["ur", "uz"]}, {"at": {"r": 0.0}, "dofs": ["ur"]}],
     "pressure": [{"on": {"z": 1.0}, "value": 0.1}],
-    "contact": [{"surface": {"polyline": [[0.0, -40.0], [35.0, -40.0], [40.0, -35.0], [40.0, -5.0],
-                                          [45.0, 0.0], [55.0, 0.0]]},
-                 "slaves": {"z": 0.0}, "sticky": True}],
+    "contact": [
+        {
+            "surface": {
+                "polyline": [[0.0, -40.0], [35.0, -40.0], [40.0, -35.0], [40.0, -5.0], [45.0, 0.0], [55.0, 0.0]]
+            },
+            "slaves": {"z": 0.0},
+            "sticky": True,
+        }
+    ],
     "monitor": [{"name": "w", "at": {"r": 0.0, "z": 0.0}, "dof": "uz"}],
     "solver": {"control": "load", "steps": 20},
 }
@@ -42,8 +48,9 @@ def test_only_a_tool_moves_until_it_touches():
     """A punch starts 5 above the sheet and moves down by 10: nothing responds to the load
     factor until it touches (the first arc of an arc length was 0 and the run hung)."""
     case = {k: v for k, v in SHEET.items() if k not in ("pressure", "contact")}
-    case["contact"] = [{"surface": {"circle": {"center": [0.0, 16.0], "radius": 10.0}},
-                        "slaves": {"z": 1.0}, "motion": {"uz": -10.0}}]
+    case["contact"] = [
+        {"surface": {"circle": {"center": [0.0, 16.0], "radius": 10.0}}, "slaves": {"z": 1.0}, "motion": {"uz": -10.0}}
+    ]
     case["monitor"] = [{"name": "w", "at": {"r": 0.0, "z": 1.0}, "dof": "uz"}]
     for control in ("load", "arc-length"):
         case["solver"] = {"control": control, "steps": 20, "target": 1.0}
@@ -61,8 +68,16 @@ BORE = {
     "mesh": {"kind": "rectangle", "r": [1.0, 2.0], "z": [0.0, 1.0], "divisions": [2, 1], "element": "q8"},
     "material": {"model": "mooney-rivlin", "C1": 0.4, "C2": 0.1, "kappa": 200.0},
     "fix": [{"at": {"z": 0.0}, "dofs": ["uz"]}, {"at": {"z": 1.0}, "dofs": ["uz"]}],
-    "cavity": [{"name": "bore", "boundary": {"r": 1.0}, "control": "gas", "ambient": 0.1, "content": 20.0,
-                "curve": [[0.0, 0.0], [0.5, 1.0]]}],
+    "cavity": [
+        {
+            "name": "bore",
+            "boundary": {"r": 1.0},
+            "control": "gas",
+            "ambient": 0.1,
+            "content": 20.0,
+            "curve": [[0.0, 0.0], [0.5, 1.0]],
+        }
+    ],
     "contact": [{"surface": {"polyline": [[2.2, -0.5], [2.2, 1.5]]}, "slaves": {"r": 2.0}, "sticky": True}],
     "solver": {"steps": 10, "target": 1.0},
 }

@@ -77,20 +77,60 @@ def paths(tree, prefix=()):
     return out
 
 
-numbers = st.one_of(st.sampled_from([0.0, -1.0, 1e-300, 1e300, -1e300, math.nan, math.inf, -math.inf, 2.0, 7.5]),
-                    st.floats(allow_nan=True, allow_infinity=True), st.integers(-3, 12))
-scalars = st.one_of(numbers, st.booleans(), st.text("abcrzuq48 _-.", max_size=6),
-                    st.sampled_from(["q8", "sfr", "neo-hooke", "gmsh", "layered", "arc-length", "displacement",
-                                     "ur", "uz", "rot", "step", "load_factor", ""]))
-values = st.one_of(scalars, st.lists(scalars, max_size=3), st.lists(st.lists(numbers, max_size=3), max_size=3),
-                   st.dictionaries(st.sampled_from(["r", "z", "box", "set", "x", "to"]), scalars, max_size=2))
+numbers = st.one_of(
+    st.sampled_from([0.0, -1.0, 1e-300, 1e300, -1e300, math.nan, math.inf, -math.inf, 2.0, 7.5]),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.integers(-3, 12),
+)
+scalars = st.one_of(
+    numbers,
+    st.booleans(),
+    st.text("abcrzuq48 _-.", max_size=6),
+    st.sampled_from(
+        [
+            "q8",
+            "sfr",
+            "neo-hooke",
+            "gmsh",
+            "layered",
+            "arc-length",
+            "displacement",
+            "ur",
+            "uz",
+            "rot",
+            "step",
+            "load_factor",
+            "",
+        ]
+    ),
+)
+values = st.one_of(
+    scalars,
+    st.lists(scalars, max_size=3),
+    st.lists(st.lists(numbers, max_size=3), max_size=3),
+    st.dictionaries(st.sampled_from(["r", "z", "box", "set", "x", "to"]), scalars, max_size=2),
+)
 
-GMSH = {"missing.msh": None, "empty.msh": "", "corrupt.msh": "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 x\n",
-        "binary.msh": bytes(range(256)), "triangles.msh": "tri", "quads.msh": "quad", "mixed.msh": "mixed",
-        "nan.msh": "nan", "x" * 300 + ".msh": None}
-CSV = {"good.csv": "0.0, 1.0\n2.0, 1.2\n", "text.csv": "0.0, 1.0\nabc, 2.0\n", "nan.csv": "0.0, nan\n1.0, 2.0\n",
-       "one.csv": "0.0\n1.0\n", "empty.csv": "", "repeat.csv": "0.0, 1.0\n0.0, 1.0\n",
-       "huge.csv": "0.0, 1e308\n1.0, 2.0\n"}
+GMSH = {
+    "missing.msh": None,
+    "empty.msh": "",
+    "corrupt.msh": "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 x\n",
+    "binary.msh": bytes(range(256)),
+    "triangles.msh": "tri",
+    "quads.msh": "quad",
+    "mixed.msh": "mixed",
+    "nan.msh": "nan",
+    "x" * 300 + ".msh": None,
+}
+CSV = {
+    "good.csv": "0.0, 1.0\n2.0, 1.2\n",
+    "text.csv": "0.0, 1.0\nabc, 2.0\n",
+    "nan.csv": "0.0, nan\n1.0, 2.0\n",
+    "one.csv": "0.0\n1.0\n",
+    "empty.csv": "",
+    "repeat.csv": "0.0, 1.0\n0.0, 1.0\n",
+    "huge.csv": "0.0, 1e308\n1.0, 2.0\n",
+}
 polylines = st.lists(st.lists(numbers, min_size=2, max_size=2), min_size=0, max_size=5)
 
 
@@ -107,8 +147,13 @@ def mutations(draw, case):
             del node[path[-1]]
         else:
             old = node[path[-1]]
-            plausible = (st.floats(-3.0, 10.0) if isinstance(old, float) else st.integers(-1, 6)
-                         if isinstance(old, int) and not isinstance(old, bool) else values)
+            plausible = (
+                st.floats(-3.0, 10.0)
+                if isinstance(old, float)
+                else st.integers(-1, 6)
+                if isinstance(old, int) and not isinstance(old, bool)
+                else values
+            )
             node[path[-1]] = draw(st.one_of(plausible, values))
     elif kind == "unknown":
         tables = [t for t in (case, case.get("mesh"), case.get("solver")) if isinstance(t, dict)]
@@ -123,13 +168,28 @@ def mutations(draw, case):
             case["mesh"]["r"] = draw(st.sampled_from([[0.0, 0.0], [-1.0, 1.0], [2.0, 1.0], [0.0, 1e-300]]))
             case["mesh"]["divisions"] = draw(st.sampled_from([[0, 1], [4, 1], [1, -1]]))
         else:
-            case["mesh"] = {"kind": "layered", "element": draw(st.sampled_from(["q4", "q8", "sfr"])),
-                            "start": [1.0, 0.0], "thickness": draw(numbers), "layers": draw(st.integers(0, 2)),
-                            "profile": [{"line": {"to": draw(st.lists(numbers, min_size=2, max_size=2)),
-                                                  "divisions": draw(st.integers(0, 4))}},
-                                        {"arc": {"center": [0.0, 0.0], "to": draw(st.lists(numbers, min_size=2,
-                                                                                            max_size=2)),
-                                                 "divisions": 2}}]}
+            case["mesh"] = {
+                "kind": "layered",
+                "element": draw(st.sampled_from(["q4", "q8", "sfr"])),
+                "start": [1.0, 0.0],
+                "thickness": draw(numbers),
+                "layers": draw(st.integers(0, 2)),
+                "profile": [
+                    {
+                        "line": {
+                            "to": draw(st.lists(numbers, min_size=2, max_size=2)),
+                            "divisions": draw(st.integers(0, 4)),
+                        }
+                    },
+                    {
+                        "arc": {
+                            "center": [0.0, 0.0],
+                            "to": draw(st.lists(numbers, min_size=2, max_size=2)),
+                            "divisions": 2,
+                        }
+                    },
+                ],
+            }
     elif kind == "contact":
         contact = copy.deepcopy(CONTACT)
         choice = draw(st.sampled_from(["circle", "polyline", "file", "profile"]))
@@ -138,12 +198,17 @@ def mutations(draw, case):
         elif choice == "file":
             contact["surface"] = {"file": draw(st.sampled_from(sorted(CSV)))}
         elif choice == "profile":
-            contact["surface"] = {"profile": {"start": [0.0, 1.0], "pieces": [
-                {"arc": {"center": draw(st.lists(numbers, min_size=2, max_size=2)), "to": [2.0, 1.0]}}]}}
+            contact["surface"] = {
+                "profile": {
+                    "start": [0.0, 1.0],
+                    "pieces": [{"arc": {"center": draw(st.lists(numbers, min_size=2, max_size=2)), "to": [2.0, 1.0]}}],
+                }
+            }
         else:
             contact["surface"]["circle"]["radius"] = draw(numbers)
         contact[draw(st.sampled_from(["penalty", "friction", "depth", "motion"]))] = draw(
-            st.one_of(numbers, st.just({"uz": -0.5})))
+            st.one_of(numbers, st.just({"uz": -0.5}))
+        )
         case["contact"] = [contact]
     elif kind == "output":  # a monitor name that would break history.csv, a huge revolved copy or mesh
         choice = draw(st.sampled_from(["name", "revolved", "divisions"]))
@@ -153,7 +218,9 @@ def mutations(draw, case):
         elif choice == "revolved":
             case["output"] = dict(copy.deepcopy(BASE["output"]), revolved=draw(st.sampled_from([1, 3600, 3601, 10**9])))
         else:  # deep copies: later mutations change lists in place
-            case["mesh"] = dict(copy.deepcopy(BASE["mesh"]), divisions=draw(st.sampled_from([[10**5, 10**5], [10**9, 1]])))
+            case["mesh"] = dict(
+                copy.deepcopy(BASE["mesh"]), divisions=draw(st.sampled_from([[10**5, 10**5], [10**9, 1]]))
+            )
     else:  # a selector matching nothing, several nodes or a set that is not there
         sel = draw(st.sampled_from([{"r": 1.234}, {"z": 0.0}, {"set": "nowhere"}, {"box": [[0, 0], [9, 9]]}, {}]))
         where = draw(st.sampled_from(["fix", "pressure", "monitor"]))
@@ -166,8 +233,12 @@ def case_files(draw):
     """(file content as bytes, command) for a fuzzed case."""
     case = copy.deepcopy(BASE)
     if draw(st.booleans()):
-        case["solver"] = {"control": "displacement", "dof": {"at": {"r": 0.0, "z": 0.2}, "dof": "uz"},
-                          "target": 0.3, "steps": 2}
+        case["solver"] = {
+            "control": "displacement",
+            "dof": {"at": {"r": 0.0, "z": 0.2}, "dof": "uz"},
+            "target": 0.3,
+            "steps": 2,
+        }
     for _ in range(draw(st.sampled_from([0, 1, 1, 1, 2, 3]))):
         draw(mutations(case))
     text = toml(case).encode()
@@ -191,8 +262,9 @@ def folder(tmp_path_factory):
             pts[4, 1] = np.nan if content == "nan" else 0.0
             cells = [("triangle", np.array([[0, 1, 2]]))] if content == "tri" else [("quad", np.array([[0, 1, 2, 3]]))]
             if content in ("mixed", "nan"):
-                cells.append(("triangle", np.array([[1, 4, 2]])) if content == "mixed" else
-                             ("quad", np.array([[1, 4, 4, 2]])))
+                cells.append(
+                    ("triangle", np.array([[1, 4, 2]])) if content == "mixed" else ("quad", np.array([[1, 4, 4, 2]]))
+                )
             meshio.write(d / name, meshio.Mesh(pts, cells), file_format="gmsh22")
         elif isinstance(content, bytes):
             (d / name).write_bytes(content)
@@ -244,9 +316,18 @@ def fuzz(folder, content: bytes, command: str) -> None:
     TALLY[(command, code)] += 1
 
 
-_settings = settings(max_examples=EXAMPLES, deadline=None, derandomize=SEED is None, database=None,
-                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture,
-                                            HealthCheck.data_too_large, HealthCheck.filter_too_much])
+_settings = settings(
+    max_examples=EXAMPLES,
+    deadline=None,
+    derandomize=SEED is None,
+    database=None,
+    suppress_health_check=[
+        HealthCheck.too_slow,
+        HealthCheck.function_scoped_fixture,
+        HealthCheck.data_too_large,
+        HealthCheck.filter_too_much,
+    ],
+)
 
 
 @_settings

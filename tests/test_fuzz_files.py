@@ -35,18 +35,27 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, seed, settings
 from hypothesis import strategies as st
+from test_fuzz import BASE, CONTACT, paths, toml
 
 from axiform.cli import main
-from test_fuzz import BASE, CONTACT, paths, toml
 
 EXAMPLES = max(int(os.environ.get("AXIFORM_FUZZ_EXAMPLES", "600")) // 20, 10)
 SEED = os.environ.get("AXIFORM_FUZZ_SEED")
 TIME_BOUND_S = 30.0
 KEY = re.compile(r"^(\(case\)|--[a-z-]+|[A-Za-z_][\w-]*(\[\d+\])*(\.[A-Za-z_\"][\w\"-]*(\[\d+\])*)*):")
 
-_settings = settings(max_examples=EXAMPLES, deadline=None, derandomize=SEED is None, database=None,
-                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture,
-                                            HealthCheck.data_too_large, HealthCheck.filter_too_much])
+_settings = settings(
+    max_examples=EXAMPLES,
+    deadline=None,
+    derandomize=SEED is None,
+    database=None,
+    suppress_health_check=[
+        HealthCheck.too_slow,
+        HealthCheck.function_scoped_fixture,
+        HealthCheck.data_too_large,
+        HealthCheck.filter_too_much,
+    ],
+)
 
 
 def seeded(test):
@@ -86,8 +95,9 @@ def judge(code: int, out: str, err: str, names: tuple[str, ...], allowed=(0, 1, 
         lines = err.strip().splitlines()
         assert lines, "exit 2 without a message"
         body = "\n".join(lines[1:] if lines[0].rstrip().endswith(":") else lines)
-        assert any(n in err for n in names) or all(KEY.match(line) for line in body.splitlines() if line), \
+        assert any(n in err for n in names) or all(KEY.match(line) for line in body.splitlines() if line), (
             f"exit 2 naming neither {names} nor a key:\n{err}"
+        )
 
 
 @pytest.fixture(scope="module")
@@ -99,13 +109,20 @@ def folder(tmp_path_factory):
 
 
 BLOCKED = "blocker/out"  # an --out that cannot be made: an accepted input stops there
-numbers = st.one_of(st.sampled_from([0.0, -1.0, 1e-300, 1e300, math.nan, math.inf, -math.inf, 1.0, 2.5]),
-                    st.floats(allow_nan=True, allow_infinity=True), st.integers(-3, 12))
+numbers = st.one_of(
+    st.sampled_from([0.0, -1.0, 1e-300, 1e300, math.nan, math.inf, -math.inf, 1.0, 2.5]),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.integers(-3, 12),
+)
 words = st.text(alphabet=st.characters(codec="utf-8", exclude_categories=("Cs",)), max_size=8)
 cells = st.one_of(numbers.map(str), words, st.sampled_from(["", " ", "nan", "1e999", "0x10", "1,5", '"', "#"]))
 # fit data: the numbers whose extremes app/fit.py does not refuse yet left out (the strict xfail below)
-fit_cells = st.one_of(st.floats(1e-3, 1e3).map(str), st.sampled_from(["-1.0", "0", "1", "1.0", "inf", "nan"]),
-                      words, st.sampled_from(["", " ", "1e999", "0x10", "1,5", '"', "#"]))
+fit_cells = st.one_of(
+    st.floats(1e-3, 1e3).map(str),
+    st.sampled_from(["-1.0", "0", "1", "1.0", "inf", "nan"]),
+    words,
+    st.sampled_from(["", " ", "1e999", "0x10", "1,5", '"', "#"]),
+)
 
 
 def spoil_text(draw, text: str) -> bytes:
@@ -158,9 +175,14 @@ def csv_texts(draw, header: list[str], good_rows: list[list[str]], cells=cells) 
 
 LAYERED = {
     "title": "fuzz tube",
-    "mesh": {"kind": "layered", "element": "q4", "start": [10.0, 0.0],
-             "profile": [{"line": {"to": [10.0, 20.0], "divisions": 4}}],
-             "thickness": [[0.0, 1.0], [10.0, 1.1], [20.0, 1.2]], "layers": 1},
+    "mesh": {
+        "kind": "layered",
+        "element": "q4",
+        "start": [10.0, 0.0],
+        "profile": [{"line": {"to": [10.0, 20.0], "divisions": 4}}],
+        "thickness": [[0.0, 1.0], [10.0, 1.1], [20.0, 1.2]],
+        "layers": 1,
+    },
     "material": {"model": "neo-hooke", "C1": 0.1, "kappa": 100.0},
     "fix": [{"at": {"set": "start"}, "dofs": ["uz"]}, {"at": {"set": "end"}, "dofs": ["uz"]}],
     "cavity": [{"name": "gas", "boundary": {"set": "inner"}, "control": "volume", "volume": 15000.0}],
@@ -175,8 +197,9 @@ def _fuzz_target(folder, data):
     text = data.draw(csv_texts(["s", "thickness"], [["0", "0.6"], ["10", "0.7"], ["20", "0.6"]]))
     target = folder / "target.csv"
     target.write_bytes(spoil_text(data.draw, text))
-    code, out, err = call(["optimize", str(folder / "tube.toml"), "--target", str(target), "--out",
-                           str(folder / BLOCKED), "-q"])
+    code, out, err = call(
+        ["optimize", str(folder / "tube.toml"), "--target", str(target), "--out", str(folder / BLOCKED), "-q"]
+    )
     judge(code, out, err, (str(target),), allowed=(2,))  # accepted targets are stopped by --out
 
 
@@ -213,12 +236,28 @@ def test_fuzzed_fit_data_never_crash(folder, monkeypatch):
 # ---- sweep files ------------------------------------------------------------------------------
 
 
-SWEEP = {"case": "case.toml", "vary": {"material.C1": [80.0, 90.0], "solver.steps": [2]},
-         "report": {"monitor": "w"}}
-sweep_values = st.one_of(numbers, words, st.booleans(), st.lists(numbers, max_size=3),
-                         st.dictionaries(st.sampled_from(["r", "z", "monitor", "x"]), numbers, max_size=2),
-                         st.sampled_from(["case.toml", "missing.toml", "blocker", ".", "w", "nope", "x" * 300,
-                                          "material.C1", "mesh.divisions", "contact[0].friction"]))
+SWEEP = {"case": "case.toml", "vary": {"material.C1": [80.0, 90.0], "solver.steps": [2]}, "report": {"monitor": "w"}}
+sweep_values = st.one_of(
+    numbers,
+    words,
+    st.booleans(),
+    st.lists(numbers, max_size=3),
+    st.dictionaries(st.sampled_from(["r", "z", "monitor", "x"]), numbers, max_size=2),
+    st.sampled_from(
+        [
+            "case.toml",
+            "missing.toml",
+            "blocker",
+            ".",
+            "w",
+            "nope",
+            "x" * 300,
+            "material.C1",
+            "mesh.divisions",
+            "contact[0].friction",
+        ]
+    ),
+)
 
 
 @st.composite
@@ -275,9 +314,29 @@ def _mould_dxf() -> list[str]:
 
 
 DXF_LINES = _mould_dxf()
-dxf_values = st.one_of(numbers.map(repr), words, st.sampled_from(["", "nan", "1e308", "-1e308", "ARC", "LINE",
-                                                                  "CIRCLE", "SPLINE", "EOF", "ENDSEC", "0", "10",
-                                                                  "999999999999", "MOULD", "Other"]))
+dxf_values = st.one_of(
+    numbers.map(repr),
+    words,
+    st.sampled_from(
+        [
+            "",
+            "nan",
+            "1e308",
+            "-1e308",
+            "ARC",
+            "LINE",
+            "CIRCLE",
+            "SPLINE",
+            "EOF",
+            "ENDSEC",
+            "0",
+            "10",
+            "999999999999",
+            "MOULD",
+            "Other",
+        ]
+    ),
+)
 
 
 @st.composite
@@ -293,9 +352,9 @@ def dxf_files(draw) -> bytes:
         elif kind == "drop":
             del lines[i]
         elif kind == "drop-pair":
-            del lines[i & ~1: (i & ~1) + 2]
+            del lines[i & ~1 : (i & ~1) + 2]
         elif kind == "double":
-            lines[i:i] = lines[i & ~1: (i & ~1) + 2]
+            lines[i:i] = lines[i & ~1 : (i & ~1) + 2]
         else:
             lines = lines[:i]
     return spoil_text(draw, "\n".join(lines) + "\n")
@@ -377,15 +436,19 @@ def npz_rewrites(draw, arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         node = layout[kind]
         for p in path[:-1]:
             node = node[p]
-        node[path[-1]] = draw(st.one_of(numbers, words, st.just(None), st.just({"__array__": "a99"}),
-                                        st.just([]), st.just({"__dict__": [1, 2]})))
+        node[path[-1]] = draw(
+            st.one_of(
+                numbers, words, st.just(None), st.just({"__array__": "a99"}), st.just([]), st.just({"__dict__": [1, 2]})
+            )
+        )
         arrays["__layout__"] = np.array(json.dumps(layout))
     elif kind == "nochecksum":  # a file of before the checksum: resumed as it is
         layout.pop("sha256", None)
         arrays["__layout__"] = np.array(json.dumps(layout))
     else:
-        arrays["__layout__"] = np.array(draw(st.sampled_from(["", "{", "[]", "null", '{"layout": 1}',
-                                                             '{"layout": {}, "meta": []}'])))
+        arrays["__layout__"] = np.array(
+            draw(st.sampled_from(["", "{", "[]", "null", '{"layout": 1}', '{"layout": {}, "meta": []}']))
+        )
     return arrays
 
 

@@ -19,7 +19,7 @@ def slab_series(z: np.ndarray, fo: float, bi: float, terms: int = 60) -> np.ndar
     out = np.zeros_like(z)
     for n in range(terms):
         zeta = optimize.brentq(lambda s: s * np.tan(s) - bi, n * np.pi + 1e-12, n * np.pi + np.pi / 2 - 1e-12)
-        out += 4 * np.sin(zeta) / (2 * zeta + np.sin(2 * zeta)) * np.exp(-zeta**2 * fo) * np.cos(zeta * z)
+        out += 4 * np.sin(zeta) / (2 * zeta + np.sin(2 * zeta)) * np.exp(-(zeta**2) * fo) * np.cos(zeta * z)
     return out
 
 
@@ -51,6 +51,7 @@ def annulus_series(r: np.ndarray, t: float, a: float, b: float, h: float, terms:
     """(T - T_inf) / (T0 - T_inf) in a long annulus a < r < b insulated at a, film h at b:
     eigenfunctions R(r) = J0(l r) Y1(l a) - Y0(l r) J1(l a) (R'(a) = 0) with -k R'(b) = h R(b),
     coefficients by orthogonality with the weight r."""
+
     def R(lam, r):
         return special.j0(lam * r) * special.y1(lam * a) - special.y0(lam * r) * special.j1(lam * a)
 
@@ -62,12 +63,15 @@ def annulus_series(r: np.ndarray, t: float, a: float, b: float, h: float, terms:
 
     grid = np.linspace(1e-6, 80.0 / (b - a), 20000)
     values = condition(grid)
-    roots = [optimize.brentq(condition, lo, hi) for lo, hi, vl, vh in zip(grid, grid[1:], values, values[1:])
-             if vl * vh < 0][:terms]
+    roots = [
+        optimize.brentq(condition, lo, hi)
+        for lo, hi, vl, vh in zip(grid, grid[1:], values, values[1:], strict=False)
+        if vl * vh < 0
+    ][:terms]
     out = np.zeros_like(r)
     for lam in roots:
-        num = integrate.quad(lambda s: s * R(lam, s), a, b, limit=200)[0]
-        den = integrate.quad(lambda s: s * R(lam, s) ** 2, a, b, limit=200)[0]
+        num = integrate.quad(lambda s, lam=lam: s * R(lam, s), a, b, limit=200)[0]
+        den = integrate.quad(lambda s, lam=lam: s * R(lam, s) ** 2, a, b, limit=200)[0]
         out += num / den * R(lam, r) * np.exp(-ALPHA * lam**2 * t)
     return out
 
@@ -79,8 +83,9 @@ def test_an_annulus_cooled_outside_follows_the_bessel_series(element):
     times."""
     a, b, T0, T_inf, h = 2.0, 6.0, 150.0, 25.0, 0.1
     mesh = rectangle((a, b), (0.0, 1.0), (32, 1), element, wall="r")
-    conduction = Conduction(mesh, constant(K), constant(RHO), constant(C),
-                            [Film(select_edges(mesh, {"r": b}), h, lambda t: T_inf)])
+    conduction = Conduction(
+        mesh, constant(K), constant(RHO), constant(C), [Film(select_edges(mesh, {"r": b}), h, lambda t: T_inf)]
+    )
     r = mesh.points[:, 0]
     for fo in (0.2, 0.5):
         t = fo * (b - a) ** 2 / ALPHA
@@ -94,8 +99,10 @@ def test_a_step_stores_the_heat_that_crosses_the_boundary():
     nodes (conduction moves heat, it makes none), to 1e-8 of the heat exchanged, also on a
     deformed (current) configuration."""
     mesh = rectangle((1.0, 4.0), (0.0, 2.0), (6, 4), "q8")
-    films = [Film(select_edges(mesh, {"z": 2.0}), 0.05, lambda t: 25.0),
-             Film(select_edges(mesh, {"r": 1.0}), 0.02, lambda t: 200.0)]
+    films = [
+        Film(select_edges(mesh, {"z": 2.0}), 0.05, lambda t: 25.0),
+        Film(select_edges(mesh, {"r": 1.0}), 0.02, lambda t: 200.0),
+    ]
     conduction = Conduction(mesh, constant(K), constant(RHO), constant(C), films)
     rng = np.random.default_rng(2)
     T = 150.0 + 10.0 * rng.standard_normal(mesh.n_nodes)

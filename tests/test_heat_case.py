@@ -8,11 +8,10 @@ import tomllib
 import numpy as np
 import pytest
 import tomli_w
-
-from axiform.case.schema import build, parse
-from axiform import solve
-
 from test_heat import ALPHA, slab_series
+
+from axiform import solve
+from axiform.case.schema import build, parse
 
 L, T0, T_INF = 2.0, 150.0, 25.0
 CASE = """
@@ -50,16 +49,22 @@ quantity = "temperature"
 target = 19.0
 steps = 100
 """
-MOULD = {"name": "mould", "surface": {"polyline": [[12.0, 2.0], [9.0, 2.0]]},
-         "slaves": {"z": 2.0}, "motion": {"uz": -1.0e-3, "curve": [[0.0, 0.0], [0.5, 1.0], [100.0, 1.0]]},
-         "temperature": 25.0, "conductance": 0.2}
+MOULD = {
+    "name": "mould",
+    "surface": {"polyline": [[12.0, 2.0], [9.0, 2.0]]},
+    "slaves": {"z": 2.0},
+    "motion": {"uz": -1.0e-3, "curve": [[0.0, 0.0], [0.5, 1.0], [100.0, 1.0]]},
+    "temperature": 25.0,
+    "conductance": 0.2,
+}
 
 
 def run(data: dict):
     built = build(parse(data))
     temps = []
-    res = solve(built.model, built.control, built.options,
-                on_step=lambda s: temps.append((s.lam, s.state.temperature.copy())))
+    res = solve(
+        built.model, built.control, built.options, on_step=lambda s: temps.append((s.lam, s.state.temperature.copy()))
+    )
     assert res.status == "finished", res.message
     return built, temps
 
@@ -93,8 +98,9 @@ def test_heat_crosses_a_thin_gap_in_proportion():
     data = tomllib.loads(CASE)
     del data["convection"]
     mould = {k: v for k, v in MOULD.items() if k != "motion"}
-    data["contact"] = [mould | {"surface": {"polyline": [[12.0, 2.05], [9.0, 2.05]]}, "conductance_gap": 0.1,
-                                "depth": 0.1}]
+    data["contact"] = [
+        mould | {"surface": {"polyline": [[12.0, 2.05], [9.0, 2.05]]}, "conductance_gap": 0.1, "depth": 0.1}
+    ]
     cools_as_the_slab(*run(data), biot=1.0)
 
 
@@ -117,7 +123,8 @@ class Stop(Exception):
 def test_a_checkpoint_carries_the_temperature(tmp_path):
     """A run stopped after step 5 and resumed from its checkpoint (through the file format)
     ends at the temperatures of the uninterrupted run."""
-    from axiform.io.checkpoint import load as load_checkpoint, save as save_checkpoint
+    from axiform.io.checkpoint import load as load_checkpoint
+    from axiform.io.checkpoint import save as save_checkpoint
 
     data = tomllib.loads(CASE.replace("steps = 100", "steps = 10"))
     data["contact"] = [MOULD]
@@ -139,18 +146,26 @@ def test_a_checkpoint_carries_the_temperature(tmp_path):
     np.testing.assert_allclose(rest.last.state.temperature, full[-1][1], rtol=1e-12)
 
 
-@pytest.mark.parametrize("edit, message", [
-    (("conductivity = 0.2", "conductivity = -0.2"), r"thermal.conductivity: .*> 0"),
-    (("density = 1.0e-9", "density = [[100.0, 1.0e-9], [90.0, 1.1e-9]]"), r"thermal.density: .*increase"),
-    (("specific_heat = 1.9e9", "specific_heat = [[100.0, 1.9e9], [120.0]]"), r"thermal.specific_heat: .*holes"),
-    (("on = { z = 2.0 }", "on = { z = 1.0 }"), r"convection\[0\].on: .*no boundary edge"),
-    (("h = 0.2", "h = 0.0"), r"convection.0..h: .*greater than 0"),
-    (("[temperature]\ninitial = 150.0\n", ""), r"thermal: .*\[temperature\]"),
-    (("steps = 100", "steps = 100\ncontrol = \"arc-length\""), r"solver.control: .*heat conduction"),
-    (("[[convection]]", "[[contact]]\nsurface = { polyline = [[12.0, 2.0], [9.0, 2.0]] }\nslaves = { z = 2.0 }\n"
-                        "temperature = 25.0\nconductance = 0.2\nconductance_gap = 5.0\n[[convection]]"),
-     r"contact\[0\].conductance_gap: 5 is beyond the contact search depth"),
-])
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (("conductivity = 0.2", "conductivity = -0.2"), r"thermal.conductivity: .*> 0"),
+        (("density = 1.0e-9", "density = [[100.0, 1.0e-9], [90.0, 1.1e-9]]"), r"thermal.density: .*increase"),
+        (("specific_heat = 1.9e9", "specific_heat = [[100.0, 1.9e9], [120.0]]"), r"thermal.specific_heat: .*holes"),
+        (("on = { z = 2.0 }", "on = { z = 1.0 }"), r"convection\[0\].on: .*no boundary edge"),
+        (("h = 0.2", "h = 0.0"), r"convection.0..h: .*greater than 0"),
+        (("[temperature]\ninitial = 150.0\n", ""), r"thermal: .*\[temperature\]"),
+        (("steps = 100", 'steps = 100\ncontrol = "arc-length"'), r"solver.control: .*heat conduction"),
+        (
+            (
+                "[[convection]]",
+                "[[contact]]\nsurface = { polyline = [[12.0, 2.0], [9.0, 2.0]] }\nslaves = { z = 2.0 }\n"
+                "temperature = 25.0\nconductance = 0.2\nconductance_gap = 5.0\n[[convection]]",
+            ),
+            r"contact\[0\].conductance_gap: 5 is beyond the contact search depth",
+        ),
+    ],
+)
 def test_bad_thermal_input_is_refused_naming_the_key(tmp_path, capsys, edit, message):
     from axiform.cli import main
 

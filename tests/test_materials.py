@@ -24,9 +24,11 @@ def full_P(m, x):
     I1 = np.trace(C)
     I2 = 0.5 * (I1**2 - np.sum(C * C))
     Fit = np.linalg.inv(F).T
-    P = (2 * m.C1 * J ** (-2 / 3) * (F - I1 / 3 * Fit)
-         + 2 * m.C2 * J ** (-4 / 3) * (I1 * F - F @ C - 2 * I2 / 3 * Fit)
-         + m.kappa * (J - 1) * J * Fit)
+    P = (
+        2 * m.C1 * J ** (-2 / 3) * (F - I1 / 3 * Fit)
+        + 2 * m.C2 * J ** (-4 / 3) * (I1 * F - F @ C - 2 * I2 / 3 * Fit)
+        + m.kappa * (J - 1) * J * Fit
+    )
     return np.array([P[0, 0], P[0, 2], P[2, 0], P[2, 2], P[1, 1]])
 
 

@@ -19,6 +19,7 @@ def test_rectangle_counts_and_sets(element, nodes):
     mesh.check()
     # areas: sum of |detJ| w equals the rectangle area (through the axisymmetric volume)
     from axiform.fem.elements import gradient_operator
+
     _, dV = gradient_operator(mesh.element, mesh.points[mesh.cells])
     assert dV.sum() == pytest.approx(np.pi * 3.0**2 * 2.0)
 
@@ -26,7 +27,7 @@ def test_rectangle_counts_and_sets(element, nodes):
 def test_q8_mid_side_nodes_are_mid_side():
     mesh = rectangle((1.0, 2.0), (0.0, 1.0), (2, 2), "q8")
     c = mesh.cells
-    for k, (a, b) in zip(range(4, 8), [(0, 1), (1, 2), (2, 3), (3, 0)]):
+    for k, (a, b) in zip(range(4, 8), [(0, 1), (1, 2), (2, 3), (3, 0)], strict=False):
         assert np.allclose(mesh.points[c[:, k]], 0.5 * (mesh.points[c[:, a]] + mesh.points[c[:, b]]))
 
 
@@ -108,6 +109,7 @@ def test_gmsh_import_with_physical_groups(tmp_path, order, element):
     e = mesh.boundary_edges[mesh.edge_sets["bottom"]]
     assert np.allclose(mesh.points[e, 1], 0.0)
     from axiform.fem.elements import gradient_operator
+
     _, dV = gradient_operator(mesh.element, mesh.points[mesh.cells])
     assert dV.sum() == pytest.approx(np.pi * 7.5**2 * 0.5, rel=1e-10)
 

@@ -6,19 +6,19 @@ import functools
 
 import numpy as np
 import pytest
-
-from axiform import LoadControl, Model, MooneyRivlin, select_edges, select_nodes, solve
-from axiform.post.fields import point_fields
-from axiform.fem.mesh import layered
-from axiform.fem.profile import Arc, Profile
 from conftest import difference_tangent, distorted_rectangle
 from oracles import SphereBVP
+
+from axiform import LoadControl, Model, MooneyRivlin, select_edges, select_nodes, solve
+from axiform.fem.mesh import layered
+from axiform.fem.profile import Arc, Profile
+from axiform.post.fields import point_fields
 
 A, B, C1, C2, P = 1.0, 1.5, 0.4, 0.1, 0.35  # the sphere of the locking report
 MU = 2.0 * (C1 + C2)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def exact_bore(kappa_over_mu: float) -> float:
     return SphereBVP(MooneyRivlin(C1, C2, kappa_over_mu * MU), A, B).bore_displacement(P, 0.18)
 
@@ -28,8 +28,9 @@ def sphere_bore(element: str, kappa_over_mu: float, formulation: str, pressure_s
     ur = 0 on r = 0, follower pressure on the bore; u_r of the bore at z = 0."""
     profile = Profile(((A + B) / 2, 0.0), (Arc((0.0, 0.0), (0.0, (A + B) / 2), 16, True),))
     mesh = layered(profile, B - A, 4, element)
-    model = Model(mesh, MooneyRivlin(C1, C2, kappa_over_mu * MU), formulation=formulation,
-                  pressure_space=pressure_space)
+    model = Model(
+        mesh, MooneyRivlin(C1, C2, kappa_over_mu * MU), formulation=formulation, pressure_space=pressure_space
+    )
     model.fix(select_nodes(mesh, {"set": "start"}), ["uz"])
     model.fix(select_nodes(mesh, {"set": "end"}), ["ur"])
     model.pressure(select_edges(mesh, {"set": "inner"}), P)

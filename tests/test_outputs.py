@@ -36,6 +36,7 @@ def test_layered_profile_geometry():
     assert prof.length() == pytest.approx(2.0 + np.pi / 2)
     # meridian area: wall 0.1 thick along the mid-surface
     from axiform.fem.elements import gauss_quad, jacobian
+
     xi, w = gauss_quad(3)
     _, _, detJ, _ = jacobian(mesh.element, mesh.points[mesh.cells], xi)
     assert (detJ * w).sum() == pytest.approx(0.1 * (2.0 + np.pi / 2), rel=1e-4)
@@ -97,8 +98,24 @@ def test_balloon_case_writes_every_output(tmp_path):
 
 def test_plot_command(tmp_path, capsys):
     out = tmp_path / "plate"
-    assert main(["run", str(EXAMPLES / "hughes_carnoy_plate.toml"), "--out", str(out), "-q",
-                 "--set", "solver.target=2.0", "--set", "solver.steps=4", "--set", "output.plots=false"]) == 0
+    assert (
+        main(
+            [
+                "run",
+                str(EXAMPLES / "hughes_carnoy_plate.toml"),
+                "--out",
+                str(out),
+                "-q",
+                "--set",
+                "solver.target=2.0",
+                "--set",
+                "solver.steps=4",
+                "--set",
+                "output.plots=false",
+            ]
+        )
+        == 0
+    )
     assert not (out / "load_curve.png").exists()
     assert main(["plot", str(out), "--field", "J"]) == 0
     assert (out / "load_curve.png").exists() and (out / "deformed.png").exists()
@@ -113,13 +130,27 @@ def test_a_run_draws_its_plots_and_a_case_without_plots_none(tmp_path):
     from axiform.app.run import run
 
     out = tmp_path / "plate"
-    assert run(str(EXAMPLES / "hughes_carnoy_plate.toml"), str(out), quiet=True,
-               overrides=["solver.steps=3", "solver.target=1.0"]) == 0
+    assert (
+        run(
+            str(EXAMPLES / "hughes_carnoy_plate.toml"),
+            str(out),
+            quiet=True,
+            overrides=["solver.steps=3", "solver.target=1.0"],
+        )
+        == 0
+    )
     for png in PNGS:
         assert (out / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     none = tmp_path / "none"
-    assert run(str(EXAMPLES / "hughes_carnoy_plate.toml"), str(none), quiet=True,
-               overrides=["solver.steps=2", "solver.target=0.5", "output.plots=false"]) == 0
+    assert (
+        run(
+            str(EXAMPLES / "hughes_carnoy_plate.toml"),
+            str(none),
+            quiet=True,
+            overrides=["solver.steps=2", "solver.target=0.5", "output.plots=false"],
+        )
+        == 0
+    )
     assert (none / "summary.json").exists() and not list(none.glob("*.png"))
 
 
@@ -133,15 +164,47 @@ def test_the_command_from_a_shell(tmp_path):
     src = Path(__file__).resolve().parents[1] / "src"
     out = tmp_path / "plate"
     env = {**os.environ, "PYTHONPATH": str(src)}
-    proc = subprocess.run([sys.executable, "-m", "axiform.cli", "run", str(EXAMPLES / "hughes_carnoy_plate.toml"),
-                           "--out", str(out), "-q", "--set", "solver.steps=2", "--set", "solver.target=0.5"],
-                          env=env, capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "axiform.cli",
+            "run",
+            str(EXAMPLES / "hughes_carnoy_plate.toml"),
+            "--out",
+            str(out),
+            "-q",
+            "--set",
+            "solver.steps=2",
+            "--set",
+            "solver.target=0.5",
+        ],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert proc.returncode == 0, proc.stderr
     assert all((out / png).exists() for png in PNGS)
     assert "axiform: finished after 2 steps" in proc.stdout
-    bad = subprocess.run([sys.executable, "-m", "axiform.cli", "run", str(EXAMPLES / "hughes_carnoy_plate.toml"),
-                          "--out", str(tmp_path / "bad"), "-q", "--set", "solver.steps=-1"],
-                         env=env, capture_output=True, text=True, timeout=120)
+    bad = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "axiform.cli",
+            "run",
+            str(EXAMPLES / "hughes_carnoy_plate.toml"),
+            "--out",
+            str(tmp_path / "bad"),
+            "-q",
+            "--set",
+            "solver.steps=-1",
+        ],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert bad.returncode == 2 and "solver.steps" in bad.stderr
 
 

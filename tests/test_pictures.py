@@ -50,59 +50,85 @@ def test_a_tool_stroke_is_on_x_and_a_monitor_that_follows_it_has_no_panel(tmp_pa
     """Die drawing: the punch force on y against the punch travel on x; the node under the
     punch (a straight line against the stroke) is left out and the title says so."""
     lam = np.linspace(0.1, 1.0, 10)
-    rows = [[k + 1, x, 3, -3.0 * x + 0.01 * np.sin(9 * x), -5 * x ** 2] for k, x in enumerate(lam)]
-    info = {"title": "die", "units": {"length": "mm", "force": "N"},
-            "load": {"quantity": "displacement", "value": -3.0, "name": "punch displacement uz"},
-            "monitor_quantities": {"punch_travel": "displacement", "punch_force": "force"},
-            "applied": [{"quantity": "displacement", "value": -3.0, "name": "punch displacement uz"}]}
+    rows = [[k + 1, x, 3, -3.0 * x + 0.01 * np.sin(9 * x), -5 * x**2] for k, x in enumerate(lam)]
+    info = {
+        "title": "die",
+        "units": {"length": "mm", "force": "N"},
+        "load": {"quantity": "displacement", "value": -3.0, "name": "punch displacement uz"},
+        "monitor_quantities": {"punch_travel": "displacement", "punch_force": "force"},
+        "applied": [{"quantity": "displacement", "value": -3.0, "name": "punch displacement uz"}],
+    }
     out = folder(tmp_path, info, ["step", "load_factor", "iterations", "punch_travel", "punch_force"], rows)
     fig = load_curve_figure(out / "history.csv", FolderInfo.read(out))
     (ax,) = panels(fig)
     assert (ax.get_xlabel(), ax.get_ylabel()) == ("punch displacement uz (mm)", "punch_force (N)")
     x, y = ax.lines[0].get_data()
-    assert x[0] == 0 and np.allclose(x[1:], -3.0 * lam) and np.allclose(y[1:], -5 * lam ** 2)
+    assert x[0] == 0 and np.allclose(x[1:], -3.0 * lam) and np.allclose(y[1:], -5 * lam**2)
     assert "punch_travel follows punch displacement uz" in " ".join(fig.get_suptitle().split())
 
 
 def test_a_process_plots_its_panels_against_time_with_the_applied_quantities(tmp_path):
     t = np.linspace(0.1, 2.0, 20)
-    plug = {"quantity": "displacement", "value": -43.0, "name": "plug displacement uz",
-            "curve": [[0, 0], [1, 1], [2, 1]]}
+    plug = {
+        "quantity": "displacement",
+        "value": -43.0,
+        "name": "plug displacement uz",
+        "curve": [[0, 0], [1, 1], [2, 1]],
+    }
     vacuum = {"quantity": "pressure", "value": 0.09, "name": "pressure", "curve": [[0, 0], [1, 0], [2, 1]]}
-    info = {"units": {"length": "mm", "pressure": "MPa", "force": "N", "time": "s"}, "load": vacuum,
-            "monitor_quantities": {"plug_force": "force"}, "applied": [vacuum, plug], "process": True}
-    out = folder(tmp_path, info, ["step", "load_factor", "iterations", "plug_force"],
-                 [[k + 1, x, 3, -x] for k, x in enumerate(t)])
+    info = {
+        "units": {"length": "mm", "pressure": "MPa", "force": "N", "time": "s"},
+        "load": vacuum,
+        "monitor_quantities": {"plug_force": "force"},
+        "applied": [vacuum, plug],
+        "process": True,
+    }
+    out = folder(
+        tmp_path,
+        info,
+        ["step", "load_factor", "iterations", "plug_force"],
+        [[k + 1, x, 3, -x] for k, x in enumerate(t)],
+    )
     fig = load_curve_figure(out / "history.csv", FolderInfo.read(out))
     axes = panels(fig)
     assert {ax.get_xlabel() for ax in axes} == {"time t (s)"}
     assert [ax.get_ylabel() for ax in axes] == ["pressure (MPa)", "plug displacement uz (mm)", "plug_force (N)"]
     x, y = axes[1].lines[0].get_data()
     assert np.allclose(y, -43.0 * np.interp(x, [0, 1, 2], [0, 1, 1]))  # the case's curve, from t = 0
-    assert FolderInfo.read(out).state(20, {"step": np.arange(1, 21), "load_factor": t}).startswith(
-        "step 20, t = 2.00 s, p = 0.0900 MPa")
+    assert (
+        FolderInfo.read(out)
+        .state(20, {"step": np.arange(1, 21), "load_factor": t})
+        .startswith("step 20, t = 2.00 s, p = 0.0900 MPa")
+    )
 
 
 def test_a_case_without_other_monitors_still_has_a_load_curve(tmp_path):
     """The parison: its only monitor is the cavity pressure that carries the load: the pressure
     against the cavity's volume V0 + lambda (V - V0); a plain pressure without monitors: the
     pressure against the load factor."""
-    info = {"units": {"length": "mm", "pressure": "MPa"},
-            "load": {"quantity": "pressure", "monitor": "pressure", "name": "blow pressure"},
-            "monitor_quantities": {"pressure": "pressure"},
-            "applied": [{"quantity": "volume", "value": 86000.0, "name": "blow volume", "cavity": "blow"}],
-            "cavities": {"blow": {"initial_volume": 30000.0}}}
+    info = {
+        "units": {"length": "mm", "pressure": "MPa"},
+        "load": {"quantity": "pressure", "monitor": "pressure", "name": "blow pressure"},
+        "monitor_quantities": {"pressure": "pressure"},
+        "applied": [{"quantity": "volume", "value": 86000.0, "name": "blow volume", "cavity": "blow"}],
+        "cavities": {"blow": {"initial_volume": 30000.0}},
+    }
     (tmp_path / "p").mkdir()
-    out = folder(tmp_path / "p", info, ["step", "load_factor", "iterations", "pressure"],
-                 [[1, 0.5, 3, 0.05], [2, 1.0, 3, 1.3]])
+    out = folder(
+        tmp_path / "p", info, ["step", "load_factor", "iterations", "pressure"], [[1, 0.5, 3, 0.05], [2, 1.0, 3, 1.3]]
+    )
     (ax,) = panels(load_curve_figure(out / "history.csv", FolderInfo.read(out)))
     assert (ax.get_xlabel(), ax.get_ylabel()) == ("blow volume (mm³)", "blow pressure (MPa)")
     assert np.allclose(ax.lines[0].get_data()[0], [58000.0, 86000.0])
     assert load_curve_reason(out / "history.csv", FolderInfo.read(out)) is None
 
     (tmp_path / "q").mkdir()
-    plain = folder(tmp_path / "q", {"load": {"quantity": "pressure", "value": 2.0, "name": "pressure"}},
-                   ["step", "load_factor", "iterations"], [[1, 0.5, 3], [2, 1.0, 3]])
+    plain = folder(
+        tmp_path / "q",
+        {"load": {"quantity": "pressure", "value": 2.0, "name": "pressure"}},
+        ["step", "load_factor", "iterations"],
+        [[1, 0.5, 3], [2, 1.0, 3]],
+    )
     (ax,) = panels(load_curve_figure(plain / "history.csv", FolderInfo.read(plain)))
     assert (ax.get_xlabel(), ax.get_ylabel()) == ("load factor λ", "pressure")
     assert np.allclose(ax.lines[0].get_data()[1], [0.0, 1.0, 2.0])
@@ -116,13 +142,22 @@ def test_plot_folder_says_why_a_picture_is_missing(tmp_path):
     assert any(line.startswith("no deformed.png: ") and "output.vtu" in line for line in made.reasons())
 
 
-@pytest.mark.parametrize("load_", [None, {"quantity": "pressure", "value": 1.0, "name": "pressure"},
-                                   {"quantity": "displacement", "value": 1.0, "name": "fix[0] uz"}])
+@pytest.mark.parametrize(
+    "load_",
+    [
+        None,
+        {"quantity": "pressure", "value": 1.0, "name": "pressure"},
+        {"quantity": "displacement", "value": 1.0, "name": "fix[0] uz"},
+    ],
+)
 def test_no_panel_plots_a_quantity_against_itself(tmp_path, load_):
-    info = {"units": {"length": "mm"}, "load": load_,
-            "monitor_quantities": {"a": "displacement", "b": "force"}}
-    out = folder(tmp_path, info, ["step", "load_factor", "iterations", "a", "b"],
-                 [[k, k / 5, 3, np.sqrt(k), k * k] for k in range(1, 6)])
+    info = {"units": {"length": "mm"}, "load": load_, "monitor_quantities": {"a": "displacement", "b": "force"}}
+    out = folder(
+        tmp_path,
+        info,
+        ["step", "load_factor", "iterations", "a", "b"],
+        [[k, k / 5, 3, np.sqrt(k), k * k] for k in range(1, 6)],
+    )
     for ax in panels(load_curve_figure(out / "history.csv", FolderInfo.read(out))):
         assert ax.get_xlabel() != ax.get_ylabel()
         assert "load factor" not in ax.get_ylabel() or load_ is None  # never a bare load factor when loaded
@@ -135,7 +170,8 @@ def test_thickness_against_the_reference_arc_length_and_z_without_loops(tmp_path
     z = np.r_[np.linspace(0, 5, 6), np.linspace(4, 0, 5)]
     assert [(r.start, r.stop) for r in z_runs(z)] == [(0, 6), (5, 11)]
     table = "s,r,z,thickness,initial_thickness,ratio,first_contact,s_current\n" + "".join(
-        f"{a},1.0,{b},0.5,1.0,0.5,,{2 * a}\n" for a, b in zip(s, z))
+        f"{a},1.0,{b},0.5,1.0,0.5,,{2 * a}\n" for a, b in zip(s, z, strict=False)
+    )
     (tmp_path / "thickness.csv").write_text(table)
     fig = thickness_figure(tmp_path / "thickness.csv", FolderInfo(units={"length": "mm"}))
     a_s, a_z, a_ratio = fig.axes[:3]
@@ -163,8 +199,9 @@ def test_the_hydrostatic_pressure_under_either_name():
     assert np.array_equal(field_values({"pressure": np.ones(2)}, "hydrostatic_pressure", {})[0], np.ones(2))
 
 
-@pytest.mark.parametrize("name", ["hydrostatic_pressure", "cauchy_stress_rr", "cauchy_stress_zz", "cauchy_stress_tt",
-                                  "cauchy_stress_rz"])
+@pytest.mark.parametrize(
+    "name", ["hydrostatic_pressure", "cauchy_stress_rr", "cauchy_stress_zz", "cauchy_stress_tt", "cauchy_stress_rz"]
+)
 def test_the_scalar_stress_fields_have_names_and_units(name):
     """The scalars a VTU file holds (fields.with_components): a name and a unit on the colour bar."""
     label = field_values({name: np.array([1.0, 2.0])}, name, {"pressure": "MPa"})[1]
@@ -181,8 +218,12 @@ def test_sweep_legend_names_what_varies(tmp_path):
 
     case = tmp_path / "c.toml"
     case.write_text("[solver]\nsteps = 40\n[[contact]]\nfriction = 0.3\n")
-    sweep = Sweep(case, ["mesh.element", "solver.steps", "contact[0].friction"],
-                  [{"mesh.element": "q4", "solver.steps": 10}, {"mesh.element": "q8"}], "w")
+    sweep = Sweep(
+        case,
+        ["mesh.element", "solver.steps", "contact[0].friction"],
+        [{"mesh.element": "q4", "solver.steps": 10}, {"mesh.element": "q8"}],
+        "w",
+    )
     cases = with_defaults(sweep)
     assert [c["solver.steps"] for c in cases] == [10, 40] and cases[1]["contact[0].friction"] == 0.3
     assert [legend_label(c, ["solver.steps"]) for c in cases] == ["solver.steps = 10", "solver.steps = 40"]
@@ -211,16 +252,20 @@ def test_sweep_plots_the_peak_of_a_monitor_that_ends_at_zero(tmp_path):
     case.write_text("[[contact]]\nfriction = 0.3\n")
     frictions = [0.1, 0.2, 0.4]
     sweep = Sweep(case, ["contact[0].friction"], [{"contact[0].friction": f} for f in frictions], "plug_force")
-    rows = [{"status": "finished", "monitors": {"plug_force": 0.0},
-             "extremes": {"plug_force": (-100.0 * (1 + f), 5.0)}} for f in frictions]
+    rows = [
+        {"status": "finished", "monitors": {"plug_force": 0.0}, "extremes": {"plug_force": (-100.0 * (1 + f), 5.0)}}
+        for f in frictions
+    ]
     rows.append({"status": "failed"})
     sweep.cases.append({"contact[0].friction": 0.8})
     (ax,) = sweep_figure(sweep, rows).axes
     peak, end = ax.lines
     assert np.allclose(peak.get_xdata(), frictions) and np.allclose(peak.get_ydata(), [-110.0, -120.0, -140.0])
     assert np.allclose(end.get_ydata(), 0.0) and end.get_linestyle() == "--"
-    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["peak (largest |value|) over the run",
-                                                                   "at the end of the run"]
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == [
+        "peak (largest |value|) over the run",
+        "at the end of the run",
+    ]
     assert ax.get_ylabel() == "plug_force: peak over the run and at the end"
     assert "3 of 4 cases finished" in ax.get_title()
 
@@ -250,8 +295,12 @@ def test_post_imports_nothing_above_it():
 
     for path in POST.glob("*.py"):
         tree = ast.parse(path.read_text())
-        typing_only = {id(n) for block in ast.walk(tree) if isinstance(block, ast.If)
-                       and "TYPE_CHECKING" in ast.unparse(block.test) for n in ast.walk(block)}
+        typing_only = {
+            id(n)
+            for block in ast.walk(tree)
+            if isinstance(block, ast.If) and "TYPE_CHECKING" in ast.unparse(block.test)
+            for n in ast.walk(block)
+        }
         for node in ast.walk(tree):
             if id(node) not in typing_only:
                 for name in names(node):

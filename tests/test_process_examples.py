@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from axiform.fem.assembly import element_dofs
 from axiform.case.schema import build, parse, read
 from axiform.cli import main
+from axiform.fem.assembly import element_dofs
 from axiform.fem.elements import gradient_operator
 from axiform.solve.solver import LoadControl, solve
 
@@ -32,8 +32,9 @@ def run_case(name: str, target: float, *sets: str):
     built = build(parse(read(path, list(sets))), path.parent)
     control = built.control
     assert isinstance(control, LoadControl)
-    return built.model, solve(built.model, LoadControl(target, max(1, round(control.steps * target / control.target))),
-                              built.options)
+    return built.model, solve(
+        built.model, LoadControl(target, max(1, round(control.steps * target / control.target))), built.options
+    )
 
 
 def volume_ratio(model, u: np.ndarray) -> float:
@@ -54,9 +55,14 @@ def test_bottle_reaches_the_mould_nearly_everywhere(tmp_path):
     frozen on the mould; the gas law p_abs V = content at the end; the body wall thinned
     to 0.2-0.4 of the parison while the neck stays above 0.8 of it."""
     out = tmp_path / "bottle"
-    sets = ["--set", "mesh.layers=1", "--set", "solver.steps=40", "--set",
-            "mesh.profile=[{arc={center=[0.0,22.0],to=[15.0,22.0],divisions=4}},"
-            "{line={to=[15.0,200.0],divisions=30}}]"]
+    sets = [
+        "--set",
+        "mesh.layers=1",
+        "--set",
+        "solver.steps=40",
+        "--set",
+        "mesh.profile=[{arc={center=[0.0,22.0],to=[15.0,22.0],divisions=4}},{line={to=[15.0,200.0],divisions=30}}]",
+    ]
     assert main(["run", str(EXAMPLES / "bottle_blow_moulding.toml"), "--out", str(out), *sets, *QUIET]) == 0
     contact = rows(out / "contact.csv")
     frozen = [r for r in contact if r["status"] == "sticky"]
@@ -100,13 +106,17 @@ def test_preform_follows_the_stretch_rod():
     rod's travel less the initial gap) less the penetration the penalty leaves, the deepest there,
     within the design's 5 % of the wall (3.5); the gas still at its initial content, so
     almost no pressure."""
-    model, res = run_case("stretch_blow_moulding", 0.06, "mesh.layers=1",
-                          "mesh.profile=[{arc={center=[0.0,115.0],to=[9.0,115.0],divisions=4}},"
-                          "{line={to=[9.0,200.0],divisions=15}}]")
+    model, res = run_case(
+        "stretch_blow_moulding",
+        0.06,
+        "mesh.layers=1",
+        "mesh.profile=[{arc={center=[0.0,115.0],to=[9.0,115.0],divisions=4}},{line={to=[9.0,200.0],divisions=15}}]",
+    )
     assert res.status == "finished"
     u = res.last.u
-    tip = int(np.flatnonzero((np.abs(model.mesh.points[:, 0]) < 1e-9)
-                             & (np.abs(model.mesh.points[:, 1] - 107.75) < 1e-9))[0])
+    tip = int(
+        np.flatnonzero((np.abs(model.mesh.points[:, 0]) < 1e-9) & (np.abs(model.mesh.points[:, 1] - 107.75) < 1e-9))[0]
+    )
     rod = model.contacts[0].report(res.last.state.contacts[0])
     assert rod["gap"][model.contacts[0].nodes == tip][0] == pytest.approx(-rod["penetration"], rel=1e-12)
     assert u[tip * model.dpn + 1] == pytest.approx(-(98.0 * 0.06 / 0.2 - 0.25) + rod["penetration"], abs=1e-6)
@@ -119,9 +129,12 @@ def test_preform_blown_into_the_mould():
     at the end, the 3 MPa blow; the wall frozen on the mould at every slave node but the
     neck's clamped one (the heel of the base included, which the 0.8 MPa of the elastic
     version of this case left open)."""
-    model, res = run_case("stretch_blow_moulding", 0.4, "mesh.layers=1",
-                          "mesh.profile=[{arc={center=[0.0,115.0],to=[9.0,115.0],divisions=4}},"
-                          "{line={to=[9.0,200.0],divisions=15}}]")
+    model, res = run_case(
+        "stretch_blow_moulding",
+        0.4,
+        "mesh.layers=1",
+        "mesh.profile=[{arc={center=[0.0,115.0],to=[9.0,115.0],divisions=4}},{line={to=[9.0,200.0],divisions=15}}]",
+    )
     assert res.status == "finished"
     cavity = res.last.state.cavities[0]
     assert (cavity.pressure + 0.1) * cavity.volume == pytest.approx(1700000.0, rel=1e-6)
@@ -139,9 +152,13 @@ def test_coarse_straight_edged_preform_passes_the_pre_blow(element):
     mid-point guard of the straight edges holds the edge's mid-point (eq. 3 for SFR) less
     than half the preform's wall (3.5) inside the rod's tip (radius 5, centre at
     z = 113 - 98 t / 0.2); measured 0.44 (Q4) and 0.76 (SFR)."""
-    model, res = run_case("stretch_blow_moulding", 0.07, "mesh.layers=1", f"mesh.element={element}",
-                          "mesh.profile=[{arc={center=[0.0,115.0],to=[9.0,115.0],divisions=4}},"
-                          "{line={to=[9.0,200.0],divisions=15}}]")
+    model, res = run_case(
+        "stretch_blow_moulding",
+        0.07,
+        "mesh.layers=1",
+        f"mesh.element={element}",
+        "mesh.profile=[{arc={center=[0.0,115.0],to=[9.0,115.0],divisions=4}},{line={to=[9.0,200.0],divisions=15}}]",
+    )
     assert res.status == "finished"
     rod = model.contacts[0]
     a, b = rod.edges[:, 0], rod.edges[:, 1]
@@ -165,8 +182,24 @@ def test_the_cold_mould_cools_the_skin_it_touches_and_stays_between_its_temperat
     capacity keeps backward Euler between them); the thinnest wall is the bottom corner,
     which the vacuum reaches last, still hot."""
     out = tmp_path / "out"
-    assert main(["run", str(EXAMPLES / "cup_cold_mould.toml"), "--out", str(out), "-q", "--set", "mesh.divisions=[50,2]",
-                 "--set", "output.plots=false", "--set", "output.vtu=false"]) == 0
+    assert (
+        main(
+            [
+                "run",
+                str(EXAMPLES / "cup_cold_mould.toml"),
+                "--out",
+                str(out),
+                "-q",
+                "--set",
+                "mesh.divisions=[50,2]",
+                "--set",
+                "output.plots=false",
+                "--set",
+                "output.vtu=false",
+            ]
+        )
+        == 0
+    )
     summary = json.loads((out / "summary.json").read_text())
     T = summary["temperature"]
     assert 40.0 <= T["min"] < 60.0 and T["max"] <= 150.0 + 1e-9

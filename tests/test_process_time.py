@@ -14,6 +14,7 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 import pytest
+from conftest import RELAXING_BAR
 
 import axiform.solve.solver as solver
 from axiform.app.console import COLUMNS
@@ -24,12 +25,14 @@ from axiform.io.files import series_times
 from axiform.post.labels import case_labels
 from axiform.post.load_curve_plot import load_curve_figure
 from axiform.post.results_folder import FolderInfo, read_history
-from conftest import RELAXING_BAR
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 # the bar of test_viscoelastic, stretched in 1 ms and held to t = 1 s, its end force monitored
-BAR = 'title = "relaxing bar"\n' + RELAXING_BAR.replace("steps = 10", "steps = 8") + """
+BAR = (
+    'title = "relaxing bar"\n'
+    + RELAXING_BAR.replace("steps = 10", "steps = 8")
+    + """
 [[monitor]]
 name = "force"
 reaction = { z = 1.0 }
@@ -43,6 +46,7 @@ length = "mm"
 force = "N"
 time = "s"
 """
+)
 
 
 def history_rows(folder: Path) -> list[dict[str, str]]:
@@ -52,7 +56,9 @@ def history_rows(folder: Path) -> list[dict[str, str]]:
 
 def pvd(folder: Path) -> list[tuple[float, str]]:
     """(timestep, file) of every DataSet of fields.pvd, in the file's order."""
-    return [(float(d.get("timestep")), d.get("file")) for d in ET.parse(folder / "fields.pvd").getroot().iter("DataSet")]
+    return [
+        (float(d.get("timestep")), d.get("file")) for d in ET.parse(folder / "fields.pvd").getroot().iter("DataSet")
+    ]
 
 
 @pytest.fixture(scope="module")
@@ -90,7 +96,9 @@ def test_the_series_timesteps_are_the_times_of_the_written_steps(bar_run):
     steps = [int(Path(f).stem.split("_")[-1]) for _, f in series]
     assert steps == [n for n in range(1, len(rows) + 1) if n % 3 == 0] + ([len(rows)] if len(rows) % 3 else [])
     assert [t for t, _ in series] == [float(rows[n - 1]["time"]) for n in steps]
-    assert all(a < b for (a, _), (b, _) in zip(series, series[1:]))  # a reader ordering by time keeps the order
+    assert all(
+        a < b for (a, _), (b, _) in zip(series, series[1:], strict=False)
+    )  # a reader ordering by time keeps the order
 
 
 def test_a_series_whose_time_goes_back_is_numbered_by_steps():
@@ -104,7 +112,7 @@ def test_the_progress_line_of_a_viscoelastic_case_says_t_in_seconds(bar_run):
     _, out, lines = bar_run
     rows = history_rows(out)
     assert len(lines) == len(rows)
-    for line, row in zip(lines, rows):
+    for line, row in zip(lines, rows, strict=False):
         words = line.split()
         assert words[2:5] == ["t", f"{float(row['time']):.4g}", "s"] and words[5] == "its", line
         assert len(line) <= COLUMNS
@@ -112,8 +120,11 @@ def test_the_progress_line_of_a_viscoelastic_case_says_t_in_seconds(bar_run):
 
 def test_without_a_time_unit_the_progress_says_t_alone(tmp_path, capsys):
     case = tmp_path / "bar.toml"
-    case.write_text(BAR.replace('time = "s"\n', "").replace("steps = 8", "steps = 2").replace(
-        "curve = [[0.0, 0.0], [0.001, 1.0], [1.0, 1.0]]\n", ""))
+    case.write_text(
+        BAR.replace('time = "s"\n', "")
+        .replace("steps = 8", "steps = 2")
+        .replace("curve = [[0.0, 0.0], [0.001, 1.0], [1.0, 1.0]]\n", "")
+    )
     assert main(["run", str(case), "--out", str(tmp_path / "out"), "--set", "output.plots=false"]) == 0
     lines = [line for line in capsys.readouterr().out.splitlines() if line.startswith("step ")]
     assert [line.split()[2:5] for line in lines] == [["t", "0.5", "its"], ["t", "1", "its"]]
@@ -144,9 +155,14 @@ def test_a_process_has_a_panel_per_applied_quantity_on_one_t_axis(tmp_path):
     the rod's stroke applied, the pressure and volume of the gas and the rod force results."""
     labels = case_labels(load(EXAMPLES / "stretch_blow_moulding.toml"))
     gas, rod = labels["applied"]
-    assert gas == {"quantity": "content", "value": 1700000.0, "name": "bottle gas content p·V",
-                   "curve": [[0.0, 0.0], [0.06, 0.0], [0.2, 0.12], [0.3, 1.0], [0.4, 1.0]], "cavity": "bottle",
-                   "ambient": 0.1}
+    assert gas == {
+        "quantity": "content",
+        "value": 1700000.0,
+        "name": "bottle gas content p·V",
+        "curve": [[0.0, 0.0], [0.06, 0.0], [0.2, 0.12], [0.3, 1.0], [0.4, 1.0]],
+        "cavity": "bottle",
+        "ambient": 0.1,
+    }
     assert rod["name"] == "rod displacement uz" and labels["process"] and labels["real_time"]
     t = np.array([0.1, 0.2, 0.3, 0.4])
     summary = {**labels, "title": "blow", "cavities": {"bottle": {"initial_volume": 1000.0}}}
@@ -156,9 +172,14 @@ def test_a_process_has_a_panel_per_applied_quantity_on_one_t_axis(tmp_path):
     (tmp_path / "history.csv").write_text("\n".join(",".join(map(str, r)) for r in [header, *rows]) + "\n")
     fig = load_curve_figure(tmp_path / "history.csv", FolderInfo.read(tmp_path))
     axes = [ax for ax in fig.axes if ax.get_visible()]
-    assert [ax.get_ylabel() for ax in axes] == ["bottle gas content p·V (MPa·mm³)", "rod displacement uz (mm)",
-                                               "blow_pressure (MPa)", "air_volume (mm³)", "rod_force (N)",
-                                               "mould_area (mm²)"]
+    assert [ax.get_ylabel() for ax in axes] == [
+        "bottle gas content p·V (MPa·mm³)",
+        "rod displacement uz (mm)",
+        "blow_pressure (MPa)",
+        "air_volume (mm³)",
+        "rod_force (N)",
+        "mould_area (mm²)",
+    ]
     assert all(ax.get_xlabel() == "time t (s)" for ax in axes)
     assert all(ax.get_shared_x_axes().joined(axes[0], ax) for ax in axes)
     content = axes[0].lines[0]
@@ -182,6 +203,7 @@ def test_a_resumed_run_writes_the_same_history_and_series(bar_run, tmp_path, mon
             on_step(s)
             if s.number == 4:
                 os.kill(os.getpid(), signal.SIGTERM)
+
         return real_solve(model, control, options, on_step=step, keep=keep, resume=resume)
 
     monkeypatch.setattr(solver, "solve", interrupted)
@@ -195,15 +217,18 @@ def test_a_resumed_run_writes_the_same_history_and_series(bar_run, tmp_path, mon
     assert main(["run", str(case), "--resume", str(out), "-q", "--set", "output.plots=false"]) == 0
     assert (out / "history.csv").read_text() == (full / "history.csv").read_text()
     times = {f"fields/step_{int(r['step']):04d}.vtu": float(r["time"]) for r in history_rows(full)}
-    assert sorted(pvd(out), key=lambda e: e[1]) == sorted([*pvd(full), (times["fields/step_0004.vtu"],
-                                                                        "fields/step_0004.vtu")], key=lambda e: e[1])
+    assert sorted(pvd(out), key=lambda e: e[1]) == sorted(
+        [*pvd(full), (times["fields/step_0004.vtu"], "fields/step_0004.vtu")], key=lambda e: e[1]
+    )
     assert [t for t, _ in pvd(out)] == sorted(times[f] for _, f in pvd(out))
 
 
 def test_time_is_no_monitor_name_and_no_monitor_of_a_sweep(tmp_path):
-    data = {"mesh": {"kind": "rectangle", "r": [0.0, 1.0], "z": [0.0, 1.0], "divisions": [1, 1]},
-            "material": {"model": "neo-hooke", "C1": 0.5, "kappa": 50.0},
-            "monitor": [{"name": "time", "at": {"r": 0.0, "z": 1.0}, "dof": "uz"}]}
+    data = {
+        "mesh": {"kind": "rectangle", "r": [0.0, 1.0], "z": [0.0, 1.0], "divisions": [1, 1]},
+        "material": {"model": "neo-hooke", "C1": 0.5, "kappa": 50.0},
+        "monitor": [{"name": "time", "at": {"r": 0.0, "z": 1.0}, "dof": "uz"}],
+    }
     with pytest.raises(Exception, match="monitor.*'time'.*one of the columns step, load_factor, time, iterations"):
         parse(data)
     (tmp_path / "history.csv").write_text("step,load_factor,time,iterations,w\n1,0.5,0.5,3,-1.0\n2,1.0,1.0,4,-3.0\n")

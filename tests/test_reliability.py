@@ -39,11 +39,25 @@ def summary(folder: Path) -> dict:
 
 # ---- stops ---------------------------------------------------------------------------------
 
+
 def _start(out: Path, *extra: str) -> subprocess.Popen:
     """The plate in 400 steps (about 20 s), field output every step, as a separate process."""
     env = {**os.environ, "PYTHONPATH": str(SRC)}
-    cmd = [sys.executable, "-m", "axiform.cli", "run", str(PLATE), "--out", str(out), "--set", "solver.steps=400",
-           "--set", "output.plots=false", "-q", *extra]
+    cmd = [
+        sys.executable,
+        "-m",
+        "axiform.cli",
+        "run",
+        str(PLATE),
+        "--out",
+        str(out),
+        "--set",
+        "solver.steps=400",
+        "--set",
+        "output.plots=false",
+        "-q",
+        *extra,
+    ]
     return subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
@@ -121,6 +135,7 @@ def test_an_unexpected_error_sets_failed_and_exit_3(tmp_path, monkeypatch, capsy
 
 # ---- the command line ---------------------------------------------------------------------
 
+
 def test_set_without_out_never_replaces_another_case(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     quick = ["--set", "solver.steps=4", "--set", "output.plots=false", "--set", "output.vtu=false"]
@@ -136,8 +151,7 @@ def test_set_without_out_never_replaces_another_case(tmp_path, monkeypatch, caps
     assert {p.name: p.read_bytes() for p in plain.iterdir() if p.is_file()} == before
     # the same case text again (the overrides in another order) goes back to its own folder
     assert main(["run", str(PLATE), "-q", "--set", "solver.target=4.0", *quick]) == 0
-    assert sorted(p.name for p in (tmp_path / "results").iterdir()) == ["hughes_carnoy_plate",
-                                                                       "hughes_carnoy_plate-2"]
+    assert sorted(p.name for p in (tmp_path / "results").iterdir()) == ["hughes_carnoy_plate", "hughes_carnoy_plate-2"]
 
 
 def test_quiet_prints_one_line_and_progress_goes_line_by_line(tmp_path, capsys):
@@ -156,8 +170,11 @@ def test_help_describes_the_arguments(command, capsys):
     with pytest.raises(SystemExit):
         main([command, "--help"])
     out = capsys.readouterr().out
-    assert ("the case file (TOML)" in out and "KEY=VALUE" in out) if command == "check" else (
-        "a results folder" in out and "--field" in out and "von_mises" in out)
+    assert (
+        ("the case file (TOML)" in out and "KEY=VALUE" in out)
+        if command == "check"
+        else ("a results folder" in out and "--field" in out and "von_mises" in out)
+    )
 
 
 # ---- bad input: refused with the key path ----------------------------------------------------
@@ -196,18 +213,24 @@ def test_bad_values_are_refused_by_check(sets, message, capsys):
 @pytest.mark.parametrize("value, code", [(0.0, 0), (0.01, 2)])
 def test_two_fixes_of_one_dof_must_agree(tmp_path, value, code, capsys):
     case = tmp_path / "twice.toml"
-    case.write_text(PLATE.read_text().replace("[[pressure]]", "[[fix]]\nat = { r = 7.5, z = 0.0 }\n"
-                                              f"dofs = [\"uz\"]\nvalue = {value}\n\n[[pressure]]"))
+    case.write_text(
+        PLATE.read_text().replace(
+            "[[pressure]]", f'[[fix]]\nat = {{ r = 7.5, z = 0.0 }}\ndofs = ["uz"]\nvalue = {value}\n\n[[pressure]]'
+        )
+    )
     assert main(["check", str(case)]) == code
     if code:
-        assert "fix[2].value: uz of node 60 is also prescribed by fix[0], with value 0.0, not 0.01" in \
-            capsys.readouterr().err
+        assert (
+            "fix[2].value: uz of node 60 is also prescribed by fix[0], with value 0.0, not 0.01"
+            in capsys.readouterr().err
+        )
 
 
 def test_arc_length_and_stop_values_must_be_finite(tmp_path, capsys):
-    text = PLATE.read_text().replace('control = "displacement"\ndof = { at = { r = 0.0, z = 0.5 }, dof = "uz" }',
-                                     'control = "arc-length"\narc_length = inf\nstop = { at = { r = 0.0, z = 0.5 }, '
-                                     'dof = "uz", value = nan }')
+    text = PLATE.read_text().replace(
+        'control = "displacement"\ndof = { at = { r = 0.0, z = 0.5 }, dof = "uz" }',
+        'control = "arc-length"\narc_length = inf\nstop = { at = { r = 0.0, z = 0.5 }, dof = "uz", value = nan }',
+    )
     case = tmp_path / "arc.toml"
     case.write_text(text)
     assert main(["check", str(case)]) == 2
@@ -219,20 +242,23 @@ def test_arc_length_and_stop_values_must_be_finite(tmp_path, capsys):
 MOULD = EXAMPLES / "toric_plate.toml"
 
 
-@pytest.mark.parametrize("surface, message", [
-    ("{ polyline = [[0.0, 1.0], [nan, 2.0]] }", "contact[0].surface.polyline[1][0]: must be a finite number"),
-    ("{ circle = { center = [4.5, 3.0], radius = inf } }", "contact[0].surface.circle.radius: must be a finite"),
-    ("{ polyline = [[0.0, 1.0], [4.0, 2.0], [4.0, 1.0], [2.0, 3.0]] }", "contact[0].surface: the outline crosses"),
-    ("{ polyline = [[0.0, 1.0], [4.0, 1.0], [2.0, 1.0]] }", "contact[0].surface: the outline crosses or runs back"),
-    ("{ file = \"text.csv\" }", "contact[0].surface.file: cannot read"),
-    ("{ file = \"nan.csv\" }", "contact[0].surface.file:"),
-])
+@pytest.mark.parametrize(
+    "surface, message",
+    [
+        ("{ polyline = [[0.0, 1.0], [nan, 2.0]] }", "contact[0].surface.polyline[1][0]: must be a finite number"),
+        ("{ circle = { center = [4.5, 3.0], radius = inf } }", "contact[0].surface.circle.radius: must be a finite"),
+        ("{ polyline = [[0.0, 1.0], [4.0, 2.0], [4.0, 1.0], [2.0, 3.0]] }", "contact[0].surface: the outline crosses"),
+        ("{ polyline = [[0.0, 1.0], [4.0, 1.0], [2.0, 1.0]] }", "contact[0].surface: the outline crosses or runs back"),
+        ('{ file = "text.csv" }', "contact[0].surface.file: cannot read"),
+        ('{ file = "nan.csv" }', "contact[0].surface.file:"),
+    ],
+)
 def test_bad_moulds_are_refused(tmp_path, surface, message, capsys):
     (tmp_path / "text.csv").write_text("0.0, 1.0\nabc, 2.0\n")
     (tmp_path / "nan.csv").write_text("0.0, 1.0\nnan, 2.0\n")
     text = MOULD.read_text()
     start = text.index("surface = ")
-    text = text[:start] + f"surface = {surface}" + text[text.index("\n", start):]
+    text = text[:start] + f"surface = {surface}" + text[text.index("\n", start) :]
     (tmp_path / "mould.toml").write_text(text)
     assert main(["check", str(tmp_path / "mould.toml")]) == 2
     err = capsys.readouterr().err
@@ -247,20 +273,37 @@ def test_mould_depth_and_motion_must_be_finite(tmp_path, key, capsys):
 
 
 def test_penalty_and_friction_must_be_finite(capsys):
-    assert main(["check", str(EXAMPLES / "die_drawing.toml"), "--set", "contact[0].penalty=inf",
-                 "--set", "contact[1].friction=nan"]) == 2
+    assert (
+        main(
+            [
+                "check",
+                str(EXAMPLES / "die_drawing.toml"),
+                "--set",
+                "contact[0].penalty=inf",
+                "--set",
+                "contact[1].friction=nan",
+            ]
+        )
+        == 2
+    )
     err = capsys.readouterr().err
     assert "contact[0].penalty: must be a finite number" in err and "contact[1].friction: must be a finite" in err
 
 
 def test_a_layered_profile_that_crosses_itself_is_refused(tmp_path, capsys):
     case = tmp_path / "loop.toml"
-    case.write_text(PLATE.read_text().split("[[fix]]")[0].replace(
-        'kind = "rectangle"\nr = [0.0, 7.5]          # in\nz = [0.0, 0.5]\ndivisions = [20, 2]     # [radial, axial]',
-        'kind = "layered"\nstart = [1.0, 0.0]\nthickness = 0.1\nlayers = 1\nprofile = [\n'
-        '  { line = { to = [3.0, 0.0], divisions = 4 } },\n  { line = { to = [3.0, 2.0], divisions = 4 } },\n'
-        '  { line = { to = [2.0, 2.0], divisions = 2 } },\n  { line = { to = [2.0, -1.0], divisions = 6 } },\n]')
-        + '[[fix]]\nat = { set = "start" }\ndofs = ["ur", "uz"]\n[[pressure]]\non = { set = "inner" }\nvalue = 1.0\n')
+    case.write_text(
+        PLATE.read_text()
+        .split("[[fix]]")[0]
+        .replace(
+            'kind = "rectangle"\nr = [0.0, 7.5]          # in\nz = [0.0, 0.5]\n'
+            "divisions = [20, 2]     # [radial, axial]",
+            'kind = "layered"\nstart = [1.0, 0.0]\nthickness = 0.1\nlayers = 1\nprofile = [\n'
+            "  { line = { to = [3.0, 0.0], divisions = 4 } },\n  { line = { to = [3.0, 2.0], divisions = 4 } },\n"
+            "  { line = { to = [2.0, 2.0], divisions = 2 } },\n  { line = { to = [2.0, -1.0], divisions = 6 } },\n]",
+        )
+        + '[[fix]]\nat = { set = "start" }\ndofs = ["ur", "uz"]\n[[pressure]]\non = { set = "inner" }\nvalue = 1.0\n'
+    )
     assert main(["check", str(case)]) == 2
     assert "mesh: the boundary crosses itself" in capsys.readouterr().err
 
@@ -300,17 +343,23 @@ def test_output_folders_that_cannot_be(tmp_path, capsys):
     assert (tmp_path / "file").read_text() == ""
 
 
-@pytest.mark.parametrize("name, content, message", [
-    ("missing.msh", None, "mesh.file: no such file"),
-    ("empty.msh", "", "mesh.file: cannot read"),
-    ("corrupt.msh", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\ngarbage\n", "mesh.file: cannot read"),
-    ("binary.msh", bytes(range(256)), "mesh.file: cannot read"),
-    ("triangles.msh", "tri", "mesh.file:"),
-])
+@pytest.mark.parametrize(
+    "name, content, message",
+    [
+        ("missing.msh", None, "mesh.file: no such file"),
+        ("empty.msh", "", "mesh.file: cannot read"),
+        ("corrupt.msh", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\ngarbage\n", "mesh.file: cannot read"),
+        ("binary.msh", bytes(range(256)), "mesh.file: cannot read"),
+        ("triangles.msh", "tri", "mesh.file:"),
+    ],
+)
 def test_gmsh_files_that_cannot_be_used(tmp_path, name, content, message, capfd):
     if content == "tri":
-        meshio.write(tmp_path / name, meshio.Mesh(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]]),
-                                                  [("triangle", np.array([[0, 1, 2]]))]), file_format="gmsh22")
+        meshio.write(
+            tmp_path / name,
+            meshio.Mesh(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]]), [("triangle", np.array([[0, 1, 2]]))]),
+            file_format="gmsh22",
+        )
     elif isinstance(content, bytes):
         (tmp_path / name).write_bytes(content)
     elif content is not None:
@@ -339,6 +388,7 @@ def test_plot_refuses_unreadable_history_and_unknown_fields(tmp_path, capsys):
 
 
 # ---- guarded numerics -----------------------------------------------------------------------
+
 
 def test_a_mechanism_never_converges_through_the_python_api():
     """Without the case file's check (free_to_slide), the solver meets the free rigid

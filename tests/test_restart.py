@@ -23,10 +23,18 @@ PUNCH = {
     "mesh": {"kind": "rectangle", "r": [0.0, 10.0], "z": [0.0, 2.0], "divisions": [10, 2], "element": "q4"},
     "material": {"model": "neo-hooke", "C1": 0.5, "kappa": 50.0},
     "fix": [{"at": {"z": 0.0}, "dofs": ["uz"]}, {"at": {"r": 0.0}, "dofs": ["ur"]}],
-    "contact": [{"surface": {"circle": {"center": [0.0, 7.0], "radius": 5.0}}, "slaves": {"z": 2.0},
-                 "sticky": True, "motion": {"uz": -0.8}}],
-    "monitor": [{"name": "w", "at": {"r": 0.0, "z": 2.0}, "dof": "uz"},
-                {"name": "force", "contact": 0, "quantity": "force-z"}],
+    "contact": [
+        {
+            "surface": {"circle": {"center": [0.0, 7.0], "radius": 5.0}},
+            "slaves": {"z": 2.0},
+            "sticky": True,
+            "motion": {"uz": -0.8},
+        }
+    ],
+    "monitor": [
+        {"name": "w", "at": {"r": 0.0, "z": 2.0}, "dof": "uz"},
+        {"name": "force", "contact": 0, "quantity": "force-z"},
+    ],
     "solver": {"control": "load", "steps": 8},
     "output": {"vtu": False, "plots": False},
 }
@@ -37,12 +45,18 @@ PLATE = {
     "fix": [{"at": {"r": 7.5}, "dofs": ["ur", "uz", "rot"]}, {"at": {"r": 0.0}, "dofs": ["ur"]}],
     "pressure": [{"on": {"z": 0.0}, "value": 1.0}],
     "monitor": [{"name": "w", "at": {"r": 0.0, "z": 0.5}, "dof": "uz"}],
-    "solver": {"control": "displacement", "dof": {"at": {"r": 0.0, "z": 0.5}, "dof": "uz"}, "target": 6.0,
-               "steps": 10},
+    "solver": {"control": "displacement", "dof": {"at": {"r": 0.0, "z": 0.5}, "dof": "uz"}, "target": 6.0, "steps": 10},
     "output": {"vtu": False, "plots": False},
 }
-ARC = {**PLATE, "solver": {"control": "arc-length", "target": 100.0, "steps": 20,
-                           "stop": {"at": {"r": 0.0, "z": 0.5}, "dof": "uz", "value": 8.0}}}
+ARC = {
+    **PLATE,
+    "solver": {
+        "control": "arc-length",
+        "target": 100.0,
+        "steps": 20,
+        "stop": {"at": {"r": 0.0, "z": 0.5}, "dof": "uz", "value": 8.0},
+    },
+}
 
 
 class Stop(Exception):
@@ -69,7 +83,7 @@ def test_resumed_steps_equal_the_uninterrupted_run(case, tmp_path):
     rest = solve(*_model(case), resume=state)
     assert rest.status == "finished"
     assert [s.number for s in rest.steps] == [s.number for s in full.steps[k:]]
-    for a, b in zip(rest.steps, full.steps[k:]):
+    for a, b in zip(rest.steps, full.steps[k:], strict=False):
         assert a.lam == pytest.approx(b.lam, rel=1e-12, abs=1e-14)
         assert a.iterations == b.iterations
         np.testing.assert_allclose(a.u, b.u, rtol=1e-10, atol=1e-12 * np.abs(b.u).max())
@@ -117,6 +131,7 @@ def test_axiform_run_resume_gives_the_same_history(tmp_path, monkeypatch):
             on_step(s)
             if s.number == 5:
                 os.kill(os.getpid(), signal.SIGTERM)
+
         return real_solve(model, control, options, on_step=step, keep=keep, resume=resume)
 
     monkeypatch.setattr(solver, "solve", interrupted)  # axiform run imports it when it runs

@@ -33,10 +33,18 @@ def ring_case() -> dict:
         "material": {"model": "neo-hooke", "C1": 0.5, "kappa": 1000.0},
         "contact": [
             {"name": "lower", "surface": {"polyline": [[10.0, 0.0], [30.0, 0.0]]}, "slaves": {"z": 0.0}},
-            {"name": "upper", "surface": {"polyline": [[30.0, H + 1.0], [10.0, H + 1.0]]}, "slaves": {"z": H},
-             "motion": {"uz": -2.2}},
-            {"name": "far", "surface": {"polyline": [[40.0, -1.0], [40.0, H + 1.0]]}, "slaves": {"r": B},
-             "stabilization": 0.0},
+            {
+                "name": "upper",
+                "surface": {"polyline": [[30.0, H + 1.0], [10.0, H + 1.0]]},
+                "slaves": {"z": H},
+                "motion": {"uz": -2.2},
+            },
+            {
+                "name": "far",
+                "surface": {"polyline": [[40.0, -1.0], [40.0, H + 1.0]]},
+                "slaves": {"r": B},
+                "stabilization": 0.0,
+            },
         ],
         "solver": {"control": "load", "steps": 4},
     }
@@ -67,8 +75,11 @@ def test_the_warnings_of_a_run(ring_run):
     out, _, result, _, err = ring_run
     assert result.status == "finished"
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["warnings"] == ["a pre-run warning", "said during the run",
-                                   'contact[2] ("far") never touched the body']
+    assert summary["warnings"] == [
+        "a pre-run warning",
+        "said during the run",
+        'contact[2] ("far") never touched the body',
+    ]
     # printed at the end, once each; the pre-run ones were printed by the caller
     assert err.splitlines() == ["warning: said during the run", 'warning: contact[2] ("far") never touched the body']
 
@@ -86,7 +97,8 @@ def test_the_run_maxima_and_the_stabilization(ring_run):
     stab = summary["stabilization"]
     work = sum(held.damping_work for held in result.last.state.contacts)
     assert stab["work"] == pytest.approx(work) and stab["strain_energy"] == pytest.approx(
-        model.strain_energy(result.last.u))
+        model.strain_energy(result.last.u)
+    )
     assert 0 < stab["ratio"] < 0.01  # no warning
     # the thinnest wall: the ring's height through z (a rectangle's wall), squeezed to about 70 %,
     # the same at every r (frictionless plates squeeze the ring homogeneously): the thinnest is
@@ -128,8 +140,7 @@ def fake_model(stabilization=0.0, energy=1.0):
 
 
 def report(nodes, gap, status):
-    return {"node": nodes, "gap": np.asarray(gap, float), "status": np.asarray(status), "force_r": 1.0,
-            "force_z": -2.0}
+    return {"node": nodes, "gap": np.asarray(gap, float), "status": np.asarray(status), "force_r": 1.0, "force_z": -2.0}
 
 
 def test_a_penetration_above_5_percent_of_the_wall_is_a_warning():
@@ -168,14 +179,27 @@ def test_stabilization_work_above_1_percent_of_the_strain_energy_is_a_warning():
 
 def test_the_units_of_the_csv_columns_are_in_the_summary():
     """The headers stay bare names (every reader keys on them); summary.json maps them to units."""
-    units = column_units({"units": {"length": "mm", "pressure": "MPa", "force": "N"},
-                          "monitor_quantities": {"travel": "displacement", "F": "force", "A": "area",
-                                                 "phi": "rotation", "V": "volume", "p": "pressure"}})
+    units = column_units(
+        {
+            "units": {"length": "mm", "pressure": "MPa", "force": "N"},
+            "monitor_quantities": {
+                "travel": "displacement",
+                "F": "force",
+                "A": "area",
+                "phi": "rotation",
+                "V": "volume",
+                "p": "pressure",
+            },
+        }
+    )
     assert units["history.csv"] == {"travel": "mm", "F": "N", "A": "mm^2", "phi": "rad", "V": "mm^3", "p": "MPa"}
     assert units["thickness.csv"]["thickness"] == "mm" and "ratio" not in units["thickness.csv"]
     assert units["contact.csv"] == {"r": "mm", "z": "mm", "gap": "mm", "pressure": "MPa"}
     assert column_units({"units": {}, "monitor_quantities": {"F": "force"}}) == {
-        "history.csv": {}, "thickness.csv": {}, "contact.csv": {}}
+        "history.csv": {},
+        "thickness.csv": {},
+        "contact.csv": {},
+    }
 
 
 def test_a_resumed_run_keeps_the_maxima_of_its_first_part(tmp_path):

@@ -9,16 +9,21 @@ import copy
 import numpy as np
 import pytest
 
-from axiform.case.schema import build, parse
 from axiform.app.sensitivity import DesignError, sensitivity
-from axiform.solve.solver import ArcLengthControl, NewtonOptions, solve
+from axiform.case.schema import build, parse
 from axiform.post.thickness import thickness_table
+from axiform.solve.solver import ArcLengthControl, NewtonOptions, solve
 
 TUBE = {
     "title": "tube",
-    "mesh": {"kind": "layered", "element": "q4", "start": [10.0, 0.0],
-             "profile": [{"line": {"to": [10.0, 12.0], "divisions": 6}}],
-             "thickness": [[0.0, 1.0], [6.0, 1.2], [12.0, 0.9]], "layers": 1},
+    "mesh": {
+        "kind": "layered",
+        "element": "q4",
+        "start": [10.0, 0.0],
+        "profile": [{"line": {"to": [10.0, 12.0], "divisions": 6}}],
+        "thickness": [[0.0, 1.0], [6.0, 1.2], [12.0, 0.9]],
+        "layers": 1,
+    },
     "material": {"model": "neo-hooke", "C1": 0.1, "kappa": 100.0},
     "fix": [{"at": {"set": "start"}, "dofs": ["uz"]}, {"at": {"set": "end"}, "dofs": ["uz"]}],
     "cavity": [{"name": "gas", "boundary": {"set": "inner"}, "control": "volume", "volume": 6000.0}],
@@ -43,8 +48,9 @@ def tube(formulation="mixed", element="q4", contact=None, volume=6000.0):
 def builder(tree):
     def model(x):
         t = copy.deepcopy(tree)
-        t["mesh"]["thickness"] = [[row[0], float(v)] for row, v in zip(tree["mesh"]["thickness"], x)]
+        t["mesh"]["thickness"] = [[row[0], float(v)] for row, v in zip(tree["mesh"]["thickness"], x, strict=False)]
         return build(parse(t)).model
+
     return model
 
 
@@ -54,8 +60,11 @@ def forward(model, control, options, lams):
     u = result.last.u.reshape(-1, model.dpn)[:, :2]
     table = thickness_table(model.mesh, u)
     held = result.last.state
-    return (table["thickness"], held.cavities[0].pressure,
-            [p.report(s)["status"] for p, s in zip(model.contacts, held.contacts)])
+    return (
+        table["thickness"],
+        held.cavities[0].pressure,
+        [p.report(s)["status"] for p, s in zip(model.contacts, held.contacts, strict=False)],
+    )
 
 
 def check_against_forward_differences(tree, rel=1e-5):
@@ -72,7 +81,7 @@ def check_against_forward_differences(tree, rel=1e-5):
         e[k] = h
         tp, pp, cp = forward(make(x0 + e), built.control, built.options, lams)
         tm, pm, cm = forward(make(x0 - e), built.control, built.options, lams)
-        for a, b in zip(cp, cm):  # the contact set does not change between the two
+        for a, b in zip(cp, cm, strict=False):  # the contact set does not change between the two
             assert np.array_equal(a, b)
         fd = (tp - tm) / (2 * h)
         err = np.abs(sens.dthickness_ds[:, k] - fd).max() / np.abs(fd).max()

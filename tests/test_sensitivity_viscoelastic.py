@@ -24,9 +24,14 @@ REL = 1e-6  # measured: 2e-9 (volume control) to 5e-8 (pressure control)
 PRONY = {"g": [0.5, 0.3], "tau": [0.1, 1.0]}
 TUBE = {
     "title": "viscoelastic tube",
-    "mesh": {"kind": "layered", "element": "q4", "start": [10.0, 0.0],
-             "profile": [{"line": {"to": [10.0, 12.0], "divisions": 6}}],
-             "thickness": [[0.0, 1.0], [6.0, 1.2], [12.0, 0.9]], "layers": 1},
+    "mesh": {
+        "kind": "layered",
+        "element": "q4",
+        "start": [10.0, 0.0],
+        "profile": [{"line": {"to": [10.0, 12.0], "divisions": 6}}],
+        "thickness": [[0.0, 1.0], [6.0, 1.2], [12.0, 0.9]],
+        "layers": 1,
+    },
     "material": {"model": "neo-hooke", "C1": 0.1, "kappa": 100.0, "viscoelastic": PRONY},
     "fix": [{"at": {"set": "start"}, "dofs": ["uz"]}, {"at": {"set": "end"}, "dofs": ["uz"]}],
     # the differences need the same path: steps of a fixed length (no growth)
@@ -50,8 +55,9 @@ def tube(control: str, formulation: str, element: str, viscoelastic: bool = True
 def builder(tree):
     def model(x):
         t = copy.deepcopy(tree)
-        t["mesh"]["thickness"] = [[row[0], float(v)] for row, v in zip(tree["mesh"]["thickness"], x)]
+        t["mesh"]["thickness"] = [[row[0], float(v)] for row, v in zip(tree["mesh"]["thickness"], x, strict=False)]
         return build(parse(t)).model
+
     return model
 
 
@@ -71,8 +77,11 @@ def forward(model, built, times):
     result = solve(model, built.control, built.options)
     assert [s.lam for s in result.steps] == pytest.approx(times, abs=1e-12)  # the same path
     u = result.last.u
-    return thickness_table(model.mesh, u.reshape(-1, model.dpn)[:, :2])["thickness"], u, \
-        result.last.state.cavities[0].pressure
+    return (
+        thickness_table(model.mesh, u.reshape(-1, model.dpn)[:, :2])["thickness"],
+        u,
+        result.last.state.cavities[0].pressure,
+    )
 
 
 def history_held(tree, sens) -> np.ndarray:
@@ -84,8 +93,10 @@ def history_held(tree, sens) -> np.ndarray:
     for k in range(s.size):
         e = np.zeros(s.size)
         e[k] = 1e-6 * s[k]
-        dR[:, k] = (make(s + e).evaluate(last.u_f, last.lam, before.state, tangent=False).r
-                    - make(s - e).evaluate(last.u_f, last.lam, before.state, tangent=False).r) / (2 * e[k])
+        dR[:, k] = (
+            make(s + e).evaluate(last.u_f, last.lam, before.state, tangent=False).r
+            - make(s - e).evaluate(last.u_f, last.lam, before.state, tangent=False).r
+        ) / (2 * e[k])
     K = model.evaluate(last.u_f, last.lam, before.state).K
     du_f = -np.asarray(factorize(K)(dR)).reshape(model.n_free, s.size)
     dm = model.dofmap
@@ -112,9 +123,15 @@ def agree_with_differences(tree: dict, sens, built, pressure: bool = False) -> N
             assert sens.dp_ds[-1][0, k] == pytest.approx((pp - pm) / (2 * e[k]), rel=REL)
 
 
-@pytest.mark.parametrize("control, formulation, element", [("volume", "mixed", "q4"), ("pressure", "mixed", "q4"),
-                                                           ("volume", "displacement", "q8"),
-                                                           ("pressure", "displacement", "sfr")])
+@pytest.mark.parametrize(
+    "control, formulation, element",
+    [
+        ("volume", "mixed", "q4"),
+        ("pressure", "mixed", "q4"),
+        ("volume", "displacement", "q8"),
+        ("pressure", "displacement", "sfr"),
+    ],
+)
 def test_derivatives_carry_the_history_of_the_prony_series(control, formulation, element):
     tree = tube(control, formulation, element)
     sens, built = differentiate(tree)

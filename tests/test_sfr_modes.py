@@ -30,10 +30,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-from axiform import Mesh, Model, MooneyRivlin, SFR, rectangle, select_edges, select_nodes
-from axiform.fem.assembly import SolidAssembly
 from conftest import distorted_rectangle
+
+from axiform import SFR, Mesh, Model, MooneyRivlin, rectangle, select_edges, select_nodes
+from axiform.fem.assembly import SolidAssembly
 
 MATERIAL = MooneyRivlin(80.0, 20.0, 1.0e4)
 ZERO = 1e-10  # relative: eigenvalue / largest eigenvalue
@@ -48,7 +48,7 @@ def global_stiffness(mesh: Mesh) -> tuple[np.ndarray, SolidAssembly]:
     n = mesh.n_nodes * mesh.element.dofs_per_node
     _, Ke = asm.evaluate(np.zeros(n), tangent=True)
     K = np.zeros((n, n))
-    for dofs, k in zip(asm.dofs, Ke):
+    for dofs, k in zip(asm.dofs, Ke, strict=False):
         K[np.ix_(dofs, dofs)] += k
     return K, asm
 
@@ -61,7 +61,7 @@ def zero_modes(K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     w = w / w[-1]
     nz = int((np.abs(w) < ZERO).sum())
     assert np.all(np.abs(w[:nz]) < ROUNDOFF), w[:nz]
-    assert np.all(w[nz:] > GAP), w[nz:nz + 3]  # no negative eigenvalue, no near-zero one
+    assert np.all(w[nz:] > GAP), w[nz : nz + 3]  # no negative eigenvalue, no near-zero one
     return w, V[:, :nz]
 
 
@@ -211,7 +211,7 @@ def test_supported_strip_is_nonsingular(divisions, rule):
     K = model.evaluate(np.zeros(model.n_free), 0.0).K.toarray()
     assert np.abs(K - K.T).max() <= 1e-12 * np.abs(K).max()
     w = np.linalg.eigvalsh(K)
-    assert w[0] > 1e-8 * w[-1], (w[0] / w[-1])
+    assert w[0] > 1e-8 * w[-1], w[0] / w[-1]
     s = np.linalg.svd(K, compute_uv=False)
     assert s[-1] > 1e-8 * s[0]
 

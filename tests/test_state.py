@@ -24,7 +24,7 @@ def die_drawing(steps: int = 10, target: float = 0.3):
 def snapshot(model, step):
     """Everything a writer reads off a converged step: the contact reports, the point fields
     and the monitors."""
-    reports = [pair.report(held) for pair, held in zip(model.contacts, step.state.contacts)]
+    reports = [pair.report(held) for pair, held in zip(model.contacts, step.state.contacts, strict=False)]
     return reports, point_fields(model, step.u, step.state)
 
 
@@ -32,7 +32,7 @@ def same(a, b) -> bool:
     if isinstance(a, dict):
         return a.keys() == b.keys() and all(same(a[k], b[k]) for k in a)
     if isinstance(a, (list, tuple)):
-        return len(a) == len(b) and all(same(x, y) for x, y in zip(a, b))
+        return len(a) == len(b) and all(same(x, y) for x, y in zip(a, b, strict=False))
     return np.array_equal(np.asarray(a), np.asarray(b), equal_nan=True)
 
 
@@ -77,9 +77,9 @@ def test_the_line_search_commits_the_state_of_the_u_it_accepts():
     res = solve(model, built.control, built.options, on_step=record)
     assert res.status == "finished"
     touched = 0
-    for step, before in zip(steps, committed):
+    for step, before in zip(steps, committed, strict=False):
         again = model.evaluate(step.u_f, step.lam, before).trial
-        for held, fresh in zip(step.state.contacts, again.contacts):
+        for held, fresh in zip(step.state.contacts, again.contacts, strict=False):
             for name in ContactState.HISTORY:
                 assert np.array_equal(getattr(held, name), getattr(fresh, name), equal_nan=True), (step.number, name)
             touched += int(np.isfinite(held.first_contact).sum())

@@ -1,6 +1,5 @@
 """A stop names the cause a user can act on before the element that failed."""
 
-
 from axiform.case.schema import build, parse
 from axiform.solve.controls import LoadControl, NewtonOptions
 from axiform.solve.paths import LoadPath
@@ -15,8 +14,12 @@ def ring_on_a_short_plate(plate_end: float) -> dict:
         "material": {"model": "neo-hooke", "C1": 0.5, "kappa": 1000.0},
         "contact": [
             {"name": "plate", "surface": {"polyline": [[10.0, 0.0], [plate_end, 0.0]]}, "slaves": {"z": 0.0}},
-            {"name": "press", "surface": {"polyline": [[30.0, 4.0], [10.0, 4.0]]}, "slaves": {"z": 4.0},
-             "motion": {"uz": -0.2}},
+            {
+                "name": "press",
+                "surface": {"polyline": [[30.0, 4.0], [10.0, 4.0]]},
+                "slaves": {"z": 4.0},
+                "motion": {"uz": -0.2},
+            },
         ],
         "solver": {"control": "load", "steps": 2},
     }
@@ -61,8 +64,7 @@ def test_the_cause_comes_before_the_failure(monkeypatch):
     from axiform.solve import solver
 
     monkeypatch.setattr(LoadPath, "diagnosis", lambda self: "the cause")
-    built = build(parse(ring_on_a_short_plate(30.0) | {"solver": {"control": "load", "steps": 1,
-                                                                  "max_iterations": 1}}))
+    built = build(parse(ring_on_a_short_plate(30.0) | {"solver": {"control": "load", "steps": 1, "max_iterations": 1}}))
     res = solver.solve(built.model, built.control, built.options)
     assert res.status == "stopped"
     assert res.message.startswith("step 1: the cause; no convergence")

@@ -9,8 +9,8 @@ import tomllib
 import numpy as np
 import pytest
 
-from axiform.cli import main
 from axiform.app.sweep import load_sweep, toml_value
+from axiform.cli import main
 
 PLATE = """
 title = "small plate"
@@ -87,15 +87,31 @@ def test_sweep_failure_recorded_and_resume(sweep_dir, capsys):
     args = ["sweep", str(sweep_dir / "sweep.toml"), "--out", str(out), "--workers", "2"]
     assert main(args) == 1  # one case did not finish
     rows = stress_rows(out / "sweep.csv")
-    assert list(rows[0]) == ["case", "material.C1", "solver.steps", "solver.max_iterations", "solver.min_step",
-                             "status", "exit_code", "steps", "wall_time_s", "message", "w_center", "rim_force_z",
-                             "thickness_min", "w_center_min", "w_center_max", "rim_force_z_min", "rim_force_z_max"]
+    assert list(rows[0]) == [
+        "case",
+        "material.C1",
+        "solver.steps",
+        "solver.max_iterations",
+        "solver.min_step",
+        "status",
+        "exit_code",
+        "steps",
+        "wall_time_s",
+        "message",
+        "w_center",
+        "rim_force_z",
+        "thickness_min",
+        "w_center_min",
+        "w_center_max",
+        "rim_force_z_min",
+        "rim_force_z_max",
+    ]
     assert [r["case"] for r in rows] == ["0001", "0002", "0003"]
     assert [r["status"] for r in rows] == ["finished", "stopped", "finished"]
     assert [r["exit_code"] for r in rows] == ["0", "1", "0"]
     assert "no convergence" in rows[1]["message"]
     assert rows[1]["material.C1"] == "80.0" and rows[0]["solver.steps"] == ""
-    for r, case in zip(rows, ("0001", "0002", "0003")):
+    for r, case in zip(rows, ("0001", "0002", "0003"), strict=False):
         summary = json.loads((out / "cases" / case / "summary.json").read_text())
         assert summary["status"] == r["status"]
     for r in (rows[0], rows[2]):  # the last monitor values of the finished cases, as their summary has them
@@ -127,17 +143,20 @@ def test_sweep_failure_recorded_and_resume(sweep_dir, capsys):
     assert again[0]["rim_force_z"] == rows[0]["rim_force_z"]
 
 
-@pytest.mark.parametrize("text, key", [
-    ('[vary]\n"material.C1" = [60.0]', "case"),
-    ('case = "nowhere.toml"\n[vary]\n"material.C1" = [60.0]', "case"),
-    ('case = "plate.toml"', "vary / cases"),
-    ('case = "plate.toml"\n[vary]\n"material.C1" = [60.0]\n[[cases]]\n"material.C1" = 1.0', "vary / cases"),
-    ('case = "plate.toml"\n[vary]\n"material.C1" = []', "vary.material.C1"),
-    ('case = "plate.toml"\n[vary]\n"material.C1" = [60.0, -1.0]', "material.C1"),
-    ('case = "plate.toml"\n[vary]\n"material.C9" = [1.0]', "material"),
-    ('case = "plate.toml"\n[vary]\n"material.C1" = [60.0]\n[report]\nmonitor = "nothing"', "report.monitor"),
-    ('case = "plate.toml"\nworkers = 3\n[vary]\n"material.C1" = [60.0]', "workers"),
-])
+@pytest.mark.parametrize(
+    "text, key",
+    [
+        ('[vary]\n"material.C1" = [60.0]', "case"),
+        ('case = "nowhere.toml"\n[vary]\n"material.C1" = [60.0]', "case"),
+        ('case = "plate.toml"', "vary / cases"),
+        ('case = "plate.toml"\n[vary]\n"material.C1" = [60.0]\n[[cases]]\n"material.C1" = 1.0', "vary / cases"),
+        ('case = "plate.toml"\n[vary]\n"material.C1" = []', "vary.material.C1"),
+        ('case = "plate.toml"\n[vary]\n"material.C1" = [60.0, -1.0]', "material.C1"),
+        ('case = "plate.toml"\n[vary]\n"material.C9" = [1.0]', "material"),
+        ('case = "plate.toml"\n[vary]\n"material.C1" = [60.0]\n[report]\nmonitor = "nothing"', "report.monitor"),
+        ('case = "plate.toml"\nworkers = 3\n[vary]\n"material.C1" = [60.0]', "workers"),
+    ],
+)
 def test_invalid_sweep_file(sweep_dir, capsys, text, key):
     (sweep_dir / "bad.toml").write_text(text)
     out = sweep_dir / "bad"
@@ -148,18 +167,28 @@ def test_invalid_sweep_file(sweep_dir, capsys, text, key):
 
 
 def test_full_factorial_order_and_values(sweep_dir):
-    (sweep_dir / "f.toml").write_text('case = "plate.toml"\n[vary]\n"material.C1" = [60.0, 80.0]\n'
-                                      '"solver.target" = [0.5, 1.0, 1.5]\n"output.every" = [2]\n')
+    (sweep_dir / "f.toml").write_text(
+        'case = "plate.toml"\n[vary]\n"material.C1" = [60.0, 80.0]\n'
+        '"solver.target" = [0.5, 1.0, 1.5]\n"output.every" = [2]\n'
+    )
     sweep = load_sweep(sweep_dir / "f.toml")
     assert sweep.keys == ["material.C1", "solver.target", "output.every"]
     assert [(c["material.C1"], c["solver.target"]) for c in sweep.cases] == [
-        (60.0, 0.5), (60.0, 1.0), (60.0, 1.5), (80.0, 0.5), (80.0, 1.0), (80.0, 1.5)]
+        (60.0, 0.5),
+        (60.0, 1.0),
+        (60.0, 1.5),
+        (80.0, 0.5),
+        (80.0, 1.0),
+        (80.0, 1.5),
+    ]
     assert sweep.overrides(4) == ["material.C1=80.0", "solver.target=1.0", "output.every=2"]
     assert sweep.report == "w_center"  # the first monitor when [report] is left out
     assert sweep.monitors == ["w_center", "rim_force_z"]
 
 
-@pytest.mark.parametrize("value", [1.5, -2, True, "q8", [40, 4], {"r": 7.5, "z": 0.0}, [[0.0, 0.0], [1.0, 2.0]], 1e-300])
+@pytest.mark.parametrize(
+    "value", [1.5, -2, True, "q8", [40, 4], {"r": 7.5, "z": 0.0}, [[0.0, 0.0], [1.0, 2.0]], 1e-300]
+)
 def test_toml_value_round_trip(value):
     assert tomllib.loads(f"v = {toml_value(value)}")["v"] == value
 

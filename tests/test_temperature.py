@@ -12,8 +12,8 @@ import tomli_w
 
 from axiform import LoadControl, Model, NeoHooke, NewtonOptions, rectangle, select_nodes, solve
 from axiform.fem.curves import Curve
-from axiform.materials.temperature import WLF, Arrhenius, Table, TemperatureDependent
 from axiform.materials import MooneyRivlin
+from axiform.materials.temperature import WLF, Arrhenius, Table, TemperatureDependent
 from axiform.materials.viscoelastic import Prony, Viscoelastic
 
 PRONY = Prony((0.4, 0.3), (0.05, 0.5))
@@ -21,8 +21,15 @@ CUTS = NewtonOptions(min_step=1e-9)
 WLF_PET = WLF(17.44, 51.6, 100.0)
 
 
-def bar(material, duration: float, T: float | None = None, shift=None, element: str = "q4",
-        formulation: str = "displacement", hold: float = 0.0):
+def bar(
+    material,
+    duration: float,
+    T: float | None = None,
+    shift=None,
+    element: str = "q4",
+    formulation: str = "displacement",
+    hold: float = 0.0,
+):
     """A homogeneous bar (r 0..1, z 0..1) stretched to 1.5 along z at a constant rate over
     `duration` (then held for `hold`), at the temperature T with the shift."""
     mesh = rectangle((0.0, 1.0), (0.0, 1.0), (2, 2), element)
@@ -80,8 +87,11 @@ def test_constants_as_tables_are_the_law_at_the_temperature(element, formulation
     """A law whose C1, C2 and kappa are tables of T, at T between two knots, gives the forces
     of the plain law with the interpolated constants; with T varying along the bar, each
     element takes its own (the force differs from both ends' uniform values)."""
-    tables = {"C1": Table((140.0, 160.0), (0.6, 0.4)), "C2": Table((140.0, 160.0), (0.1, 0.05)),
-              "kappa": Table((140.0,), (400.0,))}
+    tables = {
+        "C1": Table((140.0, 160.0), (0.6, 0.4)),
+        "C2": Table((140.0, 160.0), (0.1, 0.05)),
+        "kappa": Table((140.0,), (400.0,)),
+    }
     law = TemperatureDependent(lambda c: MooneyRivlin(c["C1"], c["C2"], c["kappa"]), tables, {}, 150.0)
     assert law.shear_modulus == pytest.approx(2 * (0.5 + 0.075))  # its scales: the law at the reference
     _, hot = history(*bar(law, 1.0, 155.0, element=element, formulation=formulation), 1.0, 2)
@@ -99,9 +109,12 @@ def test_the_tangent_with_tables_and_a_shift_matches_differences():
     """The tangent of a tabled law with a Prony series under a shift, T varying in the body."""
     from conftest import difference_tangent
 
-    law = TemperatureDependent(lambda c: MooneyRivlin(c["C1"], 0.05, c["kappa"]),
-                               {"C1": Table((140.0, 160.0), (0.6, 0.4)), "kappa": Table((140.0, 160.0), (60., 40.))},
-                               {}, 150.0)
+    law = TemperatureDependent(
+        lambda c: MooneyRivlin(c["C1"], 0.05, c["kappa"]),
+        {"C1": Table((140.0, 160.0), (0.6, 0.4)), "kappa": Table((140.0, 160.0), (60.0, 40.0))},
+        {},
+        150.0,
+    )
     model, _ = bar(Viscoelastic(law, PRONY), 0.1, 150.0, WLF(17.44, 51.6, 150.0), "q8", "mixed")
     model.heat(140.0 + 20.0 * model.mesh.points[:, 1], WLF(17.44, 51.6, 150.0))
     model.finalize()
@@ -167,17 +180,24 @@ def test_a_case_writes_the_temperature(tmp_path):
 ARRHENIUS = "shift = { arrhenius = { activation = 8.0e3 } }"
 
 
-@pytest.mark.parametrize("edits, message", [
-    ([("[1.0, 160.0]]", "[1.0, 90.0]]")], r"temperature.shift.wlf.C2: .*pole"),
-    ([("C1 = [[140.0, 0.6], [160.0, 0.4]]", "C1 = [[160.0, 0.6], [140.0, 0.4]]")], r"material.C1: .*increase"),
-    ([("C1 = [[140.0, 0.6], [160.0, 0.4]]", "C1 = [[140.0, 0.6], [160.0, -0.4]]")], r"material.C1: .*> 0"),
-    ([("[[0.0, 140.0], [1.0, 160.0]]", "[[1.0, 140.0], [0.0, 160.0]]")], r"temperature.initial: table: .*increase"),
-    ([("reference = 150.0", "")], r"temperature: .*reference"),
-    ([("shift = { wlf = { C1 = 17.44, C2 = 51.6 } }", "shift = { wlf = { C1 = 17.44, C2 = -5.0 } }")],
-     r"temperature.shift.wlf.C2: .*greater than 0"),
-    ([("shift = { wlf = { C1 = 17.44, C2 = 51.6 } }", ARRHENIUS), ("[[0.0, 140.0]", "[[0.0, -10.0]")],
-     r"temperature.shift.arrhenius: .*kelvin"),
-])
+@pytest.mark.parametrize(
+    "edits, message",
+    [
+        ([("[1.0, 160.0]]", "[1.0, 90.0]]")], r"temperature.shift.wlf.C2: .*pole"),
+        ([("C1 = [[140.0, 0.6], [160.0, 0.4]]", "C1 = [[160.0, 0.6], [140.0, 0.4]]")], r"material.C1: .*increase"),
+        ([("C1 = [[140.0, 0.6], [160.0, 0.4]]", "C1 = [[140.0, 0.6], [160.0, -0.4]]")], r"material.C1: .*> 0"),
+        ([("[[0.0, 140.0], [1.0, 160.0]]", "[[1.0, 140.0], [0.0, 160.0]]")], r"temperature.initial: table: .*increase"),
+        ([("reference = 150.0", "")], r"temperature: .*reference"),
+        (
+            [("shift = { wlf = { C1 = 17.44, C2 = 51.6 } }", "shift = { wlf = { C1 = 17.44, C2 = -5.0 } }")],
+            r"temperature.shift.wlf.C2: .*greater than 0",
+        ),
+        (
+            [("shift = { wlf = { C1 = 17.44, C2 = 51.6 } }", ARRHENIUS), ("[[0.0, 140.0]", "[[0.0, -10.0]")],
+            r"temperature.shift.arrhenius: .*kelvin",
+        ),
+    ],
+)
 def test_bad_temperature_input_is_refused_naming_the_key(tmp_path, capsys, edits, message):
     from axiform.cli import main
 
@@ -202,12 +222,17 @@ def test_a_table_needs_a_temperature(tmp_path, capsys):
     assert "material.C1: a table of the temperature needs the case's [temperature]" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("edits, warning", [
-    ([("viscoelastic = { g = [0.4, 0.3], tau = [0.05, 0.5] }\n", "")], "temperature.shift: .*changes nothing"),
-    ([("C1 = [[140.0, 0.6], [160.0, 0.4]]", "C1 = 0.5"), ("shift = { wlf = { C1 = 17.44, C2 = 51.6 } }", "")],
-     "temperature: no constant .* changes nothing"),
-    ([], None),
-])
+@pytest.mark.parametrize(
+    "edits, warning",
+    [
+        ([("viscoelastic = { g = [0.4, 0.3], tau = [0.05, 0.5] }\n", "")], "temperature.shift: .*changes nothing"),
+        (
+            [("C1 = [[140.0, 0.6], [160.0, 0.4]]", "C1 = 0.5"), ("shift = { wlf = { C1 = 17.44, C2 = 51.6 } }", "")],
+            "temperature: no constant .* changes nothing",
+        ),
+        ([], None),
+    ],
+)
 def test_a_temperature_that_changes_nothing_is_warned_before_the_run(edits, warning):
     from axiform.case.preflight import idle_temperature
 
@@ -219,7 +244,6 @@ def test_a_temperature_that_changes_nothing_is_warned_before_the_run(edits, warn
 
     lines = idle_temperature(build(parse(tomllib.loads(text))))
     assert (lines == []) if warning is None else re.search(warning, lines[0])
-
 
 
 @pytest.mark.parametrize("element, formulation", [("q4", "mixed"), ("q8", "displacement"), ("sfr", "mixed")])

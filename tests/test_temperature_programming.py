@@ -23,12 +23,25 @@ KNOWN = [146.0, 153.0, 148.0, 151.0]
 # tube stretches more and ends thinner
 TUBE = {
     "title": "viscoelastic tube, temperature programmed",
-    "mesh": {"kind": "layered", "element": "q4", "start": [10.0, 0.0],
-             "profile": [{"line": {"to": [10.0, 12.0], "divisions": 12}}], "thickness": 1.0, "layers": 1},
-    "material": {"model": "neo-hooke", "C1": [[140.0, 0.2], [160.0, 0.05]], "kappa": 100.0,
-                 "viscoelastic": {"g": [0.5, 0.3], "tau": [0.1, 1.0]}},
-    "temperature": {"initial": {"along": "s", "table": [[s, 150.0] for s in KNOTS]}, "reference": 150.0,
-                    "shift": {"wlf": {"C1": 6.85, "C2": 100.0}}},
+    "mesh": {
+        "kind": "layered",
+        "element": "q4",
+        "start": [10.0, 0.0],
+        "profile": [{"line": {"to": [10.0, 12.0], "divisions": 12}}],
+        "thickness": 1.0,
+        "layers": 1,
+    },
+    "material": {
+        "model": "neo-hooke",
+        "C1": [[140.0, 0.2], [160.0, 0.05]],
+        "kappa": 100.0,
+        "viscoelastic": {"g": [0.5, 0.3], "tau": [0.1, 1.0]},
+    },
+    "temperature": {
+        "initial": {"along": "s", "table": [[s, 150.0] for s in KNOTS]},
+        "reference": 150.0,
+        "shift": {"wlf": {"C1": 6.85, "C2": 100.0}},
+    },
     "fix": [{"at": {"set": "start"}, "dofs": ["uz"]}, {"at": {"set": "end"}, "dofs": ["uz"]}],
     "cavity": [{"name": "gas", "boundary": {"set": "inner"}, "control": "volume", "volume": 6000.0}],
     "solver": {"target": 1.0, "steps": 8, "growth": 1.0},
@@ -37,7 +50,7 @@ TUBE = {
 
 def with_profile(values) -> dict:
     tree = copy.deepcopy(TUBE)
-    tree["temperature"]["initial"]["table"] = [[s, float(v)] for s, v in zip(KNOTS, values)]
+    tree["temperature"]["initial"]["table"] = [[s, float(v)] for s, v in zip(KNOTS, values, strict=False)]
     return tree
 
 
@@ -71,14 +84,32 @@ def test_a_known_profile_is_found_again_in_fewer_solves_than_the_rule(tmp_path):
     target = tmp_path / "target.csv"
     wall = final_wall(KNOWN)
     s = np.linspace(0.0, 12.0, wall.size)
-    target.write_text("s,thickness\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(s, wall)))
+    target.write_text("s,thickness\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(s, wall, strict=False)))
     case = tmp_path / "tube.toml"
     case.write_text(tomli_w.dumps(TUBE))
     solves = {}
     for method in ("gradient", "fixed-point"):
         out = tmp_path / method
-        assert main(["optimize", str(case), "--target", str(target), "--out", str(out), "--vary", "temperature",
-                     "--method", method, "--max-iter", "30", "-q"]) == 0
+        assert (
+            main(
+                [
+                    "optimize",
+                    str(case),
+                    "--target",
+                    str(target),
+                    "--out",
+                    str(out),
+                    "--vary",
+                    "temperature",
+                    "--method",
+                    method,
+                    "--max-iter",
+                    "30",
+                    "-q",
+                ]
+            )
+            == 0
+        )
         summary = json.loads((out / "optimize.json").read_text())
         assert summary["reached"] and summary["max_rel_deviation"] <= 0.01 and summary["vary"] == "temperature.initial"
         solves[method] = summary["forward_solves"]
@@ -87,11 +118,14 @@ def test_a_known_profile_is_found_again_in_fewer_solves_than_the_rule(tmp_path):
     assert solves["gradient"] < solves["fixed-point"]
 
 
-@pytest.mark.parametrize("args, message", [
-    (["--vary", "temperature", "--bounds", "100"], "--bounds: '100' is not LOW,HIGH"),
-    (["--vary", "temperature", "--bounds", "180,120"], "--bounds: the low bound 180 must be below"),
-    (["--bounds", "120,180"], "--bounds: belongs to --vary temperature"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--vary", "temperature", "--bounds", "100"], "--bounds: '100' is not LOW,HIGH"),
+        (["--vary", "temperature", "--bounds", "180,120"], "--bounds: the low bound 180 must be below"),
+        (["--bounds", "120,180"], "--bounds: belongs to --vary temperature"),
+    ],
+)
 def test_bad_bounds_are_refused(tmp_path, capsys, args, message):
     case = tmp_path / "tube.toml"
     case.write_text(tomli_w.dumps(TUBE))
@@ -108,7 +142,11 @@ def test_a_constant_temperature_is_no_design(tmp_path, capsys):
     case.write_text(tomli_w.dumps(tree))
     target = tmp_path / "target.csv"
     target.write_text("s,thickness\n0,0.8\n12,0.8\n")
-    assert main(["optimize", str(case), "--target", str(target), "--out", str(tmp_path / "o"),
-                 "--vary", "temperature"]) == 2
-    assert "temperature.initial: optimize --vary temperature needs the initial temperature as a table" \
+    assert (
+        main(["optimize", str(case), "--target", str(target), "--out", str(tmp_path / "o"), "--vary", "temperature"])
+        == 2
+    )
+    assert (
+        "temperature.initial: optimize --vary temperature needs the initial temperature as a table"
         in capsys.readouterr().err
+    )

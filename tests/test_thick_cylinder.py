@@ -25,11 +25,15 @@ import functools
 
 import numpy as np
 import pytest
+from oracles import (
+    RadialBVP,
+    incompressible_by_quadrature,
+    incompressible_cylinder_pressure,
+    lame_plane_strain,
+    linear_constants,
+)
 
-from axiform import (DisplacementControl, LoadControl, Model, MooneyRivlin, rectangle, select_edges,
-                     select_nodes, solve)
-from oracles import (RadialBVP, incompressible_by_quadrature, incompressible_cylinder_pressure,
-                     lame_plane_strain, linear_constants)
+from axiform import DisplacementControl, LoadControl, Model, MooneyRivlin, rectangle, select_edges, select_nodes, solve
 
 A, B, H = 1.5, 3.0, 0.2  # inner and outer radius, height of the slice
 NZ = 2  # element rows
@@ -48,8 +52,7 @@ SYMMETRY_TOL = 1e-10
 
 
 # ---------------------------------------------------------------------------------- helpers
-def cylinder(element: str, nr: int, kappa: float, p_ref: float = 1.0,
-             formulation: str = "displacement") -> tuple:
+def cylinder(element: str, nr: int, kappa: float, p_ref: float = 1.0, formulation: str = "displacement") -> tuple:
     mesh = rectangle((A, B), (0.0, H), (nr, NZ), element)
     model = Model(mesh, MooneyRivlin(C1, C2, kappa), formulation=formulation)
     model.fix(select_nodes(mesh, {"z": 0.0}), ["uz"])
@@ -79,7 +82,7 @@ def check_plane_strain(mesh, model, u: np.ndarray) -> None:
         assert np.abs(u[2::3]).max() * (B - A) <= SYMMETRY_TOL * scale
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def opening(element: str, nr: int, kappa: float, formulation: str = "displacement") -> np.ndarray:
     """Drive the inner radius a from A to 1.5 A by displacement control of the inner ur
     (4 steps); return the pressures at A_TARGETS (checking plane strain at every step)."""
@@ -97,7 +100,7 @@ def opening(element: str, nr: int, kappa: float, formulation: str = "displacemen
     return p[[h[0] for h in hit]]
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def bvp_pressures(kappa: float, tol: float = 1e-8) -> np.ndarray:
     return RadialBVP(MooneyRivlin(C1, C2, kappa), A, B, tol=tol).pressures(A_TARGETS)
 
@@ -169,7 +172,7 @@ def test_small_strain_lame(element):
             res = solve(model, LoadControl(target=1.0, steps=1))
             assert res.status == "finished"
             check_plane_strain(mesh, model, res.last.u)
-            u[sign] = res.last.u[0::model.dpn]
+            u[sign] = res.last.u[0 :: model.dpn]
         u_lin = 0.5 * (u[1.0] - u[-1.0])
         # the even part is the second-order response: O(p/mu) relative (measured 1.1e-4 to 1.3e-4)
         assert np.abs(0.5 * (u[1.0] + u[-1.0])).max() <= 3 * p / MU * np.abs(u_lin).max()
@@ -236,7 +239,7 @@ def test_large_strain_compressible_bvp(element):
     r = ORDER[element]
     ps = [opening(element, nr, KAPPA_BVP) for nr in BVP_MESHES[element]]
     errors = [p / p_ref - 1 for p in ps]
-    for coarse, fine in zip(errors, errors[1:]):
+    for coarse, fine in zip(errors, errors[1:], strict=False):
         assert np.all(coarse > 0) and np.all(fine > 0)  # overstiff, monotone from above
         rate = np.log2(coarse / fine)
         assert np.all((rate > r - 0.3) & (rate < r + 0.5)), rate
@@ -290,8 +293,7 @@ def test_mixed_free_of_locking(element):
     for kappa_over_mu in (20.0, 1e3, 1e4):
         kappa = kappa_over_mu * MU
         p_ref = bvp_pressures(kappa)
-        errors = [np.abs(opening(element, nr, kappa, "mixed") / p_ref - 1).max()
-                  for nr in MIXED_MESHES[element]]
+        errors = [np.abs(opening(element, nr, kappa, "mixed") / p_ref - 1).max() for nr in MIXED_MESHES[element]]
         # rates where the oracle's own error (bvp_accuracy, 1e-6 at 1e4) is well below the FE error
         above = np.array(errors[1:]) > 3 * bvp_accuracy(kappa)
         rates = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))[above]

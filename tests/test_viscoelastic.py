@@ -3,11 +3,11 @@ stress of a law, its history per quadrature point committed with converged steps
 
 import numpy as np
 import pytest
+from conftest import RELAXING_BAR
 
 from axiform import LoadControl, Model, NeoHooke, NewtonOptions, rectangle, select_nodes, solve
 from axiform.fem.curves import Curve
 from axiform.materials.viscoelastic import Prony, Viscoelastic
-from conftest import RELAXING_BAR
 
 PRONY = Prony((0.4, 0.3), (0.05, 0.5))
 RAMP = 1e-6  # the step of strain takes this long (2e-5 of the shortest relaxation time)
@@ -27,8 +27,9 @@ def bar(material, element: str, formulation: str, stretch: float = 1.3) -> tuple
     return model.finalize(), model.dof(top, "uz")
 
 
-@pytest.mark.parametrize("element, formulation", [("q4", "displacement"), ("q8", "mixed"), ("sfr", "mixed"),
-                                                  ("q4", "mixed")])
+@pytest.mark.parametrize(
+    "element, formulation", [("q4", "displacement"), ("q8", "mixed"), ("sfr", "mixed"), ("q4", "mixed")]
+)
 def test_a_step_of_stretch_relaxes_as_the_prony_series(element, formulation):
     """The force on the bar's end after a step of stretch: F(t) = F_elastic g(t), g(t) = 1 -
     sum g_i (1 - exp(-t / tau_i)), within 0.1 % at every step (kappa / mu = 1e4), whatever
@@ -84,12 +85,15 @@ def test_checkpoints_carry_the_history():
 CASE = RELAXING_BAR
 
 
-@pytest.mark.parametrize("edit, message", [
-    (("g = [0.4, 0.3]", "g = [0.7, 0.4]"), "material.viscoelastic: .*sum < 1"),
-    (("tau = [0.05, 0.5]", "tau = [0.05, -0.5]"), "material.viscoelastic: .*tau_i > 0"),
-    (("g = [0.4, 0.3]", "g = [0.4]"), "material.viscoelastic: .*as many g as tau"),
-    (("steps = 10", 'steps = 10\ncontrol = "arc-length"'), "solver.control: .*viscoelastic"),
-])
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (("g = [0.4, 0.3]", "g = [0.7, 0.4]"), "material.viscoelastic: .*sum < 1"),
+        (("tau = [0.05, 0.5]", "tau = [0.05, -0.5]"), "material.viscoelastic: .*tau_i > 0"),
+        (("g = [0.4, 0.3]", "g = [0.4]"), "material.viscoelastic: .*as many g as tau"),
+        (("steps = 10", 'steps = 10\ncontrol = "arc-length"'), "solver.control: .*viscoelastic"),
+    ],
+)
 def test_a_bad_series_or_control_is_refused_naming_the_key(tmp_path, capsys, edit, message):
     import re
 
@@ -119,8 +123,9 @@ def test_the_written_stress_relaxes(tmp_path):
 
 def test_max_dt_caps_every_step(tmp_path):
     """[solver] max_dt: no step of the process longer than it (the steps would grow to 0.1)."""
-    from axiform.case.schema import build, parse
     import tomllib
+
+    from axiform.case.schema import build, parse
 
     data = tomllib.loads(CASE)
     data["solver"]["max_dt"] = 0.03

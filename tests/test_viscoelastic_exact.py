@@ -5,13 +5,13 @@ constant stretch rate, then under a held pressure (creep)."""
 
 import numpy as np
 import pytest
+from oracles import PronySphere, uniaxial_prony
 
 from axiform import LoadControl, Model, MooneyRivlin, NewtonOptions, rectangle, select_nodes, solve
 from axiform.fem.curves import Curve
 from axiform.fem.mesh import layered
 from axiform.fem.profile import Arc, Profile
 from axiform.materials.viscoelastic import Prony, Viscoelastic
-from oracles import PronySphere, uniaxial_prony
 
 G, TAU = (0.4, 0.3), (0.05, 0.5)
 C1, C2 = 1.0, 0.1
@@ -100,7 +100,7 @@ def test_a_sphere_inflated_at_a_constant_stretch_rate_against_the_thick_wall_sol
     duration, l_end = 0.4, 3.0
     knots = np.linspace(0.0, duration, 9)
     l_knots = 1.0 + (l_end - 1.0) * knots / duration
-    curve = Curve([[t, (l**3 - 1) / (l_end**3 - 1)] for t, l in zip(knots, l_knots)])
+    curve = Curve([[t, (l**3 - 1) / (l_end**3 - 1)] for t, l in zip(knots, l_knots, strict=False)])
     target = l_end**3 * 2.0 / 3.0 * np.pi * A**3  # the bore's volume at l_end (a half sphere)
 
     def volume(model, mesh):
@@ -150,11 +150,15 @@ def test_a_sphere_under_held_pressure_creeps_from_the_elastic_to_the_long_term_s
     assert long_term / elastic > 1.1  # the creep is a large one
     ramp = 1.0e-6
     knots = np.append(0.01 * 1.25 ** np.arange(36), 40.0)
-    curves = [np.array([[ramp * k / 8, k / 8] for k in range(9)] + [[t, 1.0] for t in hold]) for hold in
-              (knots, np.sort(np.append(knots, (knots[1:] + knots[:-1]) / 2)))]
+    curves = [
+        np.array([[ramp * k / 8, k / 8] for k in range(9)] + [[t, 1.0] for t in hold])
+        for hold in (knots, np.sort(np.append(knots, (knots[1:] + knots[:-1]) / 2)))
+    ]
     radii = []
     for table in curves:
-        model, bore_dof, _ = sphere(lambda model, mesh: model.pressure(mesh.edge_sets["inner"], p, Curve(table)))
+        model, bore_dof, _ = sphere(
+            lambda model, mesh, table=table: model.pressure(mesh.edge_sets["inner"], p, Curve(table))
+        )
         res = solve(model, LoadControl(40.0, 1), NewtonOptions(min_step=1e-9))
         assert res.status == "finished" and res.n_steps == len(table) - 1, res.message
         t = np.array([s.lam for s in res.steps])

@@ -35,16 +35,22 @@ wall = geo.addPlaneSurface([loop])
 geo.synchronize()
 
 # named physical groups: node sets (all) and edge sets (curves) of the axiform mesh
-for dim, tags, name in ((1, [equator], "equator"), (1, [outer], "outer"), (1, [axis], "axis"),
-                        (1, [inner], "inner"), (0, [p_in_pole], "pole"), (2, [wall], "wall")):
+for dim, tags, name in (
+    (1, [equator], "equator"),
+    (1, [outer], "outer"),
+    (1, [axis], "axis"),
+    (1, [inner], "inner"),
+    (0, [p_in_pole], "pole"),
+    (2, [wall], "wall"),
+):
     gmsh.model.setPhysicalName(dim, gmsh.model.addPhysicalGroup(dim, tags), name)
 
 gmsh.option.setNumber("Mesh.MeshSizeMax", args.size)
-gmsh.option.setNumber("Mesh.Algorithm", 8)                # frontal-Delaunay for quads
-gmsh.option.setNumber("Mesh.RecombineAll", 1)             # triangles -> quadrangles
-gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)   # blossom
-gmsh.option.setNumber("Mesh.SubdivisionAlgorithm", 1)     # split what is left: quadrangles only
-gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 1)    # 8-node quadrangles, not 9
+gmsh.option.setNumber("Mesh.Algorithm", 8)  # frontal-Delaunay for quads
+gmsh.option.setNumber("Mesh.RecombineAll", 1)  # triangles -> quadrangles
+gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)  # blossom
+gmsh.option.setNumber("Mesh.SubdivisionAlgorithm", 1)  # split what is left: quadrangles only
+gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 1)  # 8-node quadrangles, not 9
 gmsh.model.mesh.generate(2)
 if args.order == 2:
     gmsh.model.mesh.setOrder(2)

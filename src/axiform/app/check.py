@@ -25,8 +25,10 @@ def check(case_path: str, overrides: list[str] = (), plot: str | None = None) ->
     except Exception as exc:  # noqa: BLE001 - a fault of axiform's, not of the case: exit 3
         return failed(exc, f"failed while building the model of {case_file}")
     m = built.model
-    tell(f"{case_file}: valid; {m.mesh.n_cells} {m.mesh.element.name} elements, {m.mesh.n_nodes} nodes, "
-         f"{m.n_free} free dofs")
+    tell(
+        f"{case_file}: valid; {m.mesh.n_cells} {m.mesh.element.name} elements, {m.mesh.n_nodes} nodes, "
+        f"{m.n_free} free dofs"
+    )
     warn(*preflight(built))
     if plot is not None:
         from ..post.check_plot import plot_check

@@ -162,8 +162,16 @@ class ProgressLine:
                 width, height = min(size.columns or COLUMNS, COLUMNS), size.lines or 10**4
             except (OSError, ValueError, AttributeError):
                 width, height = COLUMNS, None
-            self._bar = tqdm(total=self.total, file=self.stream, bar_format="[{bar:16}] {desc}", ascii="-#",
-                             ncols=width, nrows=height, mininterval=0, leave=True)
+            self._bar = tqdm(
+                total=self.total,
+                file=self.stream,
+                bar_format="[{bar:16}] {desc}",
+                ascii="-#",
+                ncols=width,
+                nrows=height,
+                mininterval=0,
+                leave=True,
+            )
         self._bar.n = min(max(done, 0), self.total)
         self._bar.set_description_str(bar_text, refresh=False)
         self._bar.refresh()

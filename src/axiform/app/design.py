@@ -52,8 +52,10 @@ def read_target(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
             raise TargetError(f"{path}: line {n}: s must be finite and the thickness finite and > 0")
         for name, value in (("s", a), ("thickness", b)):
             if abs(value) > MAX_MAGNITUDE or 0 < abs(value) < MIN_MAGNITUDE:
-                raise TargetError(f"{path}: line {n}: {name} {value:g} is beyond the magnitude of a case's numbers "
-                                  f"(at most {MAX_MAGNITUDE:g}, and nonzero at least {MIN_MAGNITUDE:g})")
+                raise TargetError(
+                    f"{path}: line {n}: {name} {value:g} is beyond the magnitude of a case's numbers "
+                    f"(at most {MAX_MAGNITUDE:g}, and nonzero at least {MIN_MAGNITUDE:g})"
+                )
         if s and a <= s[-1]:
             raise TargetError(f"{path}: line {n}: s must increase")
         s.append(a)
@@ -101,18 +103,21 @@ class ThicknessDesign(CaseDesign):
     name = "mesh.thickness"  # the table that holds the design
 
     @classmethod
-    def from_case(cls, path: str | Path, overrides: list[str] = ()) -> "ThicknessDesign":
+    def from_case(cls, path: str | Path, overrides: list[str] = ()) -> ThicknessDesign:
         """Read a case for optimization: a layered mesh with a thickness table, load control.
         CaseError names the key at fault."""
         path = Path(path)
         tree = read(path, overrides)
         case = parse(tree)
         if case.mesh.kind != "layered" or not isinstance(case.mesh.thickness, list):
-            raise CaseError("mesh.thickness: optimize needs a layered mesh whose thickness is a table "
-                            "[[s, t], ...]: its t are the design variables")
+            raise CaseError(
+                "mesh.thickness: optimize needs a layered mesh whose thickness is a table "
+                "[[s, t], ...]: its t are the design variables"
+            )
         if case.solver.control != "load":
-            raise CaseError(f"solver.control: optimize follows the load path under load control, not "
-                            f"\"{case.solver.control}\"")
+            raise CaseError(
+                f'solver.control: optimize follows the load path under load control, not "{case.solver.control}"'
+            )
         built = build(case, path.parent)
         table = np.asarray(case.mesh.thickness, float)
         return cls(absolute_paths(tree, path.parent), path.parent, table[:, 0], table[:, 1], built)
@@ -120,7 +125,7 @@ class ThicknessDesign(CaseDesign):
     def case_tree(self, values: np.ndarray) -> dict[str, Any]:
         """The case tree with the thickness table's t replaced by `values`."""
         tree = copy.deepcopy(self.tree)
-        tree["mesh"]["thickness"] = [[float(s), float(t)] for s, t in zip(self.knots, values)]
+        tree["mesh"]["thickness"] = [[float(s), float(t)] for s, t in zip(self.knots, values, strict=False)]
         return tree
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
@@ -183,8 +188,10 @@ class Objective:
         tol = 1e-9 * max(1.0, float(np.abs(s).max()))
         self.inside = (s >= self.target_s[0] - tol) & (s <= self.target_s[-1] + tol)
         if self.inside.sum() < 1:
-            raise TargetError(f"the target's s range [{self.target_s[0]:g}, {self.target_s[-1]:g}] holds no "
-                              f"station of the wall (s from {s[0]:g} to {s[-1]:g})")
+            raise TargetError(
+                f"the target's s range [{self.target_s[0]:g}, {self.target_s[-1]:g}] holds no "
+                f"station of the wall (s from {s[0]:g} to {s[-1]:g})"
+            )
         self.target = np.interp(s, self.target_s, self.target_t)
         si = s[self.inside]
         w = np.zeros(len(si))
@@ -209,7 +216,7 @@ class Objective:
         """The second-difference operator (m - 2, m) over the design, relative to its scale."""
         D = np.zeros((max(m - 2, 0), m))
         for i in range(m - 2):
-            D[i, i:i + 3] = (1.0, -2.0, 1.0)
+            D[i, i : i + 3] = (1.0, -2.0, 1.0)
         return D / self.scale
 
     def residuals(self, thickness: np.ndarray, design: np.ndarray) -> np.ndarray:

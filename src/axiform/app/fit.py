@@ -49,9 +49,14 @@ STABILITY_STRETCHES = 10.0 ** np.linspace(-1.0, 1.0, 401)  # 0.1 to 10, 1 in the
 # the stretches and stresses a data file may hold: beyond them the fit's powers overflow
 STRETCH_RANGE = (1e-3, 1e3)
 ALPHA_BOUND = 25.0  # |alpha_i| of the Ogden fit, so that lambda^alpha stays finite
-OGDEN_ALPHA_STARTS = ((2.0, -2.0, 4.0, -1.0, 6.0, 1.0), (1.3, 5.0, -2.0, 3.0, -4.0, 8.0),
-                      (1.0, 3.0, 6.0, -2.0, -4.0, 9.0), (3.0, -1.0, 8.0, 1.5, -3.0, 5.0),
-                      (0.5, 4.0, -3.0, 2.0, 7.0, -1.0), (6.0, -4.0, 1.0, 3.0, -2.0, 10.0))
+OGDEN_ALPHA_STARTS = (
+    (2.0, -2.0, 4.0, -1.0, 6.0, 1.0),
+    (1.3, 5.0, -2.0, 3.0, -4.0, 8.0),
+    (1.0, 3.0, 6.0, -2.0, -4.0, 9.0),
+    (3.0, -1.0, 8.0, 1.5, -3.0, 5.0),
+    (0.5, 4.0, -3.0, 2.0, 7.0, -1.0),
+    (6.0, -4.0, 1.0, 3.0, -2.0, 10.0),
+)
 
 
 class FitDataError(ValueError):
@@ -107,7 +112,7 @@ def read_data(paths: list[str | Path]) -> Data:
                 continue
             if len(cells) != 3:
                 raise FitDataError(f"{where}: expected 3 values (mode,stretch,stress), got {len(cells)}")
-            value = dict(zip(header, cells))
+            value = dict(zip(header, cells, strict=False))
             mode = value["mode"].lower()
             if mode not in MODES:
                 raise FitDataError(f"{where}: unknown mode '{value['mode']}' (uniaxial, equibiaxial or planar)")
@@ -123,11 +128,15 @@ def read_data(paths: list[str | Path]) -> Data:
             if lam <= 0:
                 raise FitDataError(f"{where}: stretch must be > 0, got {value['stretch']}")
             if not STRETCH_RANGE[0] <= lam <= STRETCH_RANGE[1]:
-                raise FitDataError(f"{where}: stretch {value['stretch']} is beyond the magnitude of a test "
-                                   f"({STRETCH_RANGE[0]:g} to {STRETCH_RANGE[1]:g})")
+                raise FitDataError(
+                    f"{where}: stretch {value['stretch']} is beyond the magnitude of a test "
+                    f"({STRETCH_RANGE[0]:g} to {STRETCH_RANGE[1]:g})"
+                )
             if abs(stress) > MAX_MAGNITUDE or 0 < abs(stress) < MIN_MAGNITUDE:
-                raise FitDataError(f"{where}: stress {value['stress']} is beyond the magnitude of a number of "
-                                   f"axiform (nonzero, {MIN_MAGNITUDE:g} to {MAX_MAGNITUDE:g})")
+                raise FitDataError(
+                    f"{where}: stress {value['stress']} is beyond the magnitude of a number of "
+                    f"axiform (nonzero, {MIN_MAGNITUDE:g} to {MAX_MAGNITUDE:g})"
+                )
             if lam == 1.0:
                 notes.append(f"{where}: stretch 1 skipped (every law gives stress 0 there)")
                 continue
@@ -147,8 +156,11 @@ def kinematics(mode: str, lam: np.ndarray) -> np.ndarray:
     """x = F components (n, 5) of the incompressible test, loading direction r, thickness z."""
     lam = np.asarray(lam, float)
     one = np.ones_like(lam)
-    lateral, thickness = {"uniaxial": (lam**-0.5, lam**-0.5), "equibiaxial": (lam, lam**-2.0),
-                          "planar": (one, 1.0 / lam)}[mode]
+    lateral, thickness = {
+        "uniaxial": (lam**-0.5, lam**-0.5),
+        "equibiaxial": (lam, lam**-2.0),
+        "planar": (one, 1.0 / lam),
+    }[mode]
     zero = np.zeros_like(lam)
     return np.stack([lam, zero, zero, thickness, lateral], axis=-1)
 
@@ -209,7 +221,7 @@ class Family:
 
     def law(self, p: np.ndarray) -> Hyperelastic:
         """The law (kappa = 1) of the constants p = (linear, nonlinear)."""
-        return self.make(p[:len(self.linear)], p[len(self.linear):])
+        return self.make(p[: len(self.linear)], p[len(self.linear) :])
 
     def table(self, p: np.ndarray) -> dict:
         """The case-file constants (KEYS) of the law of p."""
@@ -219,8 +231,10 @@ class Family:
 
 def _max_I1(data: Data) -> float:
     """The largest I1 of the data points (incompressible: I1 = sum of squared stretches)."""
-    return max(float(np.sum(kinematics(m, data.stretch[data.mode == i]) ** 2, axis=-1).max(initial=3.0))
-               for i, m in enumerate(MODES))
+    return max(
+        float(np.sum(kinematics(m, data.stretch[data.mode == i]) ** 2, axis=-1).max(initial=3.0))
+        for i, m in enumerate(MODES)
+    )
 
 
 def family(model: str, terms: int = 3) -> Family:
@@ -229,25 +243,42 @@ def family(model: str, terms: int = 3) -> Family:
     if model == "neo-hooke":
         return Family(model, ("C1",), (), lambda a, b: MooneyRivlin(a[0], 0.0, 1.0), (positive,))
     if model == "mooney-rivlin":
-        return Family(model, ("C1", "C2"), (), lambda a, b: MooneyRivlin(a[0], a[1], 1.0),
-                      (positive, "nonnegative"))
+        return Family(model, ("C1", "C2"), (), lambda a, b: MooneyRivlin(a[0], a[1], 1.0), (positive, "nonnegative"))
     if model == "yeoh":
-        return Family(model, ("C10", "C20", "C30"), (), lambda a, b: Yeoh(a[0], a[1], a[2], 1.0),
-                      (positive, "free", "free"))
+        return Family(
+            model, ("C10", "C20", "C30"), (), lambda a, b: Yeoh(a[0], a[1], a[2], 1.0), (positive, "free", "free")
+        )
     if model == "ogden":
         n = terms
-        return Family(model, tuple(f"mu_{i + 1}" for i in range(n)), tuple(f"alpha_{i + 1}" for i in range(n)),
-                      lambda a, b: Ogden(tuple(a), tuple(b), 1.0), ("free",) * n,
-                      lambda data: (np.full(n, -ALPHA_BOUND), np.full(n, ALPHA_BOUND)),
-                      lambda data: [np.array(s[:n]) for s in OGDEN_ALPHA_STARTS])
+        return Family(
+            model,
+            tuple(f"mu_{i + 1}" for i in range(n)),
+            tuple(f"alpha_{i + 1}" for i in range(n)),
+            lambda a, b: Ogden(tuple(a), tuple(b), 1.0),
+            ("free",) * n,
+            lambda data: (np.full(n, -ALPHA_BOUND), np.full(n, ALPHA_BOUND)),
+            lambda data: [np.array(s[:n]) for s in OGDEN_ALPHA_STARTS],
+        )
     if model == "gent":
-        return Family(model, ("mu",), ("Jm",), lambda a, b: Gent(a[0], b[0], 1.0), (positive,),
-                      lambda data: (np.array([(_max_I1(data) - 3.0) * (1 + 1e-9)]), np.array([np.inf])),
-                      lambda data: [np.array([(_max_I1(data) - 3.0) * f]) for f in (1.05, 1.5, 3.0, 10.0, 100.0)])
+        return Family(
+            model,
+            ("mu",),
+            ("Jm",),
+            lambda a, b: Gent(a[0], b[0], 1.0),
+            (positive,),
+            lambda data: (np.array([(_max_I1(data) - 3.0) * (1 + 1e-9)]), np.array([np.inf])),
+            lambda data: [np.array([(_max_I1(data) - 3.0) * f]) for f in (1.05, 1.5, 3.0, 10.0, 100.0)],
+        )
     if model == "arruda-boyce":
-        return Family(model, ("mu",), ("lambda_m",), lambda a, b: ArrudaBoyce(a[0], b[0], 1.0), (positive,),
-                      lambda data: (np.array([1.0 + 1e-9]), np.array([np.inf])),
-                      lambda data: [np.array([v]) for v in (1.5, 3.0, 6.0, 12.0, 50.0)])
+        return Family(
+            model,
+            ("mu",),
+            ("lambda_m",),
+            lambda a, b: ArrudaBoyce(a[0], b[0], 1.0),
+            (positive,),
+            lambda data: (np.array([1.0 + 1e-9]), np.array([np.inf])),
+            lambda data: [np.array([v]) for v in (1.5, 3.0, 6.0, 12.0, 50.0)],
+        )
     raise ValueError(f"unknown model {model!r}")
 
 
@@ -297,8 +328,16 @@ def fit(data: Data, model: str, terms: int = 3, kappa: float | None = None) -> F
         basis = np.stack([_nominal(fam.law(np.concatenate([e, b])), data.x) for e in np.eye(n)], axis=1)
         a = lsq_linear(basis * w[:, None], np.sign(data.stress), bounds=(lin_lo, np.full(n, np.inf))).x
         p0 = np.clip(np.concatenate([a, b]), lo, hi)
-        sol = least_squares(lambda p: _residual(fam, data, p), p0, bounds=(lo, hi), x_scale="jac",
-                            xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=500)
+        sol = least_squares(
+            lambda p: _residual(fam, data, p),
+            p0,
+            bounds=(lo, hi),
+            x_scale="jac",
+            xtol=1e-12,
+            ftol=1e-12,
+            gtol=1e-12,
+            max_nfev=500,
+        )
         if _admissible(fam, sol.x) and (best is None or sol.cost < best.cost):
             best = sol
     if best is None:
@@ -381,7 +420,8 @@ def run(paths: list[str], model: str, terms: int | None, out: str | None, kappa:
     counts = ", ".join(f"{m} {c}" for m, c in result.points.items())
     table = material_table(result)
     (folder / "material.toml").write_text(
-        f"# axiform fit --model {model}: {', '.join(map(str, paths))} ({counts} points)\n" + table)
+        f"# axiform fit --model {model}: {', '.join(map(str, paths))} ({counts} points)\n" + table
+    )
     both = combined_range(result)
     summary = {
         "model": model,

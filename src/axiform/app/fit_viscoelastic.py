@@ -26,14 +26,16 @@ import numpy as np
 
 from ..case.schema import MAX_MAGNITUDE, MIN_MAGNITUDE
 from ..materials.viscoelastic import MAX_TERMS
-from ..materials.viscoelastic_fit import (PronyFit, WLFFit, decades, fit_dynamic, fit_relaxation, fit_wlf,
-                                          zero_crossing)
+from ..materials.viscoelastic_fit import PronyFit, WLFFit, decades, fit_dynamic, fit_relaxation, fit_wlf, zero_crossing
 from ..post.fit_viscoelastic_plots import plot_dynamic, plot_relaxation, plot_wlf
 from .fit import FitDataError, read_text
 from .run import prepare_folder
 
-HEADERS = {"relaxation": ("time", "modulus"), "dynamic": ("frequency", "storage", "loss"),
-           "wlf": ("temperature", "log10_shift")}
+HEADERS = {
+    "relaxation": ("time", "modulus"),
+    "dynamic": ("frequency", "storage", "loss"),
+    "wlf": ("temperature", "log10_shift"),
+}
 LONG_TERM_MIN = 1e-6  # E_inf / E0 below this: the data relax to nothing (no solid)
 WLF_POLE_MARGIN = 1e-3  # C2 + T - T_ref at the data or T_ref below this x their span: at the pole
 
@@ -69,7 +71,7 @@ def read_table(path: str | Path, kinds: tuple[str, ...]) -> Table:
         if len(cells) != len(header):
             raise FitDataError(f"{where}: expected {len(header)} values ({','.join(header)}), got {len(cells)}")
         values = []
-        for key, cell in zip(header, cells):
+        for key, cell in zip(header, cells, strict=False):
             try:
                 values.append(float(cell))
             except ValueError:
@@ -77,8 +79,10 @@ def read_table(path: str | Path, kinds: tuple[str, ...]) -> Table:
             if not math.isfinite(values[-1]):
                 raise FitDataError(f"{where}: {key} must be finite, got {cell}")
             if abs(values[-1]) > MAX_MAGNITUDE or 0 < abs(values[-1]) < MIN_MAGNITUDE:
-                raise FitDataError(f"{where}: {key} {cell} is beyond the magnitude of a number of axiform "
-                                   f"(nonzero, {MIN_MAGNITUDE:g} to {MAX_MAGNITUDE:g})")
+                raise FitDataError(
+                    f"{where}: {key} {cell} is beyond the magnitude of a number of axiform "
+                    f"(nonzero, {MIN_MAGNITUDE:g} to {MAX_MAGNITUDE:g})"
+                )
         rows.append(values)
         lines.append(number)
     if header is None:
@@ -94,8 +98,9 @@ def check_positive(table: Table, keys: tuple[str, ...]) -> None:
     for key in keys:
         bad = np.flatnonzero(table.columns[key] <= 0)
         if bad.size:
-            raise FitDataError(f"{table.path} line {table.lines[bad[0]]}: {key} must be > 0, "
-                               f"got {table.columns[key][bad[0]]:g}")
+            raise FitDataError(
+                f"{table.path} line {table.lines[bad[0]]}: {key} must be > 0, got {table.columns[key][bad[0]]:g}"
+            )
 
 
 def check_monotone(table: Table, key: str, sign: int, what: str) -> None:
@@ -104,8 +109,10 @@ def check_monotone(table: Table, key: str, sign: int, what: str) -> None:
     bad = np.flatnonzero(sign * np.diff(table.columns[key]) <= 0)
     if bad.size:
         i = bad[0] + 1
-        raise FitDataError(f"{table.path} line {table.lines[i]}: {key} must {what} from row to row, "
-                           f"got {table.columns[key][i]:g} after {table.columns[key][i - 1]:g}")
+        raise FitDataError(
+            f"{table.path} line {table.lines[i]}: {key} must {what} from row to row, "
+            f"got {table.columns[key][i]:g} after {table.columns[key][i - 1]:g}"
+        )
 
 
 def _error(message: str) -> int:
@@ -128,8 +135,9 @@ def _digits(values, n: int = 8) -> list[float]:
     return [float(f"{v:.{n}g}") for v in np.atleast_1d(values)]
 
 
-def run(paths: list[str], model: str, terms: int | None, out: str | None, kappa: float | None,
-        reference: float | None) -> int:
+def run(
+    paths: list[str], model: str, terms: int | None, out: str | None, kappa: float | None, reference: float | None
+) -> int:
     """The `axiform fit --model prony|wlf` command: exit 2 for bad input, 1 if nothing
     admissible, 0 otherwise."""
     if len(paths) != 1:
@@ -168,8 +176,9 @@ def prony_terms(table: Table, terms: int | None) -> tuple[int, tuple[float, floa
         if not 1 <= terms <= MAX_TERMS:
             raise FitDataError(f"--terms must be 1 to {MAX_TERMS}, got {terms}")
         if 2 * terms + 1 > values:
-            raise FitDataError(f"--terms {terms}: {2 * terms + 1} parameters (E0, g_i, tau_i) but {table.path} "
-                               f"holds {values} values")
+            raise FitDataError(
+                f"--terms {terms}: {2 * terms + 1} parameters (E0, g_i, tau_i) but {table.path} holds {values} values"
+            )
         return terms, span
     n = min(decades(*span), (values - 1) // 2)
     if n < 1:
@@ -187,8 +196,10 @@ def check_trend(table: Table) -> None:
         key, along, sign, wrong, right = "storage", "frequency", -1.0, "falls", "a storage modulus rises with frequency"
     v = table.columns[key]
     if sign * (v[-1] - v[0]) > 0:
-        raise FitDataError(f"{table.path} line {table.lines[-1]}: {key} {wrong} from {v[0]:g} at the first {along} "
-                           f"to {v[-1]:g} at the last: {right}")
+        raise FitDataError(
+            f"{table.path} line {table.lines[-1]}: {key} {wrong} from {v[0]:g} at the first {along} "
+            f"to {v[-1]:g} at the last: {right}"
+        )
 
 
 def run_prony(path: str, terms: int | None, out: str | None) -> int:
@@ -202,15 +213,21 @@ def run_prony(path: str, terms: int | None, out: str | None) -> int:
     if folder is None:
         return 2
     c = table.columns
-    result = (fit_relaxation(c["time"], c["modulus"], n) if table.kind == "relaxation"
-              else fit_dynamic(c["frequency"], c["storage"], c["loss"], n))
+    result = (
+        fit_relaxation(c["time"], c["modulus"], n)
+        if table.kind == "relaxation"
+        else fit_dynamic(c["frequency"], c["storage"], c["loss"], n)
+    )
     if not result.g.size:
         print(f"axiform fit: {path}: no relaxation: every term fitted carries no modulus", file=sys.stderr)
         return 1
     if result.long_term < LONG_TERM_MIN * result.E0:
-        print(f"axiform fit: {path}: the data relax to no long-term modulus (E0 (1 - sum g) = "
-              f"{result.long_term:.3g}, E0 = {result.E0:.6g}): a Prony series on a law needs one (sum g < 1). "
-              "Fit the curve up to its rubbery plateau, without the flow at the longest times", file=sys.stderr)
+        print(
+            f"axiform fit: {path}: the data relax to no long-term modulus (E0 (1 - sum g) = "
+            f"{result.long_term:.3g}, E0 = {result.E0:.6g}): a Prony series on a law needs one (sum g < 1). "
+            "Fit the curve up to its rubbery plateau, without the flow at the longest times",
+            file=sys.stderr,
+        )
         return 1
     g, tau = _digits(result.g), _digits(result.tau)
     summary = prony_summary(table, n, span, result)
@@ -220,13 +237,15 @@ def run_prony(path: str, terms: int | None, out: str | None) -> int:
         plot_relaxation(c["time"], c["modulus"], result, folder / "fit_prony.png")
     else:
         plot_dynamic(c["frequency"], c["storage"], c["loss"], result, folder / "fit_prony.png")
-    print(f"Prony series of {len(g)} terms fitted to {len(table.lines)} rows of {path} ({table.kind}); "
-          f"instantaneous modulus E0 = {result.E0:.6g}, long-term E0 (1 - sum g) = {result.long_term:.6g}")
+    print(
+        f"Prony series of {len(g)} terms fitted to {len(table.lines)} rows of {path} ({table.kind}); "
+        f"instantaneous modulus E0 = {result.E0:.6g}, long-term E0 (1 - sum g) = {result.long_term:.6g}"
+    )
     if result.dropped:
         print(f"{result.dropped} of {n} terms carried no modulus and were dropped")
     print()
     print(f"{'i':>3} {'g_i':>12} {'tau_i':>12}")
-    for i, (gi, ti) in enumerate(zip(g, tau), start=1):
+    for i, (gi, ti) in enumerate(zip(g, tau, strict=False), start=1):
         print(f"{i:>3} {gi:>12.6g} {ti:>12.6g}")
     for key, value in summary["rms_relative_error"].items():
         print(f"RMS relative error ({key}) {100 * value:.3g} %")
@@ -237,8 +256,11 @@ def run_prony(path: str, terms: int | None, out: str | None) -> int:
 def prony_summary(table: Table, n: int, span: tuple[float, float], result: PronyFit) -> dict:
     """fit.json of a Prony fit."""
     m = len(table.lines)
-    r = {"modulus": result.residual} if table.kind == "relaxation" else \
-        {"storage": result.residual[:m], "loss": result.residual[m:]}
+    r = (
+        {"modulus": result.residual}
+        if table.kind == "relaxation"
+        else {"storage": result.residual[:m], "loss": result.residual[m:]}
+    )
     return {
         "model": "prony",
         "data": str(table.path),
@@ -261,18 +283,21 @@ def prony_summary(table: Table, n: int, span: tuple[float, float], result: Prony
 def prony_snippet(table: Table, result: PronyFit, g: list[float], tau: list[float]) -> str:
     """material.toml of a Prony fit: the viscoelastic key and, as comments, how to set the law."""
     E0 = result.E0
-    return "\n".join([
-        f"# axiform fit --model prony: {table.path} ({table.kind}, {len(table.lines)} rows)",
-        f"# instantaneous modulus E0 = {E0:.6g}, long-term E0 (1 - sum g) = {result.long_term:.6g};",
-        "# tau in the data's time unit: the case's [units] time.  Give the law the initial",
-        "# modulus E0: incompressible neo-hooke C1 = E0 / 6 for a tensile modulus E(t), C1 = G0 / 2",
-        "# for a shear modulus G(t); e.g. for E(t):",
-        '# model = "neo-hooke"',
-        f"# C1 = {E0 / 6:.6g}",
-        f"# kappa = {1000 * E0 / 3:.6g}",
-        "[material]",
-        f"viscoelastic = {{ g = {g}, tau = {tau} }}",
-        ""])
+    return "\n".join(
+        [
+            f"# axiform fit --model prony: {table.path} ({table.kind}, {len(table.lines)} rows)",
+            f"# instantaneous modulus E0 = {E0:.6g}, long-term E0 (1 - sum g) = {result.long_term:.6g};",
+            "# tau in the data's time unit: the case's [units] time.  Give the law the initial",
+            "# modulus E0: incompressible neo-hooke C1 = E0 / 6 for a tensile modulus E(t), C1 = G0 / 2",
+            "# for a shear modulus G(t); e.g. for E(t):",
+            '# model = "neo-hooke"',
+            f"# C1 = {E0 / 6:.6g}",
+            f"# kappa = {1000 * E0 / 3:.6g}",
+            "[material]",
+            f"viscoelastic = {{ g = {g}, tau = {tau} }}",
+            "",
+        ]
+    )
 
 
 def run_wlf(path: str, reference: float | None, out: str | None) -> int:
@@ -285,14 +310,18 @@ def run_wlf(path: str, reference: float | None, out: str | None) -> int:
         if reference is None:
             reference = zero_crossing(T, y)
             if reference is None:
-                raise FitDataError(f"{path}: log10_shift does not reach 0 (from {y[0]:g} to {y[-1]:g}): "
-                                   "give the reference temperature with --reference")
+                raise FitDataError(
+                    f"{path}: log10_shift does not reach 0 (from {y[0]:g} to {y[-1]:g}): "
+                    "give the reference temperature with --reference"
+                )
             given = False
         else:
             given = True
         if len(T) < 2 + given:
-            raise FitDataError(f"{path}: {len(T)} rows, fewer than the {2 + given} parameters (C1, C2"
-                               f"{', the shift at --reference' if given else ''})")
+            raise FitDataError(
+                f"{path}: {len(T)} rows, fewer than the {2 + given} parameters (C1, C2"
+                f"{', the shift at --reference' if given else ''})"
+            )
     except FitDataError as exc:
         return _error(str(exc))
     folder = _folder(out, "wlf")
@@ -301,21 +330,30 @@ def run_wlf(path: str, reference: float | None, out: str | None) -> int:
     result = fit_wlf(T, y, reference, given)
     margin = result.C2 + min(T.min() - reference, 0.0)  # C2 + T - T_ref over the data and at T_ref
     if margin < WLF_POLE_MARGIN * np.ptp(T):
-        print(f"axiform fit: {path}: the shifts do not follow WLF: the fit runs into its pole (C2 + T - T_ref = "
-              f"{margin:.3g} at T = {min(T.min(), reference):g}; C1 = {result.C1:.6g}, C2 = {result.C2:.6g} at "
-              f"T_ref = {reference:g}); C2 + T - T_ref must stay > 0 over the data and at T_ref", file=sys.stderr)
+        print(
+            f"axiform fit: {path}: the shifts do not follow WLF: the fit runs into its pole (C2 + T - T_ref = "
+            f"{margin:.3g} at T = {min(T.min(), reference):g}; C1 = {result.C1:.6g}, C2 = {result.C2:.6g} at "
+            f"T_ref = {reference:g}); C2 + T - T_ref must stay > 0 over the data and at T_ref",
+            file=sys.stderr,
+        )
         return 1
     summary = wlf_summary(table, result, given, margin)
     (folder / "material.toml").write_text(wlf_snippet(table, result, margin))
     (folder / "fit.json").write_text(json.dumps(summary, indent=2) + "\n")
     plot_wlf(T, y, result, folder / "fit_wlf.png")
-    print(f"WLF fitted to {len(T)} rows of {path}: C1 = {result.C1:.6g}, C2 = {result.C2:.6g} at T_ref = "
-          f"{reference:.6g} ({'--reference' if given else 'where the data shift is 0'})")
+    print(
+        f"WLF fitted to {len(T)} rows of {path}: C1 = {result.C1:.6g}, C2 = {result.C2:.6g} at T_ref = "
+        f"{reference:.6g} ({'--reference' if given else 'where the data shift is 0'})"
+    )
     if given:
-        print(f"the data's log10 a_T at T_ref: {result.offset:.6g} (tau of a master curve at the data's own "
-              f"reference x 10^{result.offset:.6g} at T_ref)")
-    print(f"C2 + T - T_ref >= {margin:.6g} over the data and at T_ref (the pole at T = {reference - result.C2:.6g}); "
-          f"RMS error of log10 a_T {summary['rms_error']:.3g}")
+        print(
+            f"the data's log10 a_T at T_ref: {result.offset:.6g} (tau of a master curve at the data's own "
+            f"reference x 10^{result.offset:.6g} at T_ref)"
+        )
+    print(
+        f"C2 + T - T_ref >= {margin:.6g} over the data and at T_ref (the pole at T = {reference - result.C2:.6g}); "
+        f"RMS error of log10 a_T {summary['rms_error']:.3g}"
+    )
     print(f"\nwrote {folder / 'material.toml'}, fit.json, fit_wlf.png")
     return 0
 
@@ -342,12 +380,23 @@ def wlf_summary(table: Table, result: WLFFit, given: bool, margin: float) -> dic
 def wlf_snippet(table: Table, result: WLFFit, margin: float) -> str:
     """material.toml of a WLF fit: the [temperature] reference and shift."""
     C1, C2 = _digits([result.C1, result.C2])
-    lines = [f"# axiform fit --model wlf: {table.path} ({len(table.lines)} rows)",
-             f"# C2 + T - T_ref >= {margin:.6g} over the data and at T_ref: the pole at T = "
-             f"{result.reference - result.C2:.6g}"]
+    lines = [
+        f"# axiform fit --model wlf: {table.path} ({len(table.lines)} rows)",
+        f"# C2 + T - T_ref >= {margin:.6g} over the data and at T_ref: the pole at T = "
+        f"{result.reference - result.C2:.6g}",
+    ]
     if result.offset:
-        lines += [f"# the data's log10 a_T at this reference is {result.offset:.6g}: the relaxation times of a",
-                  f"# master curve at the data's own reference (shift 0) x 10^{result.offset:.6g} here"]
-    return "\n".join(lines + ["[temperature]", "# initial = ...  (the part's temperature, which the table needs)",
-                              f"reference = {_digits(result.reference)[0]}",
-                              f"shift = {{ wlf = {{ C1 = {C1}, C2 = {C2} }} }}", ""])
+        lines += [
+            f"# the data's log10 a_T at this reference is {result.offset:.6g}: the relaxation times of a",
+            f"# master curve at the data's own reference (shift 0) x 10^{result.offset:.6g} here",
+        ]
+    return "\n".join(
+        lines
+        + [
+            "[temperature]",
+            "# initial = ...  (the part's temperature, which the table needs)",
+            f"reference = {_digits(result.reference)[0]}",
+            f"shift = {{ wlf = {{ C1 = {C1}, C2 = {C2} }} }}",
+            "",
+        ]
+    )

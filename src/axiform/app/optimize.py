@@ -29,14 +29,15 @@ import contextlib
 import io
 import json
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
-from ..post.thickness import thickness_table
 from ..post.optimize_plots import plot_optimization
+from ..post.thickness import thickness_table
 from ..solve.solver import solve
 from .design import SMOOTHNESS, Objective, TargetError, ThicknessDesign, read_target
 from .sensitivity import sensitivity
@@ -152,8 +153,7 @@ def fixed_point(forward: Forward, initial: Iterate, max_iter: int, tolerance: fl
     best = current = initial
     while current.deviation > tolerance and len(forward.rows) <= max_iter:
         t = current.thickness
-        ratio = np.interp(design.knots, _stations(design, t)[inside],
-                          objective.target[inside] / t["thickness"][inside])
+        ratio = np.interp(design.knots, _stations(design, t)[inside], objective.target[inside] / t["thickness"][inside])
         ratio[~active] = 1.0
         current, _ = forward(np.clip(design.rule(current.design, ratio), lo, hi), False)
         if not current.finished:
@@ -224,8 +224,15 @@ class LeastSquares:
 
         lo, hi = self.forward.design.bounds()
         bounds = (self.forward.design.to_y(lo[self.active]), self.forward.design.to_y(hi[self.active]))
-        out = least_squares(self.fun, self.y0, jac=self.jac, bounds=bounds, method="trf",
-                            max_nfev=4 * self.max_iter + 4, callback=self.callback)
+        out = least_squares(
+            self.fun,
+            self.y0,
+            jac=self.jac,
+            bounds=bounds,
+            method="trf",
+            max_nfev=4 * self.max_iter + 4,
+            callback=self.callback,
+        )
         converged = out.status > 0
         if converged:
             message = f"the optimizer converged to a best fit: {out.message}"
@@ -236,9 +243,15 @@ class LeastSquares:
         return self.best, converged, message
 
 
-def optimize(design: Design, target: tuple[np.ndarray, np.ndarray], method: str = "gradient",
-             max_iter: int = 20, tolerance: float = TOLERANCE, smoothness: float = SMOOTHNESS,
-             report: Callable[[Row], None] | None = None) -> OptimizeResult:
+def optimize(
+    design: Design,
+    target: tuple[np.ndarray, np.ndarray],
+    method: str = "gradient",
+    max_iter: int = 20,
+    tolerance: float = TOLERANCE,
+    smoothness: float = SMOOTHNESS,
+    report: Callable[[Row], None] | None = None,
+) -> OptimizeResult:
     """Find the thickness table whose final wall meets the target (module docstring).
     report(row) is called with each row of optimize.csv as it comes."""
     if method not in METHODS:
@@ -249,9 +262,18 @@ def optimize(design: Design, target: tuple[np.ndarray, np.ndarray], method: str 
     initial, first = forward(design.initial.astype(float), method == "gradient")
     forward.record(initial)
     if not initial.finished:
-        return OptimizeResult(method, tolerance, forward.rows, initial, initial, forward.solves, False, "stopped",
-                              f"the forward solve of the initial design stopped: {initial.message}",
-                              time.perf_counter() - t0)
+        return OptimizeResult(
+            method,
+            tolerance,
+            forward.rows,
+            initial,
+            initial,
+            forward.solves,
+            False,
+            "stopped",
+            f"the forward solve of the initial design stopped: {initial.message}",
+            time.perf_counter() - t0,
+        )
     best, converged, message = initial, False, ""  # converged: a best fit that misses the tolerance
     if method == "fixed-point":
         best, message = fixed_point(forward, initial, max_iter, tolerance)
@@ -263,8 +285,18 @@ def optimize(design: Design, target: tuple[np.ndarray, np.ndarray], method: str 
     elif not message:
         message = f"the tolerance was not reached in {max_iter} iterations"
     status = "finished" if reached or converged else "stopped"
-    return OptimizeResult(method, tolerance, forward.rows, initial, best, forward.solves, reached, status, message,
-                          time.perf_counter() - t0)
+    return OptimizeResult(
+        method,
+        tolerance,
+        forward.rows,
+        initial,
+        best,
+        forward.solves,
+        reached,
+        status,
+        message,
+        time.perf_counter() - t0,
+    )
 
 
 def case_text(design: Design, values: np.ndarray) -> str:
@@ -274,8 +306,9 @@ def case_text(design: Design, values: np.ndarray) -> str:
     return tomli_w.dumps(design.case_tree(values))
 
 
-def write_outputs(out: Path, design: Design, result: OptimizeResult,
-                  target: tuple[np.ndarray, np.ndarray], final: Path | None) -> None:
+def write_outputs(
+    out: Path, design: Design, result: OptimizeResult, target: tuple[np.ndarray, np.ndarray], final: Path | None
+) -> None:
     """optimized.toml, optimize.csv, optimize.json and optimize.png in `out`."""
     import csv
 
@@ -287,29 +320,41 @@ def write_outputs(out: Path, design: Design, result: OptimizeResult,
     w.writerow(["iteration", "objective", "max_rel_deviation", "forward_solves"])
     w.writerows([i, repr(o), repr(d), n] for i, o, d, n in result.rows)
     write_atomic(out / "optimize.csv", table.getvalue())
-    summary = {"method": result.method, "tolerance": result.tolerance, "status": result.status, "message": result.message,
-               "reached": result.reached, "iterations": len(result.rows) - 1,
-               "forward_solves": result.forward_solves, "wall_time_s": round(result.wall_time_s, 3),
-               "objective": result.best.objective, "max_rel_deviation": result.best.deviation,
-               "initial_objective": result.initial.objective,
-               "initial_max_rel_deviation": result.initial.deviation,
-               "vary": design.name, "knots": design.knots.tolist(),
-               f"initial_{_quantity(design)}": design.initial.tolist(),
-               f"optimized_{_quantity(design)}": result.best.design.tolist(),
-               "final": None if final is None else final.name}
+    summary = {
+        "method": result.method,
+        "tolerance": result.tolerance,
+        "status": result.status,
+        "message": result.message,
+        "reached": result.reached,
+        "iterations": len(result.rows) - 1,
+        "forward_solves": result.forward_solves,
+        "wall_time_s": round(result.wall_time_s, 3),
+        "objective": result.best.objective,
+        "max_rel_deviation": result.best.deviation,
+        "initial_objective": result.initial.objective,
+        "initial_max_rel_deviation": result.initial.deviation,
+        "vary": design.name,
+        "knots": design.knots.tolist(),
+        f"initial_{_quantity(design)}": design.initial.tolist(),
+        f"optimized_{_quantity(design)}": result.best.design.tolist(),
+        "final": None if final is None else final.name,
+    }
     write_atomic(out / "optimize.json", json.dumps(summary, indent=2) + "\n")
     plot_optimization(out / "optimize.png", design, result, target)
 
 
 def _quantity(design: Design) -> str:
-    """"thickness" or "temperature": what the design's values are."""
+    """ "thickness" or "temperature": what the design's values are."""
     return "temperature" if isinstance(design, TemperatureDesign) else "thickness"
 
 
 def _invalid_option(max_iter: int, tolerance: float, smoothness: float) -> str | None:
     """The message for an option out of range, or None."""
-    for name, v, ok in (("--max-iter", max_iter, max_iter >= 1), ("--tolerance", tolerance, 0 < tolerance < 1),
-                        ("--smoothness", smoothness, smoothness >= 0 and np.isfinite(smoothness))):
+    for name, v, ok in (
+        ("--max-iter", max_iter, max_iter >= 1),
+        ("--tolerance", tolerance, 0 < tolerance < 1),
+        ("--smoothness", smoothness, smoothness >= 0 and np.isfinite(smoothness)),
+    ):
         if not ok:
             return f"axiform: invalid option:\n{name}: {v!r} is out of range"
     return None
@@ -334,9 +379,18 @@ def run_final(out_dir: Path, design: Design, result: OptimizeResult, quiet: bool
     return final
 
 
-def run(case_path: str, target_path: str, out: str, max_iter: int = 20, method: str = "gradient",
-        tolerance: float = TOLERANCE, smoothness: float = SMOOTHNESS, quiet: bool = False, vary: str = "thickness",
-        bounds: str | None = None) -> int:
+def run(
+    case_path: str,
+    target_path: str,
+    out: str,
+    max_iter: int = 20,
+    method: str = "gradient",
+    tolerance: float = TOLERANCE,
+    smoothness: float = SMOOTHNESS,
+    quiet: bool = False,
+    vary: str = "thickness",
+    bounds: str | None = None,
+) -> int:
     """`axiform optimize`: returns the exit code (0 finished, 1 stopped short, 2 invalid input).
     vary: "thickness" (the mesh.thickness table) or "temperature" ([temperature] initial);
     bounds: "LOW,HIGH" of every temperature (--vary temperature only)."""
@@ -355,12 +409,17 @@ def run(case_path: str, target_path: str, out: str, max_iter: int = 20, method: 
             say(f"axiform: invalid option:\n--bounds: {bounds!r} is not LOW,HIGH (two numbers)")
             return 2
         if vary != "temperature":
-            say("axiform: invalid option:\n--bounds: belongs to --vary temperature (a thickness is bounded to "
-                "0.2 to 5 times its initial value)")
+            say(
+                "axiform: invalid option:\n--bounds: belongs to --vary temperature (a thickness is bounded to "
+                "0.2 to 5 times its initial value)"
+            )
             return 2
     try:
-        design = (TemperatureDesign.from_case(case_file, bounds=limits) if vary == "temperature"
-                  else ThicknessDesign.from_case(case_file))
+        design = (
+            TemperatureDesign.from_case(case_file, bounds=limits)
+            if vary == "temperature"
+            else ThicknessDesign.from_case(case_file)
+        )
     except CaseError as exc:
         return invalid(case_file, exc)
     try:
@@ -379,19 +438,25 @@ def run(case_path: str, target_path: str, out: str, max_iter: int = 20, method: 
         say(f"axiform: invalid output folder:\n--out: {problem}")
         return 2
     if not quiet:
-        say(f"axiform optimize: {design.knots.size} design variables ({design.name}), method {method}, "
-            f"tolerance {tolerance:g} -> {out_dir}")
+        say(
+            f"axiform optimize: {design.knots.size} design variables ({design.name}), method {method}, "
+            f"tolerance {tolerance:g} -> {out_dir}"
+        )
 
     def report(row: Row) -> None:
         if not quiet:
-            say(f"iteration {row[0]}  objective {row[1]:.4g}  max deviation {100 * row[2]:.3g} %  "
-                f"forward solves {row[3]}")
+            say(
+                f"iteration {row[0]}  objective {row[1]:.4g}  max deviation {100 * row[2]:.3g} %  "
+                f"forward solves {row[3]}"
+            )
 
     with np.errstate(all="ignore"):
         result = optimize(design, target, method, max_iter, tolerance, smoothness, report)
     final = run_final(out_dir, design, result, quiet)
     write_outputs(out_dir, design, result, target, final)
-    say(f"axiform optimize: {result.status} after {len(result.rows) - 1} iterations, {result.forward_solves} "
+    say(
+        f"axiform optimize: {result.status} after {len(result.rows) - 1} iterations, {result.forward_solves} "
         f"forward solves, {result.wall_time_s:.1f} s: max deviation {100 * result.best.deviation:.3g} % "
-        f"({result.message}) -> {out_dir}")
+        f"({result.message}) -> {out_dir}"
+    )
     return 0 if result.status == "finished" else 1

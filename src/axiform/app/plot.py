@@ -16,8 +16,11 @@ def fields_of(folder: Path) -> set[str] | None:
     vtu = last_vtu(folder)
     if vtu is None or not vtu.exists():
         return None
-    return {a.get("Name") for a in ET.parse(vtu).getroot().iter("DataArray")
-            if a.get("Name") and a.get("Name") not in ("types", "offsets", "connectivity", "Points")}
+    return {
+        a.get("Name")
+        for a in ET.parse(vtu).getroot().iter("DataArray")
+        if a.get("Name") and a.get("Name") not in ("types", "offsets", "connectivity", "Points")
+    }
 
 
 def plot(folder: str, field: str, animate: bool = False) -> int:

@@ -154,8 +154,13 @@ def check_fit(state: dict, model, folder: Path) -> None:
     from ..case.schema import CaseError
     from ..io.checkpoint import FILE, check_like
 
-    template = {"path": {"u_f": np.zeros(model.n_free)}, "model": model.initial_state().to_dict(),
-                "size": 0.0, "step": 0, "newton_iterations": 0}
+    template = {
+        "path": {"u_f": np.zeros(model.n_free)},
+        "model": model.initial_state().to_dict(),
+        "size": 0.0,
+        "step": 0,
+        "newton_iterations": 0,
+    }
     try:
         check_like(state, template)
     except ValueError as exc:
@@ -185,7 +190,7 @@ class Job:
         self.warnings = preflight(self.built)
 
     @classmethod
-    def read(cls, case_file: Path, overrides: list[str], out: str | None, resume: str | None) -> "Job":
+    def read(cls, case_file: Path, overrides: list[str], out: str | None, resume: str | None) -> Job:
         """Read, validate and build the case (CaseError: exit 2)."""
         from ..case.schema import CaseError, build, parse, read
 
@@ -214,17 +219,35 @@ class Job:
         from ..post.labels import case_labels
 
         o, case = self.case.output, self.case
-        return ResultsWriter(out_dir, self.built.model, self.built.monitors, case.title, every=o.every, vtu=o.vtu,
-                             gid_files=o.gid, revolved=o.revolved, plots=o.plots,
-                             thickness_every=o.thickness_every, labels=case_labels(case),
-                             case={"file": str(self.case_file), "overrides": self.overrides, "sha256": self.digest},
-                             restart_every=case.restart.every,
-                             restart_meta={key: fingerprint(self.data.get(key, {})) for key in FROZEN_ON_RESUME},
-                             resume=self.state, flush_every_s=FLUSH_EVERY_S, warnings=self.warnings)
+        return ResultsWriter(
+            out_dir,
+            self.built.model,
+            self.built.monitors,
+            case.title,
+            every=o.every,
+            vtu=o.vtu,
+            gid_files=o.gid,
+            revolved=o.revolved,
+            plots=o.plots,
+            thickness_every=o.thickness_every,
+            labels=case_labels(case),
+            case={"file": str(self.case_file), "overrides": self.overrides, "sha256": self.digest},
+            restart_every=case.restart.every,
+            restart_meta={key: fingerprint(self.data.get(key, {})) for key in FROZEN_ON_RESUME},
+            resume=self.state,
+            flush_every_s=FLUSH_EVERY_S,
+            warnings=self.warnings,
+        )
 
 
-def run(case_path: str, out: str | None, quiet: bool = False, overrides: list[str] = (),
-        resume: str | None = None, stream=None) -> int:
+def run(
+    case_path: str,
+    out: str | None,
+    quiet: bool = False,
+    overrides: list[str] = (),
+    resume: str | None = None,
+    stream=None,
+) -> int:
     """Read, check, solve and write a case (or resume a run in its folder); returns the exit code.
     stream: where the header, the progress and the status line go (the command line gives
     sys.stdout); None: sys.stderr, as for a caller that captures stderr (a sweep's worker)."""
@@ -236,8 +259,9 @@ def run(case_path: str, out: str | None, quiet: bool = False, overrides: list[st
             return 128 + exc.signum
 
 
-def _run(case_file: Path, out: str | None, quiet: bool, overrides: list[str], stops: Stops,
-         resume: str | None, stream) -> int:
+def _run(
+    case_file: Path, out: str | None, quiet: bool, overrides: list[str], stops: Stops, resume: str | None, stream
+) -> int:
     from ..case.schema import CaseError
 
     try:
@@ -305,14 +329,18 @@ def _step_progress(job: Job, quiet: bool, stream):
         frac = (step.u[driven] if driven is not None else step.lam) / goal
         head = f"step {step.number}  {lam} {step.lam:.4g}{unit}  its {step.iterations}  {line.elapsed:.1f} s"
         mon = [f"{k} {v:.4g}" for k, v in list(values.items())[:3]]
-        line.show(frac, f"{100 * min(max(frac, 0.0), 1.0):5.1f}%  " + fitted(head, mon, COLUMNS - BAR_COLUMNS),
-                  fitted(head, mon, COLUMNS))
+        line.show(
+            frac,
+            f"{100 * min(max(frac, 0.0), 1.0):5.1f}%  " + fitted(head, mon, COLUMNS - BAR_COLUMNS),
+            fitted(head, mon, COLUMNS),
+        )
 
     return show, line
 
 
-def status_line(status: str, message: str, warnings: list[str], steps: int, iterations: int, wall: float,
-                out_dir: Path) -> str:
+def status_line(
+    status: str, message: str, warnings: list[str], steps: int, iterations: int, wall: float, out_dir: Path
+) -> str:
     """The final line of a run.  A stopped run with pre-run warnings says them first, as the
     likely cause, then the solver's message: `stopped at step N ...: likely cause: W; then M`."""
     head = f"axiform: {status}"
@@ -320,11 +348,15 @@ def status_line(status: str, message: str, warnings: list[str], steps: int, iter
         at = re.match(r"step (\d+): ", message)
         if at:
             head += f" at step {at.group(1)}"
-            message = message[at.end():]
-        message = f"likely cause: {'; '.join(warnings)}; then {message}" if message else \
-            f"likely cause: {'; '.join(warnings)}"
-    return (f"{head} after {steps} steps, {iterations} Newton iterations, {wall:.2f} s -> {out_dir}"
-            + (f": {message}" if message else ""))
+            message = message[at.end() :]
+        message = (
+            f"likely cause: {'; '.join(warnings)}; then {message}"
+            if message
+            else f"likely cause: {'; '.join(warnings)}"
+        )
+    return f"{head} after {steps} steps, {iterations} Newton iterations, {wall:.2f} s -> {out_dir}" + (
+        f": {message}" if message else ""
+    )
 
 
 def _solve(job: Job, out_dir: Path, note: str, writer, quiet: bool, stops: Stops, stream) -> int:
@@ -347,8 +379,11 @@ def _solve(job: Job, out_dir: Path, note: str, writer, quiet: bool, stops: Stops
         with stops.held():
             writer = writer or job.writer(out_dir)
         if not quiet:
-            tell(f"axiform {__version__}: {job.case.title or job.case_file.name}: {model.mesh.n_cells} "
-                 f"{model.mesh.element.name} elements, {model.n_free} free dofs -> {out_dir}{note}", stream=stream)
+            tell(
+                f"axiform {__version__}: {job.case.title or job.case_file.name}: {model.mesh.n_cells} "
+                f"{model.mesh.element.name} elements, {model.n_free} free dofs -> {out_dir}{note}",
+                stream=stream,
+            )
         warn(*job.warnings)
         result = solve(model, job.built.control, job.built.options, on_step=on_step, keep=1, resume=job.state)
         status, message = result.status, result.message
@@ -369,8 +404,9 @@ def _solve(job: Job, out_dir: Path, note: str, writer, quiet: bool, stops: Stops
     stops.raised = True  # wind up whatever comes now
     status, message = _finish(writer, status, message)
     wall = result.wall_time_s if result is not None else time.perf_counter() - t0
-    tell(status_line(status, message, job.warnings, writer.steps, writer.newton_iterations, wall, out_dir),
-         stream=stream)
+    tell(
+        status_line(status, message, job.warnings, writer.steps, writer.newton_iterations, wall, out_dir), stream=stream
+    )
     if status == "interrupted":
         return 128 + stops.signum
     return EXIT.get(status, 1)

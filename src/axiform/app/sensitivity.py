@@ -32,15 +32,15 @@ conduction step each with heat conduction), one back-substitution with m right-h
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
-from ..solve.linsolve import factorize
 from ..model.model import Model
-from ..solve.solver import LoadControl, NewtonOptions, SolveResult, Step, solve
 from ..post.thickness import thickness_table
+from ..solve.linsolve import factorize
+from ..solve.solver import LoadControl, NewtonOptions, SolveResult, Step, solve
 
 RELATIVE_STEP = 1e-6  # the difference step of the semi-analytic residual, relative to |s_k|
 
@@ -83,14 +83,19 @@ class Sensitivity:
 
 
 def _same_numbering(base: Model, other: Model, k: int) -> None:
-    if (other.mesh.n_nodes != base.mesh.n_nodes or other.n_free != base.n_free
-            or not np.array_equal(other.dofmap.eq, base.dofmap.eq)
-            or len(other.contacts) != len(base.contacts)
-            or any(not np.array_equal(a.nodes, b.nodes) for a, b in zip(base.contacts, other.contacts))
-            or len(other.cavities) != len(base.cavities)):
-        raise DesignError(f"the model built for a perturbed design variable {k} has other dofs, supports or "
-                          "contact nodes than the base model: select nodes by named sets (start, end, inner, "
-                          "outer, ...) or by coordinates that do not move with the design")
+    if (
+        other.mesh.n_nodes != base.mesh.n_nodes
+        or other.n_free != base.n_free
+        or not np.array_equal(other.dofmap.eq, base.dofmap.eq)
+        or len(other.contacts) != len(base.contacts)
+        or any(not np.array_equal(a.nodes, b.nodes) for a, b in zip(base.contacts, other.contacts, strict=False))
+        or len(other.cavities) != len(base.cavities)
+    ):
+        raise DesignError(
+            f"the model built for a perturbed design variable {k} has other dofs, supports or "
+            "contact nodes than the base model: select nodes by named sets (start, end, inner, "
+            "outer, ...) or by coordinates that do not move with the design"
+        )
 
 
 def has_history(model: Model) -> bool:
@@ -100,10 +105,15 @@ def has_history(model: Model) -> bool:
     return bool(model.contacts) or bool(model.initial_state().solid) or model.conduction is not None
 
 
-def sensitivity(build: Callable[[np.ndarray], Model], design: np.ndarray, control: LoadControl,
-                options: NewtonOptions | None = None, keep_steps: bool = True,
-                on_step: Callable[[Step, np.ndarray], None] | None = None,
-                relative_step: float = RELATIVE_STEP) -> Sensitivity:
+def sensitivity(
+    build: Callable[[np.ndarray], Model],
+    design: np.ndarray,
+    control: LoadControl,
+    options: NewtonOptions | None = None,
+    keep_steps: bool = True,
+    on_step: Callable[[Step, np.ndarray], None] | None = None,
+    relative_step: float = RELATIVE_STEP,
+) -> Sensitivity:
     """Solve the model build(design) under load control and differentiate every converged
     state with respect to the design variables (module docstring).
 
@@ -130,7 +140,9 @@ def sensitivity(build: Callable[[np.ndarray], Model], design: np.ndarray, contro
         for shadow in pair:
             _same_numbering(model, shadow, k)
         shadows.append(pair)
-    dx_ds = np.stack([(p.mesh.points - q.mesh.points) / (2 * hk) for (p, q), hk in zip(shadows, h)], axis=-1)
+    dx_ds = np.stack(
+        [(p.mesh.points - q.mesh.points) / (2 * hk) for (p, q), hk in zip(shadows, h, strict=False)], axis=-1
+    )
     history = has_history(model)
     dm = model.dofmap
     out = Sensitivity(SolveResult("running"), model, s, dx_ds)
@@ -144,13 +156,14 @@ def sensitivity(build: Callable[[np.ndarray], Model], design: np.ndarray, contro
         ev = model.evaluate(u_f, lam, lag_state)
         lag_state = step.state  # committed by the solver: h_n, the history of the next step's K
         dR = np.empty((model.n_free, m))
-        for k, ((plus, minus), (s_plus, s_minus)) in enumerate(zip(shadows, shadow_states)):
-            dR[:, k] = (plus.evaluate(u_f, lam, s_plus, tangent=False).r
-                        - minus.evaluate(u_f, lam, s_minus, tangent=False).r) / (2 * h[k])
+        for k, ((plus, minus), (s_plus, s_minus)) in enumerate(zip(shadows, shadow_states, strict=False)):
+            dR[:, k] = (
+                plus.evaluate(u_f, lam, s_plus, tangent=False).r - minus.evaluate(u_f, lam, s_minus, tangent=False).r
+            ) / (2 * h[k])
         du_f = -np.asarray(factorize(ev.K)(dR)).reshape(model.n_free, m)
         if history:
-            for k, (pair, states) in enumerate(zip(shadows, shadow_states)):
-                for j, (shadow, sign) in enumerate(zip(pair, (1.0, -1.0))):
+            for k, (pair, states) in enumerate(zip(shadows, shadow_states, strict=False)):
+                for j, (shadow, sign) in enumerate(zip(pair, (1.0, -1.0), strict=False)):
                     moved = u_f + sign * h[k] * du_f[:, k]
                     trial = shadow.evaluate(moved, lam, states[j], tangent=False).trial
                     states[j] = shadow.settle(states[j], trial, shadow.expand(moved, lam))
@@ -159,7 +172,7 @@ def sensitivity(build: Callable[[np.ndarray], Model], design: np.ndarray, contro
             out.du_ds.clear()
             out.dp_ds.clear()
         out.du_ds.append(du)
-        out.dp_ds.append(du_f[dm.nf:])
+        out.dp_ds.append(du_f[dm.nf :])
         if on_step is not None:
             on_step(step, du)
 

@@ -15,7 +15,8 @@ Case k (k = 1, 2, ...; the last key of [vary] varies fastest) runs in DIR/cases/
 DIR/cases/NNNN`: a normal results folder.  DIR/sweep.csv has one row per case (case, the
 varied keys, status, exit_code, steps, wall_time_s, message, the last value of every
 monitor, thickness_min (the thinnest wall at the end, meshes with a wall), then M_min and
-M_max of every monitor M over the run, from the case's history.csv), rewritten as cases finish; DIR/sweep.png plots the report monitor against the
+M_max of every monitor M over the run, from the case's history.csv), rewritten as cases finish; DIR/sweep.png plots
+the report monitor against the
 varied keys.  A case that fails or stops keeps its row; a second run of the same command
 skips the cases whose summary.json says "finished" for the same case text (resume).
 
@@ -91,7 +92,7 @@ class SweepFile(BaseModel):
         return value
 
     @model_validator(mode="after")
-    def _one_of(self) -> "SweepFile":
+    def _one_of(self) -> SweepFile:
         if (self.vary is None) == (self.cases is None):
             raise ValueError("vary / cases: give exactly one of [vary] (a full factorial) and [[cases]]")
         return self
@@ -164,7 +165,7 @@ def load_sweep(path: str | Path) -> Sweep:
         if n > MAX_CASES:
             raise CaseError(f"vary: {n:,} cases (the product of the list lengths); at most {MAX_CASES:,}")
         keys = list(spec.vary)
-        cases = [dict(zip(keys, combo)) for combo in itertools.product(*spec.vary.values())]
+        cases = [dict(zip(keys, combo, strict=False)) for combo in itertools.product(*spec.vary.values())]
     else:
         for i, case in enumerate(spec.cases):
             for key, value in case.items():
@@ -186,9 +187,12 @@ def load_sweep(path: str | Path) -> Sweep:
             raise CaseError(f"{where}: case {k + 1} ({text}) is invalid:\n{exc}") from None
         monitors = monitors if monitors is not None else [m.name for m in parsed.monitor]
     if monitor is not None and monitor not in monitors:
-        raise CaseError(f"report.monitor: the case has no monitor {monitor!r} (it has: {', '.join(monitors) or 'none'})")
-    return Sweep(case_file, keys, cases, monitor if monitor is not None else (monitors[0] if monitors else None),
-                 monitors)
+        raise CaseError(
+            f"report.monitor: the case has no monitor {monitor!r} (it has: {', '.join(monitors) or 'none'})"
+        )
+    return Sweep(
+        case_file, keys, cases, monitor if monitor is not None else (monitors[0] if monitors else None), monitors
+    )
 
 
 def run_case(case_file: str, overrides: list[str], out: str) -> dict[str, Any]:
@@ -204,8 +208,12 @@ def run_case(case_file: str, overrides: list[str], out: str) -> dict[str, Any]:
         with redirect_stderr(said), np.errstate(all="ignore"):  # as `axiform run`: the guards report
             code = run(case_file, out, quiet=True, overrides=overrides)
     except BaseException as exc:  # noqa: BLE001 - the row says what happened, the sweep goes on
-        return {"status": "failed", "exit_code": 3, "wall_time_s": time.perf_counter() - t0,
-                "message": f"{type(exc).__name__}: {exc}"}
+        return {
+            "status": "failed",
+            "exit_code": 3,
+            "wall_time_s": time.perf_counter() - t0,
+            "message": f"{type(exc).__name__}: {exc}",
+        }
     row = summary_row(Path(out))
     row["exit_code"] = code
     if row.get("status") in (None, "running"):
@@ -224,9 +232,16 @@ def summary_row(folder: Path) -> dict[str, Any]:
         s = json.loads((folder / "summary.json").read_text())
     except (OSError, ValueError):
         return {}
-    return {"status": s.get("status"), "steps": s.get("steps"), "wall_time_s": s.get("wall_time_s"),
-            "message": s.get("message", ""), "monitors": s.get("monitors", {}), "sha256": s.get("case", {}).get("sha256"),
-            "thickness_min": (s.get("thickness") or {}).get("min"), "extremes": monitor_extremes(folder / "history.csv")}
+    return {
+        "status": s.get("status"),
+        "steps": s.get("steps"),
+        "wall_time_s": s.get("wall_time_s"),
+        "message": s.get("message", ""),
+        "monitors": s.get("monitors", {}),
+        "sha256": s.get("case", {}).get("sha256"),
+        "thickness_min": (s.get("thickness") or {}).get("min"),
+        "extremes": monitor_extremes(folder / "history.csv"),
+    }
 
 
 def monitor_extremes(history: Path) -> dict[str, tuple[float, float]]:
@@ -264,8 +279,11 @@ class SweepProgress:
         elapsed = self.line.elapsed
         what = "skipped (finished before)" if skipped else f"{row.get('status')} (exit {row.get('exit_code')})"
         why = f": {row['message']}" if row.get("status") != "finished" and row.get("message") else ""
-        self.line.show(self.done, f"{self.done}/{self.total} cases, {self.failed} not finished, {elapsed:.1f} s",
-                       f"case {name} {what}  [{self.done}/{self.total}, {elapsed:.1f} s]{why}")
+        self.line.show(
+            self.done,
+            f"{self.done}/{self.total} cases, {self.failed} not finished, {elapsed:.1f} s",
+            f"case {name} {what}  [{self.done}/{self.total}, {elapsed:.1f} s]{why}",
+        )
 
     def close(self) -> None:
         self.line.close()
@@ -277,18 +295,37 @@ def write_table(path: Path, sweep: Sweep, rows: list[dict | None]) -> None:
 
     text = io.StringIO()
     w = csv.writer(text, lineterminator="\n")
-    w.writerow(["case", *sweep.keys, *FIXED_COLUMNS, *sweep.monitors, "thickness_min",
-                *[f"{m}_{end}" for m in sweep.monitors for end in ("min", "max")]])
+    w.writerow(
+        [
+            "case",
+            *sweep.keys,
+            *FIXED_COLUMNS,
+            *sweep.monitors,
+            "thickness_min",
+            *[f"{m}_{end}" for m in sweep.monitors for end in ("min", "max")],
+        ]
+    )
     for k, row in enumerate(rows):
         row = row or {"status": "pending"}
-        values = [v if isinstance(v, str) else toml_value(v) for v in (sweep.cases[k].get(key, "") for key in sweep.keys)]
+        values = [
+            v if isinstance(v, str) else toml_value(v) for v in (sweep.cases[k].get(key, "") for key in sweep.keys)
+        ]
         wall = row.get("wall_time_s")
         monitors, extremes, thinnest = row.get("monitors", {}), row.get("extremes", {}), row.get("thickness_min")
-        w.writerow([f"{k + 1:04d}", *values, row.get("status", ""), row.get("exit_code", ""), row.get("steps", ""),
-                    "" if wall is None else f"{wall:.3f}", " ".join(str(row.get("message", "")).split()),
-                    *[repr(monitors[m]) if m in monitors else "" for m in sweep.monitors],
-                    "" if thinnest is None else repr(thinnest),
-                    *[repr(v) for m in sweep.monitors for v in extremes.get(m, ("", ""))]])
+        w.writerow(
+            [
+                f"{k + 1:04d}",
+                *values,
+                row.get("status", ""),
+                row.get("exit_code", ""),
+                row.get("steps", ""),
+                "" if wall is None else f"{wall:.3f}",
+                " ".join(str(row.get("message", "")).split()),
+                *[repr(monitors[m]) if m in monitors else "" for m in sweep.monitors],
+                "" if thinnest is None else repr(thinnest),
+                *[repr(v) for m in sweep.monitors for v in extremes.get(m, ("", ""))],
+            ]
+        )
     write_atomic(path, text.getvalue())
 
 
@@ -300,8 +337,14 @@ def _client(scheduler: str | None, workers: int | None):
 
     if scheduler:
         return Client(scheduler), None
-    cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                           dashboard_address=None, silence_logs=logging.ERROR, env=WORKER_ENV)
+    cluster = LocalCluster(
+        n_workers=workers or os.cpu_count() or 1,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=None,
+        silence_logs=logging.ERROR,
+        env=WORKER_ENV,
+    )
     return Client(cluster), cluster
 
 
@@ -320,7 +363,9 @@ def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: 
     try:
         (root / "cases").mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        print(f"axiform: invalid output folder:\n--out: cannot create {root / 'cases'} ({exc.strerror or exc})", file=say)
+        print(
+            f"axiform: invalid output folder:\n--out: cannot create {root / 'cases'} ({exc.strerror or exc})", file=say
+        )
         return 2
     n = len(sweep.cases)
     rows: list[dict | None] = [None] * n
@@ -329,7 +374,9 @@ def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: 
     todo = []
     for k in range(n):  # resume: a finished folder of the same case text is kept
         done = summary_row(folders[k])
-        if done.get("status") == "finished" and done.get("sha256") == fingerprint(read(sweep.case_file, sweep.overrides(k))):
+        if done.get("status") == "finished" and done.get("sha256") == fingerprint(
+            read(sweep.case_file, sweep.overrides(k))
+        ):
             rows[k] = done | {"exit_code": 0}
             progress(folders[k].name, rows[k], skipped=True)
         else:
@@ -341,9 +388,17 @@ def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: 
 
         client, cluster = _client(scheduler, workers)
         try:
-            futures = {client.submit(run_case, str(sweep.case_file), sweep.overrides(k), str(folders[k].resolve()),
-                                     key=f"axiform-case-{k + 1:04d}-{os.getpid()}-{time.time_ns()}", pure=False): k
-                       for k in todo}
+            futures = {
+                client.submit(
+                    run_case,
+                    str(sweep.case_file),
+                    sweep.overrides(k),
+                    str(folders[k].resolve()),
+                    key=f"axiform-case-{k + 1:04d}-{os.getpid()}-{time.time_ns()}",
+                    pure=False,
+                ): k
+                for k in todo
+            }
             for future in as_completed(futures):
                 k = futures[future]
                 try:
@@ -362,7 +417,10 @@ def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: 
     except Exception as exc:  # noqa: BLE001 - the cases and sweep.csv stand; say why the picture does not
         print(f"axiform sweep: sweep.png not written ({type(exc).__name__}: {exc})", file=say)
     bad = [f"{k + 1:04d}" for k, r in enumerate(rows) if r.get("status") != "finished"]
-    print(f"axiform sweep: {n - len(bad)} of {n} cases finished" + (f"; not finished: {', '.join(bad)}" if bad else "")
-          + f" -> {root / 'sweep.csv'}", file=say)
+    print(
+        f"axiform sweep: {n - len(bad)} of {n} cases finished"
+        + (f"; not finished: {', '.join(bad)}" if bad else "")
+        + f" -> {root / 'sweep.csv'}",
+        file=say,
+    )
     return 1 if bad else 0
-

@@ -45,8 +45,9 @@ class TemperatureDesign(CaseDesign):
     name = "temperature.initial"
 
     @classmethod
-    def from_case(cls, path: str | Path, overrides: list[str] = (), bounds: tuple[float, float] | None = None
-                  ) -> "TemperatureDesign":
+    def from_case(
+        cls, path: str | Path, overrides: list[str] = (), bounds: tuple[float, float] | None = None
+    ) -> TemperatureDesign:
         """Read a case for temperature programming: a [temperature] whose initial field is a
         table, load control, a wall with thickness stations.  CaseError names the key."""
         path = Path(path)
@@ -54,28 +55,35 @@ class TemperatureDesign(CaseDesign):
         case = parse(tree)
         heat = case.temperature
         if heat is None or isinstance(heat.initial, float):
-            raise CaseError("temperature.initial: optimize --vary temperature needs the initial temperature as a "
-                            "table, initial = { along = \"s\" | \"r\" | \"z\", table = [[x, T], ...] }: its T are the "
-                            "design variables")
+            raise CaseError(
+                "temperature.initial: optimize --vary temperature needs the initial temperature as a "
+                'table, initial = { along = "s" | "r" | "z", table = [[x, T], ...] }: its T are the '
+                "design variables"
+            )
         if case.solver.control != "load":
-            raise CaseError(f"solver.control: optimize follows the load path under load control, not "
-                            f"\"{case.solver.control}\"")
+            raise CaseError(
+                f'solver.control: optimize follows the load path under load control, not "{case.solver.control}"'
+            )
         built = build(case, path.parent)
         if built.model.mesh.fibres is None:
             raise CaseError("mesh: optimize needs a wall whose thickness is measured (a layered or rectangle mesh)")
         table = np.asarray(heat.initial.table, float)
-        limits = bounds if bounds is not None else (float(table[:, 1].min()) - MARGIN,
-                                                    float(table[:, 1].max()) + MARGIN)
+        limits = (
+            bounds if bounds is not None else (float(table[:, 1].min()) - MARGIN, float(table[:, 1].max()) + MARGIN)
+        )
         if not limits[0] < limits[1]:
             raise CaseError(f"--bounds: the low bound {limits[0]:g} must be below the high one {limits[1]:g}")
-        return cls(absolute_paths(tree, path.parent), path.parent, heat.initial.along, table[:, 0], table[:, 1],
-                   built, limits)
+        return cls(
+            absolute_paths(tree, path.parent), path.parent, heat.initial.along, table[:, 0], table[:, 1], built, limits
+        )
 
     def case_tree(self, values: np.ndarray) -> dict[str, Any]:
         """The case tree with the temperature table's T replaced by `values`."""
         tree = copy.deepcopy(self.tree)
-        tree["temperature"]["initial"] = {"along": self.along,
-                                          "table": [[float(x), float(T)] for x, T in zip(self.knots, values)]}
+        tree["temperature"]["initial"] = {
+            "along": self.along,
+            "table": [[float(x), float(T)] for x, T in zip(self.knots, values, strict=False)],
+        }
         return tree
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:

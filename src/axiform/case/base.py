@@ -48,7 +48,7 @@ class CurveMixin(Strict):
     def _curve(self):
         if self.curve is not None:
             t = [k[0] for k in self.curve]
-            if any(b <= a for a, b in zip(t, t[1:])):
+            if any(b <= a for a, b in zip(t, t[1:], strict=False)):
                 raise ValueError("curve: the times must increase")
         return self
 

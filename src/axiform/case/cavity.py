@@ -7,11 +7,11 @@ from typing import Annotated, Literal
 
 from pydantic import Field, model_validator
 
-from .base import CaseError, CurveMixin, PositiveFloat, Selector
 from ..fem.cavity import Cavity, CavityError
 from ..fem.mesh import Mesh
-from ..model.model import Model
 from ..fem.selectors import select_edges
+from ..model.model import Model
+from .base import CaseError, CurveMixin, PositiveFloat, Selector
 
 
 class CavitySpec(CurveMixin):

@@ -11,16 +11,16 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from .base import CaseError, CurveKnots, CurveMixin, PositiveFloat, Selector, Strict
 from ..contact.dxf import DxfError, read_dxf
 from ..contact.pair import ContactPair
 from ..contact.surfaces import Circle, Polyline
-from ..model.guards import chain_crossing
-from ..materials import Hyperelastic
 from ..fem.mesh import Mesh
-from ..model.model import Model
 from ..fem.profile import Arc, Line, Profile, ProfileError
 from ..fem.selectors import select_nodes
+from ..materials import Hyperelastic
+from ..model.guards import chain_crossing
+from ..model.model import Model
+from .base import CaseError, CurveKnots, CurveMixin, PositiveFloat, Selector, Strict
 
 
 class CircleSpec(Strict):
@@ -148,8 +148,9 @@ def _path_surface(spec: SurfaceSpec, motion: tuple[float, float], base: Path, wh
     if spec.polyline is not None:
         points = np.asarray(spec.polyline, float)
     elif spec.profile is not None:
-        pieces = tuple(Line(p.line.to, 1) if p.line else Arc(p.arc.center, p.arc.to, 1, p.arc.ccw)
-                       for p in spec.profile.pieces)
+        pieces = tuple(
+            Line(p.line.to, 1) if p.line else Arc(p.arc.center, p.arc.to, 1, p.arc.ccw) for p in spec.profile.pieces
+        )
         try:
             profile = Profile(spec.profile.start, pieces)
             profile.sample(1)  # checks the arcs
@@ -159,8 +160,9 @@ def _path_surface(spec: SurfaceSpec, motion: tuple[float, float], base: Path, wh
     elif spec.dxf is not None:
         path = Path(spec.dxf)
         try:
-            return read_dxf(path if path.is_absolute() else base / path, spec.layer, tolerance=spec.tolerance,
-                            motion=motion)
+            return read_dxf(
+                path if path.is_absolute() else base / path, spec.layer, tolerance=spec.tolerance, motion=motion
+            )
         except DxfError as exc:
             raise CaseError(f"{where}.surface.dxf: {exc}") from None
     else:
@@ -178,8 +180,10 @@ def _path_surface(spec: SurfaceSpec, motion: tuple[float, float], base: Path, wh
             raise CaseError(f"{where}.surface.file: {path} must have two columns, r and z")
         bad = np.flatnonzero(~(np.abs(points) <= MAX_MAGNITUDE).all(axis=1))  # NaN compares False
         if bad.size:
-            raise CaseError(f"{where}.surface.file: {path} row {bad[0] + 1} of the data is not two finite numbers "
-                            f"(of at most {MAX_MAGNITUDE:g} in magnitude)")
+            raise CaseError(
+                f"{where}.surface.file: {path} row {bad[0] + 1} of the data is not two finite numbers "
+                f"(of at most {MAX_MAGNITUDE:g} in magnitude)"
+            )
     try:
         return Polyline(motion=motion, points=points)
     except ValueError as exc:
@@ -193,8 +197,10 @@ def _uncrossed(surface, where: str):
         found = chain_crossing(pts)
         if found is not None:
             i, j = found
-            raise CaseError(f"{where}.surface: the outline crosses or runs back over itself (near r, z = "
-                            f"{pts[i][0]:.6g}, {pts[i][1]:.6g} and {pts[j][0]:.6g}, {pts[j][1]:.6g})")
+            raise CaseError(
+                f"{where}.surface: the outline crosses or runs back over itself (near r, z = "
+                f"{pts[i][0]:.6g}, {pts[i][1]:.6g} and {pts[j][0]:.6g}, {pts[j][1]:.6g})"
+            )
     return surface
 
 
@@ -205,9 +211,19 @@ def contact_pair(mesh: Mesh, model: Model, spec: ContactSpec, base: Path, where:
     surface.curve = spec.motion.build_curve()
     slaves = select_nodes(mesh, spec.slaves.model_dump(), f"{where}.slaves")
     try:
-        pair = ContactPair(mesh, surface, slaves, spec.penalty, friction=spec.friction, sticky=spec.sticky,
-                           tangential_penalty=spec.tangential_penalty, depth=spec.depth, search=spec.search,
-                           modulus=youngs_modulus(model.material), stabilization=spec.stabilization)
+        pair = ContactPair(
+            mesh,
+            surface,
+            slaves,
+            spec.penalty,
+            friction=spec.friction,
+            sticky=spec.sticky,
+            tangential_penalty=spec.tangential_penalty,
+            depth=spec.depth,
+            search=spec.search,
+            modulus=youngs_modulus(model.material),
+            stabilization=spec.stabilization,
+        )
     except ValueError as exc:
         raise CaseError(f"{where}.slaves: {exc}") from None
     pair.name = spec.name or (spec.surface.layer.lower() if spec.surface.layer else None)

@@ -8,10 +8,10 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field
 
-from .base import CaseError, CurveMixin, DofName, Selector
 from ..fem.mesh import Mesh
-from ..model.model import Model
 from ..fem.selectors import select_edges, select_nodes
+from ..model.model import Model
+from .base import CaseError, CurveMixin, DofName, Selector
 
 
 class FixSpec(CurveMixin):
@@ -44,8 +44,10 @@ def prescribe_fixes(model: Model, mesh: Mesh, fixes: list[FixSpec]) -> None:
             clash = (owner[d] >= 0) & (value[d] != f.value)
             if clash.any():
                 k = int(np.argmax(clash))
-                raise CaseError(f"fix[{i}].value: {name} of node {int(nodes[k])} is also prescribed by "
-                                f"fix[{owner[d][k]}], with value {float(value[d][k])!r}, not {f.value!r}")
+                raise CaseError(
+                    f"fix[{i}].value: {name} of node {int(nodes[k])} is also prescribed by "
+                    f"fix[{owner[d][k]}], with value {float(value[d][k])!r}, not {f.value!r}"
+                )
             owner[d], value[d] = i, f.value
         model.prescribe(nodes, f.dofs, f.value, f.build_curve())
 
@@ -56,5 +58,6 @@ def apply_loads(model: Model, mesh: Mesh, pressures: list[PressureSpec], point_l
     for i, p in enumerate(pressures):
         model.pressure(select_edges(mesh, p.on.model_dump(), f"pressure[{i}].on"), p.value, p.build_curve())
     for i, pl in enumerate(point_loads):
-        model.point_load(select_nodes(mesh, pl.at.model_dump(), f"point_load[{i}].at"), pl.dof, pl.value,
-                         pl.build_curve())
+        model.point_load(
+            select_nodes(mesh, pl.at.model_dump(), f"point_load[{i}].at"), pl.dof, pl.value, pl.build_curve()
+        )

@@ -62,7 +62,7 @@ def _check_number(value: Any, test, need: str) -> Any:
     if not value:
         raise ValueError("a table of the temperature needs at least one row [T, value]")
     T = [row[0] for row in value]
-    if any(b <= a for a, b in zip(T, T[1:])):
+    if any(b <= a for a, b in zip(T, T[1:], strict=False)):
         raise ValueError("a table of the temperature: T must increase from row to row")
     for t, v in value:
         if not test(v):
@@ -74,8 +74,9 @@ def _belongs(key: str, info: ValidationInfo) -> str | None:
     """The model, after checking that the key belongs to it (None if the model is invalid)."""
     model = info.data.get("model")
     if model is not None and key not in KEYS[model] + ("kappa", "E", "nu"):
-        raise ValueError(f"does not belong to model = \"{model}\" (its keys: "
-                         f"{', '.join(KEYS[model])}, and kappa or E and nu)")
+        raise ValueError(
+            f'does not belong to model = "{model}" (its keys: {", ".join(KEYS[model])}, and kappa or E and nu)'
+        )
     return model
 
 
@@ -148,8 +149,12 @@ class MaterialSpec(BaseModel):
         if isinstance(value, list) and all(isinstance(row, list) and len(row) == 2 for row in value):
             rows = [_numbers(row, "a row [T, value] of the table") for row in value]
             return _check_number([tuple(r) for r in rows], lambda v: v > 0, "must be > 0")
-        if isinstance(value, bool) or not isinstance(value, int | float) or value != value \
-                or abs(value) == float("inf"):
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, int | float)
+            or value != value
+            or abs(value) == float("inf")
+        ):
             raise ValueError(f"must be a finite number (or a table [[T, value], ...]), got {value!r}")
         if not value > 0:
             raise ValueError(f"must be > 0, got {value}")
@@ -166,7 +171,7 @@ class MaterialSpec(BaseModel):
         if isinstance(mu, list):
             if len(mu) != len(alpha):
                 raise ValueError(f"needs as many entries as mu ({len(mu)}), got {len(alpha)}")
-            if not sum(m * a for m, a in zip(mu, alpha)) > 0:
+            if not sum(m * a for m, a in zip(mu, alpha, strict=False)) > 0:
                 raise ValueError("sum of mu_i alpha_i must be > 0 (a positive initial shear modulus)")
         return alpha
 
@@ -219,8 +224,9 @@ class MaterialSpec(BaseModel):
         mu0 = E / (2.0 * (1.0 + nu)) if E is not None else None
         m = self.model
         if m in ("neo-hooke", "mooney-rivlin"):
-            return MooneyRivlin(c["C1"] if c["C1"] is not None else mu0 / 2.0,
-                                c["C2"] if c["C2"] is not None else 0.0, kappa)
+            return MooneyRivlin(
+                c["C1"] if c["C1"] is not None else mu0 / 2.0, c["C2"] if c["C2"] is not None else 0.0, kappa
+            )
         if m == "yeoh":
             return Yeoh(c["C10"] if c["C10"] is not None else mu0 / 2.0, c["C20"], c["C30"], kappa)
         if m == "ogden":

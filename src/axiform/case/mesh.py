@@ -12,9 +12,9 @@ from typing import Annotated, Literal
 
 from pydantic import Field, model_validator
 
-from .base import CaseError, PositiveFloat, Strict
 from ..fem.mesh import Mesh, MeshError, layered, read_gmsh, rectangle
 from ..fem.profile import Arc, Line, Profile, ProfileError
+from .base import CaseError, PositiveFloat, Strict
 
 
 class LinePiece(Strict):
@@ -42,8 +42,11 @@ class PieceSpec(Strict):
         return self
 
 
-_GRID_KEYS = {"rectangle": ("r", "z", "divisions"), "gmsh": ("file",),
-              "layered": ("start", "profile", "thickness", "layers")}
+_GRID_KEYS = {
+    "rectangle": ("r", "z", "divisions"),
+    "gmsh": ("file",),
+    "layered": ("start", "profile", "thickness", "layers"),
+}
 
 
 class MeshSpec(Strict):
@@ -87,8 +90,10 @@ class MeshSpec(Strict):
         return self
 
     def build_profile(self):
-        pieces = tuple(Line(p.line.to, p.line.divisions) if p.line else
-                       Arc(p.arc.center, p.arc.to, p.arc.divisions, p.arc.ccw) for p in self.profile)
+        pieces = tuple(
+            Line(p.line.to, p.line.divisions) if p.line else Arc(p.arc.center, p.arc.to, p.arc.divisions, p.arc.ccw)
+            for p in self.profile
+        )
         return Profile(self.start, pieces)
 
 
@@ -135,9 +140,11 @@ def check_size(spec: MeshSpec, memory: int | None = None) -> None:
     memory = physical_memory() if memory is None else memory
     if size is not None and size[1] * BYTES_PER_DOF > memory:
         nodes, dofs, what = size
-        raise CaseError(f"{what} {spec.element} elements make {nodes:,} nodes, {dofs:,} dofs, which would need "
-                        f"about {dofs * BYTES_PER_DOF / 2**30:,.1f} GiB to build (this machine has "
-                        f"{memory / 2**30:,.1f} GiB): use fewer divisions")
+        raise CaseError(
+            f"{what} {spec.element} elements make {nodes:,} nodes, {dofs:,} dofs, which would need "
+            f"about {dofs * BYTES_PER_DOF / 2**30:,.1f} GiB to build (this machine has "
+            f"{memory / 2**30:,.1f} GiB): use fewer divisions"
+        )
 
 
 def build_mesh(spec: MeshSpec, base: Path) -> Mesh:

@@ -9,13 +9,14 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field, field_validator, model_validator
 
-from .base import CaseError, DofName, Selector, Strict, one_node
-from ..fem.cavity import Cavity
 from ..contact.pair import ContactPair
+from ..fem.cavity import Cavity
 from ..fem.mesh import Mesh
-from ..model.model import Model
 from ..fem.selectors import select_nodes
+from ..model.model import Model
 from ..post.results_folder import HISTORY_COLUMNS
+from .base import CaseError, DofName, Selector, Strict, one_node
+
 # characters a monitor name may not hold (besides the unprintable ones): the CSV separators and quotes
 NOT_IN_NAMES = frozenset(',;"\t')
 
@@ -36,12 +37,16 @@ class MonitorSpec(Strict):
     @classmethod
     def _name(cls, name: str) -> str:
         if not name.strip() or name in HISTORY_COLUMNS or name != name.strip():
-            raise ValueError(f"{name!r}: a monitor name must not be empty, begin or end with blanks, or be "
-                             f"one of the columns {', '.join(HISTORY_COLUMNS)}")
+            raise ValueError(
+                f"{name!r}: a monitor name must not be empty, begin or end with blanks, or be "
+                f"one of the columns {', '.join(HISTORY_COLUMNS)}"
+            )
         bad = sorted({c for c in name if c in NOT_IN_NAMES or not c.isprintable()})
         if bad:  # the name heads a column of history.csv (and sweep.csv) and labels the plots
-            raise ValueError(f"{name!r}: a monitor name heads a CSV column: it may not hold "
-                             f"{' '.join(repr(c) for c in bad)} (no commas, semicolons, double quotes, tabs or line breaks)")
+            raise ValueError(
+                f"{name!r}: a monitor name heads a CSV column: it may not hold "
+                f"{' '.join(repr(c) for c in bad)} (no commas, semicolons, double quotes, tabs or line breaks)"
+            )
         return name
 
     @model_validator(mode="after")
@@ -51,12 +56,12 @@ class MonitorSpec(Strict):
             raise ValueError("a monitor needs exactly one of 'at', 'reaction', 'contact' or 'cavity'")
         if self.cavity is not None:
             if self.quantity not in ("pressure", "volume"):
-                raise ValueError("a cavity monitor needs quantity = \"pressure\" or \"volume\"")
+                raise ValueError('a cavity monitor needs quantity = "pressure" or "volume"')
             if self.dof is not None:
                 raise ValueError("'dof' does not belong to a cavity monitor")
             return self
         if self.quantity in ("pressure", "volume"):
-            raise ValueError(f"quantity = \"{self.quantity}\" belongs to a cavity monitor")
+            raise ValueError(f'quantity = "{self.quantity}" belongs to a cavity monitor')
         if self.quantity == "temperature":
             if self.at is None or self.dof is not None:
                 raise ValueError("a temperature monitor needs 'at' (one node) and no 'dof'")
@@ -74,8 +79,7 @@ class MonitorSpec(Strict):
         return self
 
 
-_CONTACT_QUANTITY = {"force-r": "force_r", "force-z": "force_z", "area": "contact_area",
-                     "penetration": "penetration"}
+_CONTACT_QUANTITY = {"force-r": "force_r", "force-z": "force_z", "area": "contact_area", "penetration": "penetration"}
 
 
 @dataclass
@@ -107,8 +111,14 @@ class Monitor:
         return float(step.u[self.dofs].sum())
 
 
-def build_monitors(model: Model, mesh: Mesh, specs: list[MonitorSpec], cavities: dict[str, Cavity],
-                   pairs: list[ContactPair], element: str) -> list[Monitor]:
+def build_monitors(
+    model: Model,
+    mesh: Mesh,
+    specs: list[MonitorSpec],
+    cavities: dict[str, Cavity],
+    pairs: list[ContactPair],
+    element: str,
+) -> list[Monitor]:
     """The monitors of the [[monitor]] tables, over the case's cavities (by name), contact pairs
     (in [[contact]] order) and element (named in the error for a rotation it lacks)."""
     monitors = []
@@ -122,12 +132,15 @@ def build_monitors(model: Model, mesh: Mesh, specs: list[MonitorSpec], cavities:
         if m.contact is not None:
             if m.contact >= len(pairs):
                 raise CaseError(f"monitor[{i}].contact: there are {len(pairs)} [[contact]] tables (from 0)")
-            monitors.append(Monitor(m.name, pair=pairs[m.contact], quantity=m.quantity,
-                                    index=model.contacts.index(pairs[m.contact])))
+            monitors.append(
+                Monitor(
+                    m.name, pair=pairs[m.contact], quantity=m.quantity, index=model.contacts.index(pairs[m.contact])
+                )
+            )
             continue
         if m.quantity == "temperature":
             if model.temperature is None:
-                raise CaseError(f"monitor[{i}].quantity: \"temperature\" needs the case's [temperature]")
+                raise CaseError(f'monitor[{i}].quantity: "temperature" needs the case\'s [temperature]')
             monitors.append(Monitor(m.name, quantity="temperature", index=one_node(mesh, m.at, f"monitor[{i}].at")))
             continue
         if m.dof == "rot" and model.dpn == 2:

@@ -92,8 +92,10 @@ def curves_past_target(built: Built) -> list[str]:
         if np.all(np.abs(later - f_end) <= 1e-12 * max(1.0, np.abs(curve.f).max())):
             continue  # constant after the end: nothing is cut off
         target = "target" if built.case.solver.target is not None else "target (default 1)"
-        out.append(f"{where}: the curve runs to t = {t_last:g}, but the run ends at [solver] {target} = "
-                   f"{end:g}: the process is cut short there (set [solver] target = {t_last:g}?)")
+        out.append(
+            f"{where}: the curve runs to t = {t_last:g}, but the run ends at [solver] {target} = "
+            f"{end:g}: the process is cut short there (set [solver] target = {t_last:g}?)"
+        )
     return out
 
 
@@ -139,16 +141,20 @@ def mould_checks(built: Built) -> list[str]:
                 fix = f"inside = {str(not spec.surface.circle.inside).lower()}"
             else:
                 fix = f"reverse = {str(not spec.surface.reverse).lower()}"
-            out.append(f"{where}.surface: faces away from its slaves: {int(wrong[on].sum())} of the {int(on.sum())} "
-                       "slave nodes that project onto it lie behind it, its normal pointing the way the body's "
-                       f"outward normal does (walked the wrong way, or contact on the wrong face?): try {fix}")
+            out.append(
+                f"{where}.surface: faces away from its slaves: {int(wrong[on].sum())} of the {int(on.sum())} "
+                "slave nodes that project onto it lie behind it, its normal pointing the way the body's "
+                f"outward normal does (walked the wrong way, or contact on the wrong face?): try {fix}"
+            )
             continue
         inside = proj.active & ~alike & (proj.g < -pair.smoothing)
         if inside.any():
             k = int(np.argmin(np.where(inside, proj.g, np.inf)))
             r, z = pair.X[k]
-            out.append(f"{where}.slaves: {int(inside.sum())} slave node(s) lie inside the mould at t = 0, up to "
-                       f"{-proj.g[k]:.3g} deep (at r, z = {r:.6g}, {z:.6g})")
+            out.append(
+                f"{where}.slaves: {int(inside.sum())} slave node(s) lie inside the mould at t = 0, up to "
+                f"{-proj.g[k]:.3g} deep (at r, z = {r:.6g}, {z:.6g})"
+            )
     return out
 
 
@@ -215,9 +221,11 @@ def _driven_step(built: Built, reference) -> list[str]:
     if not bad:
         return []
     unit = built.case.units.length
-    return [f"solver.target: {control.target:g}{' ' + unit if unit else ''} in {control.steps} steps would invert "
-            f"elements within one step (a linear estimate at the reference state: displacement gradients up to "
-            f"{h:.2g}): is it in the units of the rest of the case?"]
+    return [
+        f"solver.target: {control.target:g}{' ' + unit if unit else ''} in {control.steps} steps would invert "
+        f"elements within one step (a linear estimate at the reference state: displacement gradients up to "
+        f"{h:.2g}): is it in the units of the rest of the case?"
+    ]
 
 
 def inverting_loads(built: Built) -> list[str]:
@@ -236,7 +244,7 @@ def inverting_loads(built: Built) -> list[str]:
     zero = np.zeros(body.n_full)
     units = case.units
     loads = []  # (key path, value, what, full load vector, full prescribed displacements)
-    for i, (spec, p) in enumerate(zip(case.pressure, body.pressures)):
+    for i, (spec, p) in enumerate(zip(case.pressure, body.pressures, strict=False)):
         step = spec.value * _step_increment(p.curve, t_end, steps)
         if step:
             fe, _ = p.evaluate(zero, tangent=False)
@@ -247,7 +255,7 @@ def inverting_loads(built: Built) -> list[str]:
         if step:
             f = _point_load_vector(body, case, i) * step / spec.value
             loads.append((f"point_load[{i}].value", spec.value, units.force, f, None))
-    for i, (spec, cav) in enumerate(zip(case.cavity, body.cavities)):
+    for i, (spec, cav) in enumerate(zip(case.cavity, body.cavities, strict=False)):
         if spec.control != "pressure":
             continue
         step = spec.pressure * _step_increment(cav.curve, t_end, steps)
@@ -273,9 +281,11 @@ def inverting_loads(built: Built) -> list[str]:
         bad, h = _inverts(body, solve(b), presc)
         if bad:
             given = f"{value:g}" + (f" {unit}" if unit else "")
-            out.append(f"{where}: {given} would invert elements within one nominal step (a linear estimate at the "
-                       f"reference state: displacement gradients up to {h:.2g} in one step of "
-                       f"{t_end / steps:g}): is it in the units of the rest of the case?")
+            out.append(
+                f"{where}: {given} would invert elements within one nominal step (a linear estimate at the "
+                f"reference state: displacement gradients up to {h:.2g} in one step of "
+                f"{t_end / steps:g}): is it in the units of the rest of the case?"
+            )
     return out
 
 
@@ -318,9 +328,13 @@ def idle_temperature(built: Built) -> list[str]:
         return []
     viscous = case.material.viscoelastic is not None
     if heat.shift is not None and not viscous:
-        return ["temperature.shift: the material has no Prony series ([material] viscoelastic): the shift of its "
-                "relaxation times changes nothing"]
+        return [
+            "temperature.shift: the material has no Prony series ([material] viscoelastic): the shift of its "
+            "relaxation times changes nothing"
+        ]
     if heat.shift is None and not case.material.tables() and case.thermal is None:
-        return ["temperature: no constant of [material] is a table of T, there is no shift and no [thermal]: the "
-                "temperature is written out but changes nothing"]
+        return [
+            "temperature: no constant of [material] is a table of T, there is no shift and no [thermal]: the "
+            "temperature is written out but changes nothing"
+        ]
     return []

@@ -21,6 +21,12 @@ from typing import Any
 import numpy as np
 from pydantic import ValidationError
 
+from ..fem.mesh import MeshError
+from ..fem.selectors import SelectorError
+from ..model.guards import boundary_crossing, free_to_slide, key_path, not_numbers
+from ..model.model import Model
+from ..post.thickness import default_wall
+from ..solve.solver import ArcLengthControl, DisplacementControl, LoadControl, NewtonOptions
 from .base import CaseError, CurveKnots, CurveMixin, DofName, PositiveFloat, Selector, Strict
 from .cavity import CavitySpec, build_cavities
 from .contact import (
@@ -37,27 +43,58 @@ from .contact import (
 )
 from .loads import FixSpec, PointLoadSpec, PressureSpec, apply_loads, prescribe_fixes
 from .material import MaterialSpec
-from .temperature import TemperatureSpec
-from .thermal import ConvectionSpec, ThermalSpec, build_conduction
 from .mesh import ArcPiece, LinePiece, MeshSpec, PieceSpec, build_mesh
 from .monitor import HISTORY_COLUMNS, Monitor, MonitorSpec, build_monitors
 from .output import MAX_REVOLVED_POINTS, OutputSpec, RestartSpec, Unit, UnitsSpec
-from .suggest import did_you_mean
 from .solver import DofRef, SolverSpec, StopSpec, build_control
-from ..model.guards import boundary_crossing, free_to_slide, key_path, not_numbers
-from ..fem.mesh import MeshError
-from ..model.model import Model
-from ..fem.selectors import SelectorError
-from ..solve.solver import ArcLengthControl, DisplacementControl, LoadControl, NewtonOptions
-from ..post.thickness import default_wall
+from .suggest import did_you_mean
+from .temperature import TemperatureSpec
+from .thermal import ConvectionSpec, ThermalSpec, build_conduction
 
 __all__ = [
-    "CaseError", "Strict", "Selector", "DofName", "PositiveFloat", "CurveKnots", "CurveMixin", "LinePiece",
-    "ArcPiece", "PieceSpec", "MeshSpec", "MaterialSpec", "FixSpec", "PressureSpec", "PointLoadSpec",
-    "CircleSpec", "SurfaceLine", "SurfaceArc", "SurfacePiece", "ProfileSurfaceSpec", "SurfaceSpec",
-    "MotionSpec", "ContactSpec", "youngs_modulus", "CavitySpec", "HISTORY_COLUMNS", "MonitorSpec", "Monitor",
-    "DofRef", "StopSpec", "SolverSpec", "OutputSpec", "Unit", "UnitsSpec", "RestartSpec", "Case", "parse",
-    "override", "load", "fingerprint", "read", "Built", "build",
+    "CaseError",
+    "Strict",
+    "Selector",
+    "DofName",
+    "PositiveFloat",
+    "CurveKnots",
+    "CurveMixin",
+    "LinePiece",
+    "ArcPiece",
+    "PieceSpec",
+    "MeshSpec",
+    "MaterialSpec",
+    "FixSpec",
+    "PressureSpec",
+    "PointLoadSpec",
+    "CircleSpec",
+    "SurfaceLine",
+    "SurfaceArc",
+    "SurfacePiece",
+    "ProfileSurfaceSpec",
+    "SurfaceSpec",
+    "MotionSpec",
+    "ContactSpec",
+    "youngs_modulus",
+    "CavitySpec",
+    "HISTORY_COLUMNS",
+    "MonitorSpec",
+    "Monitor",
+    "DofRef",
+    "StopSpec",
+    "SolverSpec",
+    "OutputSpec",
+    "Unit",
+    "UnitsSpec",
+    "RestartSpec",
+    "Case",
+    "parse",
+    "override",
+    "load",
+    "fingerprint",
+    "read",
+    "Built",
+    "build",
 ]
 
 
@@ -81,8 +118,20 @@ class Case(Strict):
 
 
 # the names pydantic gives the members of a union in an error's location: not keys
-_PYDANTIC_TAGS = ("function-", "tuple[", "list[", "dict[", "constrained-", "lax-or-strict[", "json-or-python[",
-                  "tagged-union[", "union[", "nullable[", "is-instance[", "literal[")
+_PYDANTIC_TAGS = (
+    "function-",
+    "tuple[",
+    "list[",
+    "dict[",
+    "constrained-",
+    "lax-or-strict[",
+    "json-or-python[",
+    "tagged-union[",
+    "union[",
+    "nullable[",
+    "is-instance[",
+    "literal[",
+)
 
 
 def _loc(loc: tuple) -> str:
@@ -120,11 +169,15 @@ def out_of_range(data: Any, path: list[str | int] | None = None) -> list[str]:
     if isinstance(data, (int, float)) and not isinstance(data, bool) and math.isfinite(data):
         size = abs(data)
         if size > MAX_MAGNITUDE:
-            return [f"{key_path(path)}: {data:g} is too large a magnitude (at most {MAX_MAGNITUDE:g}: the "
-                    f"products of lengths, moduli, pressures and penalties would overflow); use other units"]
+            return [
+                f"{key_path(path)}: {data:g} is too large a magnitude (at most {MAX_MAGNITUDE:g}: the "
+                f"products of lengths, moduli, pressures and penalties would overflow); use other units"
+            ]
         if 0 < size < MIN_MAGNITUDE:
-            return [f"{key_path(path)}: {data:g} is too small a magnitude (nonzero values must be at least "
-                    f"{MIN_MAGNITUDE:g}: their products would underflow to zero); use 0 or other units"]
+            return [
+                f"{key_path(path)}: {data:g} is too small a magnitude (nonzero values must be at least "
+                f"{MIN_MAGNITUDE:g}: their products would underflow to zero); use 0 or other units"
+            ]
     return []
 
 
@@ -233,14 +286,17 @@ def build(case: Case, base: str | Path = ".") -> Built:
         raise CaseError(f"mesh: {exc}") from None
     sectors = case.output.revolved
     if sectors and mesh.n_nodes * sectors > MAX_REVOLVED_POINTS:
-        raise CaseError(f"output.revolved: {sectors} sectors of a mesh of {mesh.n_nodes:,} nodes make a 3D copy of "
-                        f"{mesh.n_nodes * sectors:,} points (at most {MAX_REVOLVED_POINTS:,}): use fewer sectors")
+        raise CaseError(
+            f"output.revolved: {sectors} sectors of a mesh of {mesh.n_nodes:,} nodes make a 3D copy of "
+            f"{mesh.n_nodes * sectors:,} points (at most {MAX_REVOLVED_POINTS:,}): use fewer sectors"
+        )
     heat = case.temperature
     try:
         material = case.material.build(None if heat is None else heat.representative())
     except ValueError as exc:
-        raise CaseError(f"material.{exc}" if str(exc).split(":")[0] in case.material.tables()
-                        else f"material: {exc}") from None
+        raise CaseError(
+            f"material.{exc}" if str(exc).split(":")[0] in case.material.tables() else f"material: {exc}"
+        ) from None
     try:
         model = Model(mesh, material, formulation=case.mesh.formulation, sfr_edges=case.mesh.sfr_edges)
     except MeshError as exc:
@@ -254,8 +310,10 @@ def build(case: Case, base: str | Path = ".") -> Built:
     crossing = boundary_crossing(mesh.points, mesh.boundary_edges)
     if crossing is not None:
         p = mesh.points[mesh.boundary_edges[crossing[0], 0]]
-        raise CaseError(f"mesh: the boundary crosses itself near r, z = {p[0]:.6g}, {p[1]:.6g} "
-                        f"(a profile that crosses itself, or overlapping elements)")
+        raise CaseError(
+            f"mesh: the boundary crosses itself near r, z = {p[0]:.6g}, {p[1]:.6g} "
+            f"(a profile that crosses itself, or overlapping elements)"
+        )
     try:
         prescribe_fixes(model, mesh, case.fix)
         apply_loads(model, mesh, case.pressure, case.point_load)
@@ -271,16 +329,20 @@ def build(case: Case, base: str | Path = ".") -> Built:
         loads = [*case.pressure, *case.point_load, *case.fix]
         heated = case.thermal is not None and (case.convection or any(c.conductance for c in case.contact))
         if not any(item.value for item in loads) and not moving and not gas and not heated:
-            raise CaseError("pressure: nothing loads the model: every [[pressure]], [[point_load]] and [[fix]] "
-                            "value is zero (or absent), no [[contact]] surface moves and no [[cavity]] is loaded")
+            raise CaseError(
+                "pressure: nothing loads the model: every [[pressure]], [[point_load]] and [[fix]] "
+                "value is zero (or absent), no [[contact]] surface moves and no [[cavity]] is loaded"
+            )
     except SelectorError as exc:
         raise CaseError(str(exc)) from None
     held_uz = [d // model.dpn for d in model.fixed if d % model.dpn == 1]
     touching = np.concatenate([p.nodes for p in pairs]) if pairs else np.zeros(0, np.int64)
     free = free_to_slide(mesh.n_nodes, mesh.cells, np.array(held_uz, np.int64), touching)
     if free:
-        raise CaseError(f"fix: a mechanism: {len(free)} bod{'y' if len(free) == 1 else 'ies'} of the mesh can "
-                        "move rigidly along z (no [[fix]] holds uz on it and no [[contact]] touches it)")
+        raise CaseError(
+            f"fix: a mechanism: {len(free)} bod{'y' if len(free) == 1 else 'ies'} of the mesh can "
+            "move rigidly along z (no [[fix]] holds uz on it and no [[contact]] touches it)"
+        )
     if case.mesh.kind == "rectangle":  # the wall is normal to the faces that carry the pressure
         loaded = model.pressures + getattr(model, "cavities", [])
         mesh.set_wall(case.mesh.wall or default_wall(mesh.points, [p.nodes for p in loaded]))
@@ -289,6 +351,7 @@ def build(case: Case, base: str | Path = ".") -> Built:
     except ValueError as exc:  # a tied fibre rotation prescribed twice
         raise CaseError(f"fix: {exc}") from None
     s = case.solver
-    options = NewtonOptions(tolerance=s.tolerance, max_iterations=s.max_iterations,
-                            min_step=s.min_step, growth=s.growth)
+    options = NewtonOptions(
+        tolerance=s.tolerance, max_iterations=s.max_iterations, min_step=s.min_step, growth=s.growth
+    )
     return Built(case, model, control, options, monitors)

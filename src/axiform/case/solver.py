@@ -7,10 +7,10 @@ from typing import Annotated, Literal
 
 from pydantic import Field, model_validator
 
-from .base import CaseError, DofName, PositiveFloat, Selector, Strict, one_node
 from ..fem.mesh import Mesh
 from ..model.model import Model
 from ..solve.solver import ArcLengthControl, DisplacementControl, LoadControl
+from .base import CaseError, DofName, PositiveFloat, Selector, Strict, one_node
 
 
 class DofRef(Strict):
@@ -66,12 +66,19 @@ def build_control(model: Model, mesh: Mesh, spec: SolverSpec) -> LoadControl | D
     """The path-following control of the [solver] table, on the model with its [[fix]] tables
     prescribed (a driven or stop dof that is also fixed is refused).  A law with memory makes
     the load factor the process time: only load control advances it."""
-    timed = ("a viscoelastic material" if getattr(model.material, "prony", None) is not None
-             else "heat conduction ([thermal])" if model.conduction is not None else None)
+    timed = (
+        "a viscoelastic material"
+        if getattr(model.material, "prony", None) is not None
+        else "heat conduction ([thermal])"
+        if model.conduction is not None
+        else None
+    )
     if spec.control != "load" and timed:
-        raise CaseError(f"solver.control: \"{spec.control}\" does not work with {timed}: the load "
-                        "factor is the process time there, and time must advance; use control = \"load\" with a "
-                        "cavity under volume or gas control, or a prescribed motion with its curve")
+        raise CaseError(
+            f'solver.control: "{spec.control}" does not work with {timed}: the load '
+            'factor is the process time there, and time must advance; use control = "load" with a '
+            "cavity under volume or gas control, or a prescribed motion with its curve"
+        )
     if spec.control == "displacement":
         if spec.dof.dof == "rot":
             raise CaseError("solver.dof.dof: drive a displacement (ur or uz), not a fibre rotation")
@@ -87,6 +94,12 @@ def build_control(model: Model, mesh: Mesh, spec: SolverSpec) -> LoadControl | D
             if stop_dof in model.fixed:
                 raise CaseError("solver.stop: that dof is fixed by a [[fix]] table")
             stop_value = spec.stop.value
-        return ArcLengthControl(1.0 if spec.target is None else spec.target, spec.steps, spec.arc_length,
-                                stop_dof, stop_value, spec.max_steps)
+        return ArcLengthControl(
+            1.0 if spec.target is None else spec.target,
+            spec.steps,
+            spec.arc_length,
+            stop_dof,
+            stop_value,
+            spec.max_steps,
+        )
     return LoadControl(1.0 if spec.target is None else spec.target, spec.steps, spec.max_dt)

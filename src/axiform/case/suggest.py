@@ -1,4 +1,4 @@
-""""Did you mean": the nearest valid key of a table for an unknown key, and the nearest allowed
+""" "Did you mean": the nearest valid key of a table for an unknown key, and the nearest allowed
 word for a misspelt literal value (difflib.get_close_matches, case-insensitive)."""
 
 from __future__ import annotations
@@ -73,4 +73,3 @@ def did_you_mean(root: type[BaseModel], err: dict) -> str:
     elif err["type"] == "literal_error" and isinstance(err.get("input"), str):
         guess = nearest(err["input"], re.findall(r"'([^']*)'", str(err.get("ctx", {}).get("expected", ""))))
     return f'; did you mean "{guess}"?' if guess else ""
-

@@ -30,7 +30,7 @@ def _increasing_table(rows: list[tuple[float, float]], what: str) -> list[tuple[
     if not rows:
         raise ValueError(f"a table needs at least one row [{what}, value]")
     x = [r[0] for r in rows]
-    if any(b <= a for a, b in zip(x, x[1:])):
+    if any(b <= a for a, b in zip(x, x[1:], strict=False)):
         raise ValueError(f"the {what} of the table must increase from row to row")
     return rows
 
@@ -90,11 +90,13 @@ class TemperatureSpec(Strict):
             except ValidationError as exc:
                 err = exc.errors()[0]
                 where = ".".join(str(p) for p in err["loc"])
-                raise ValueError(f"{where}: {err['msg'].removeprefix('Value error, ')}" if where
-                                 else err["msg"]) from None
+                raise ValueError(
+                    f"{where}: {err['msg'].removeprefix('Value error, ')}" if where else err["msg"]
+                ) from None
         if isinstance(value, bool) or not isinstance(value, int | float):
-            raise ValueError(f"a temperature (a number) or {{ along = \"s\" | \"r\" | \"z\", table = [[x, T], ...] }}, "
-                             f"got {value!r}")
+            raise ValueError(
+                f'a temperature (a number) or {{ along = "s" | "r" | "z", table = [[x, T], ...] }}, got {value!r}'
+            )
         return float(value)
 
     @model_validator(mode="after")
@@ -118,8 +120,10 @@ class TemperatureSpec(Strict):
         along = self.initial.along
         if along == "s":
             if mesh.node_s is None:
-                raise CaseError("temperature.initial: along = \"s\" needs a layered mesh (its reference arc "
-                                "length); use along = \"r\" or \"z\"")
+                raise CaseError(
+                    'temperature.initial: along = "s" needs a layered mesh (its reference arc '
+                    'length); use along = "r" or "z"'
+                )
             x = mesh.node_s
         else:
             x = mesh.points[:, 0 if along == "r" else 1]

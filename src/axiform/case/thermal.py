@@ -42,7 +42,7 @@ def _property(value: Any) -> Any:
     if not isinstance(value, list) or not value or not all(isinstance(r, list) and len(r) == 2 for r in value):
         raise ValueError(f"must be a number or a table [[T, value], ...] with no holes, got {value!r}")
     T = [r[0] for r in value]
-    if any(b <= a for a, b in zip(T, T[1:])):
+    if any(b <= a for a, b in zip(T, T[1:], strict=False)):
         raise ValueError("a table of the temperature: T must increase from row to row")
     if not all(isinstance(v, int | float) and not isinstance(v, bool) and v > 0 for _, v in value):
         raise ValueError("every value of the table must be a number > 0")
@@ -79,8 +79,9 @@ class ConvectionSpec(CurveMixin):
         return (lambda t: self.ambient) if curve is None else (lambda t: self.ambient * curve(t))
 
 
-def build_conduction(model: Model, mesh: Mesh, thermal: ThermalSpec | None, convection: list[ConvectionSpec],
-                     contacts: list) -> None:
+def build_conduction(
+    model: Model, mesh: Mesh, thermal: ThermalSpec | None, convection: list[ConvectionSpec], contacts: list
+) -> None:
     """Give the model its heat conduction ([thermal], the films, the contact conductances of
     the [[contact]] tables `contacts`); CaseError naming the key where one is missing."""
     if thermal is None:
@@ -92,19 +93,28 @@ def build_conduction(model: Model, mesh: Mesh, thermal: ThermalSpec | None, conv
         return
     if model.temperature is None:
         raise CaseError("thermal: heat conduction needs the initial temperature: add [temperature] initial = ...")
-    films = [Film(select_edges(mesh, c.on.model_dump(), f"convection[{i}].on"), c.h, c.ambient_of_time())
-             for i, c in enumerate(convection)]
+    films = [
+        Film(select_edges(mesh, c.on.model_dump(), f"convection[{i}].on"), c.h, c.ambient_of_time())
+        for i, c in enumerate(convection)
+    ]
     conductances = []
     for k, c in enumerate(contacts):
         if c.conductance is not None:
             depth = model.contacts[k].depth
             if c.conductance_gap > depth:
-                raise CaseError(f"contact[{k}].conductance_gap: {c.conductance_gap:g} is beyond the contact search "
-                                f"depth {depth:g} (the nodes farther from the surface are not seen): give depth = "
-                                f"{c.conductance_gap:g} or more, or a smaller gap")
+                raise CaseError(
+                    f"contact[{k}].conductance_gap: {c.conductance_gap:g} is beyond the contact search "
+                    f"depth {depth:g} (the nodes farther from the surface are not seen): give depth = "
+                    f"{c.conductance_gap:g} or more, or a smaller gap"
+                )
             curve = None if c.temperature_curve is None else Curve(c.temperature_curve)
-            mould = (lambda t, v=c.temperature: v) if curve is None else \
-                (lambda t, v=c.temperature, f=curve: v * f(t))
+            mould = (lambda t, v=c.temperature: v) if curve is None else (lambda t, v=c.temperature, f=curve: v * f(t))
             conductances.append(Conductance(c.conductance, mould, contact_conductance(k, c.conductance_gap)))
-    model.conduct(Conduction(mesh, *(_as_property(getattr(thermal, key))
-                                     for key in ("conductivity", "density", "specific_heat")), films, conductances))
+    model.conduct(
+        Conduction(
+            mesh,
+            *(_as_property(getattr(thermal, key)) for key in ("conductivity", "density", "specific_heat")),
+            films,
+            conductances,
+        )
+    )

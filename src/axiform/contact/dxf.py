@@ -117,8 +117,13 @@ def _fmt(p: np.ndarray) -> str:
     return f"({p[0]:.6g}, {p[1]:.6g})"
 
 
-def read_dxf(path: str | Path, layer: str | None = None, reverse: bool = False,
-             tolerance: float | None = None, motion: tuple[float, float] = (0.0, 0.0)) -> Polyline:
+def read_dxf(
+    path: str | Path,
+    layer: str | None = None,
+    reverse: bool = False,
+    tolerance: float | None = None,
+    motion: tuple[float, float] = (0.0, 0.0),
+) -> Polyline:
     """The mould path of a DXF drawing: the entities of `layer` (all of the model space if
     None; layer names compare without case) chained into one open or closed path, exact arcs
     kept.  tolerance: how far apart two ends may be and still join (default 1e-6 of the
@@ -142,8 +147,9 @@ def read_dxf(path: str | Path, layer: str | None = None, reverse: bool = False,
         raise DxfError(f"cannot read {path} as a DXF drawing ({why})") from None
 
 
-def _read_dxf(path: Path, layer: str | None, reverse: bool, tolerance: float | None,
-              motion: tuple[float, float]) -> Polyline:
+def _read_dxf(
+    path: Path, layer: str | None, reverse: bool, tolerance: float | None, motion: tuple[float, float]
+) -> Polyline:
     import ezdxf
 
     try:
@@ -161,15 +167,23 @@ def _read_dxf(path: Path, layer: str | None, reverse: bool, tolerance: float | N
     unsupported = sorted({e.dxftype() for e in entities} - {"LINE", "ARC", "LWPOLYLINE", "POLYLINE"})
     if unsupported:
         place = "in the model space" if layer is None else f"on layer {layer!r}"
-        raise DxfError(f"unsupported entities {', '.join(unsupported)} {place}: use LINE, ARC, "
-                       "LWPOLYLINE or POLYLINE")
+        raise DxfError(f"unsupported entities {', '.join(unsupported)} {place}: use LINE, ARC, LWPOLYLINE or POLYLINE")
     for e in entities:  # the drawing's numbers: finite, and not so large that their products overflow
         pts = np.array([[p[0], p[1], p[2]] for p in _extent_points(e)], float).reshape(-1, 3)
-        values = np.concatenate([pts.ravel(), [float(e.dxf.get(k)) for k in ("radius", "start_angle", "end_angle")
-                                               if e.dxf.is_supported(k) and e.dxf.hasattr(k)]])
+        values = np.concatenate(
+            [
+                pts.ravel(),
+                [
+                    float(e.dxf.get(k))
+                    for k in ("radius", "start_angle", "end_angle")
+                    if e.dxf.is_supported(k) and e.dxf.hasattr(k)
+                ],
+            ]
+        )
         if not np.isfinite(values).all() or (np.abs(values) > MAX_COORDINATE).any():
-            raise DxfError(f"{_name(e)} has a coordinate that is not a finite number or is beyond "
-                           f"{MAX_COORDINATE:g} in magnitude")
+            raise DxfError(
+                f"{_name(e)} has a coordinate that is not a finite number or is beyond {MAX_COORDINATE:g} in magnitude"
+            )
     corners = np.array([[p[0], p[1], p[2]] for e in entities for p in _extent_points(e)])
     size = float(np.linalg.norm(np.ptp(corners[:, :2], axis=0))) or 1.0
     tol = tolerance if tolerance is not None else 1e-6 * size
@@ -240,7 +254,7 @@ def _chain(pieces: list[Piece], tol: float, reverse: bool, motion) -> Polyline:
     for e in range(2 * n):
         other.setdefault(int(node[e]), []).append((e // 2, e % 2))
     open_ends = np.flatnonzero(count == 1)
-    start_piece, start_end = (other[int(open_ends[0])][0] if len(open_ends) else (0, 0))
+    start_piece, start_end = other[int(open_ends[0])][0] if len(open_ends) else (0, 0)
     order, forward = [], []
     k, end = start_piece, start_end
     seen = np.zeros(n, bool)
@@ -257,15 +271,18 @@ def _chain(pieces: list[Piece], tol: float, reverse: bool, motion) -> Polyline:
         d = np.linalg.norm(loose[:, None] - loose[None], axis=2)
         d[np.arange(len(loose)), np.arange(len(loose))] = np.inf
         i, j = np.unravel_index(int(np.argmin(d)), d.shape)
-        raise DxfError(f"the pieces do not chain into one path: a gap of {d[i, j]:.6g} between "
-                       f"{_fmt(loose[i])} and {_fmt(loose[j])} (ends join within {tol:.3g}; "
-                       f"{len(loose)} open ends in all)")
+        raise DxfError(
+            f"the pieces do not chain into one path: a gap of {d[i, j]:.6g} between "
+            f"{_fmt(loose[i])} and {_fmt(loose[j])} (ends join within {tol:.3g}; "
+            f"{len(loose)} open ends in all)"
+        )
     if not seen.all():
         k = int(np.argmin(seen))
-        raise DxfError(f"the pieces do not chain into one path: a closed loop through {_fmt(pieces[k].a)} "
-                       "lies apart from it")
-    chain = [pieces[k] if f else pieces[k].flipped() for k, f in zip(order, forward)]
-    joints = [int(node[2 * k + (0 if f else 1)]) for k, f in zip(order, forward)]
+        raise DxfError(
+            f"the pieces do not chain into one path: a closed loop through {_fmt(pieces[k].a)} lies apart from it"
+        )
+    chain = [pieces[k] if f else pieces[k].flipped() for k, f in zip(order, forward, strict=False)]
+    joints = [int(node[2 * k + (0 if f else 1)]) for k, f in zip(order, forward, strict=False)]
     joints.append(int(node[2 * order[-1] + (1 if forward[-1] else 0)]))
     if not forward[order.index(0)]:  # the first entity of the drawing keeps its direction
         chain = [p.flipped() for p in chain[::-1]]
@@ -275,7 +292,7 @@ def _chain(pieces: list[Piece], tol: float, reverse: bool, motion) -> Polyline:
         joints = joints[::-1]
     points = where[joints]
     centers = []
-    for p, a, b in zip(chain, points[:-1], points[1:]):
+    for p, a, b in zip(chain, points[:-1], points[1:], strict=False):
         if p.center is None:
             centers.append(None)
             continue

@@ -119,10 +119,21 @@ class ContactPair:
     which returns the state the pair would have if the evaluation were accepted.  The solver
     holds the committed state and commits the trial of the accepted evaluation only."""
 
-    def __init__(self, mesh: Mesh, surface: RigidSurface, slaves: np.ndarray, penalty: float | None = None,
-                 friction: float = 0.0, sticky: bool = False, tangential_penalty: float | None = None,
-                 depth: float | None = None, search: str = "buckets", smoothing: float | None = None,
-                 modulus: float | None = None, stabilization: float | None = None):
+    def __init__(
+        self,
+        mesh: Mesh,
+        surface: RigidSurface,
+        slaves: np.ndarray,
+        penalty: float | None = None,
+        friction: float = 0.0,
+        sticky: bool = False,
+        tangential_penalty: float | None = None,
+        depth: float | None = None,
+        search: str = "buckets",
+        smoothing: float | None = None,
+        modulus: float | None = None,
+        stabilization: float | None = None,
+    ):
         edges = slave_edges(mesh, np.asarray(slaves))
         if len(edges) == 0:
             raise ValueError("the slave nodes hold no boundary edge (select a face, not single nodes)")
@@ -154,7 +165,8 @@ class ContactPair:
             height = edge_heights(mesh, edges)[:, None]
             weight = parts + 1e-300  # ring-area weighted mean of the heights of the node's cells
             h = np.bincount(self.edges.ravel(), (weight * height).ravel(), n) / np.bincount(
-                self.edges.ravel(), weight.ravel(), n)
+                self.edges.ravel(), weight.ravel(), n
+            )
             self.kn0 = PENALTY_FACTOR * modulus / h  # per unit current area at the reference state
             self.thinning = 1.0  # the penalty grows as the element under the node thins
         else:
@@ -183,8 +195,9 @@ class ContactPair:
     def initial_state(self) -> ContactState:
         """The history before the first step: no node touched, positions at the reference."""
         n = len(self.nodes)
-        return ContactState(self.nodes, self.X.copy(), np.full(n, np.nan), np.zeros(n, bool), np.zeros((n, 2)),
-                            np.full(n, np.nan))
+        return ContactState(
+            self.nodes, self.X.copy(), np.full(n, np.nan), np.zeros(n, bool), np.zeros((n, 2)), np.full(n, np.nan)
+        )
 
     def dofs(self, dpn: int) -> np.ndarray:
         """Full dofs (ur, uz) of the slave nodes, (n, 2)."""
@@ -195,8 +208,14 @@ class ContactPair:
         blocks of `coupling`."""
         return (self.nodes[self.edges][:, :, None] * dpn + np.arange(2)).reshape(len(self.edges), -1)
 
-    def evaluate(self, u: np.ndarray, lam: float, state: ContactState, predicting: bool = False,
-                 guard_force: np.ndarray | None = None) -> ContactTrial:
+    def evaluate(
+        self,
+        u: np.ndarray,
+        lam: float,
+        state: ContactState,
+        predicting: bool = False,
+        guard_force: np.ndarray | None = None,
+    ) -> ContactTrial:
         """The pair at displacements u (n_nodes, 2) and process time lam, from the committed
         history `state`: forces on the slave nodes, their derivatives (`ContactTrial`) and the
         trial state.  predicting: the tangent of a step's first iteration (nodes resting on
@@ -249,8 +268,9 @@ class ContactPair:
         step's first iteration, frictionless and not sticky pairs only."""
         return predicting and self.mu == 0 and not self.sticky
 
-    def _untouching(self, xa: np.ndarray, x: np.ndarray, proj, state: ContactState,
-                    guard_force: np.ndarray) -> ContactTrial:
+    def _untouching(
+        self, xa: np.ndarray, x: np.ndarray, proj, state: ContactState, guard_force: np.ndarray
+    ) -> ContactTrial:
         """`evaluate` where the pair is idle (`_idle`): no force, no derivative (None); the
         trial state that of `_next` with no node in contact (stick points released)."""
         n = len(self.nodes)
@@ -259,8 +279,9 @@ class ContactPair:
         zero = np.zeros((n, 2))
         seen = ContactSeen(x, proj, zero, np.zeros(n, np.int8), a, zero, guard_force)
         s_stick = np.full(n, np.nan) if self.mu > 0 and not self.sticky else state.s_stick
-        after = ContactState(self.nodes, x.copy(), s_stick, state.stuck, state.stuck_point, state.first_contact,
-                             seen, state.damping_work)
+        after = ContactState(
+            self.nodes, x.copy(), s_stick, state.stuck, state.stuck_point, state.first_contact, seen, state.damping_work
+        )
         return ContactTrial(zero, None, None, None, after)
 
     def _damping(self, x: np.ndarray, state: ContactState, proj):
@@ -310,7 +331,8 @@ class ContactPair:
 
     def guard(self, u: np.ndarray, lam: float, velocity: np.ndarray, state: ContactState):
         """The mid-point guards of the straight edges at node displacements u (n_nodes, dpn)
-        and load factor lam, from the committed history `state`: the rounded normal law at the mid-point's gap plus its allowance.
+        and load factor lam, from the committed history `state`: the rounded normal law at the mid-point's gap plus
+        its allowance.
         The mid-point is x_m = (x_a + x_b) / 2, and for SFR (eq. 3) also
         + (theta_a - theta_b) (-dZ, dR) / 4 with (dR, dZ) = X_b - X_a.
 
@@ -328,8 +350,9 @@ class ContactPair:
             mid += (un[e[:, 0], 2] - un[e[:, 1], 2])[:, None] * self.guard_arm
         mid_prev = 0.5 * (state.x_prev[e[:, 0]] + state.x_prev[e[:, 1]])
         x = xa - offset  # the nodes, projected in the same pass for `evaluate`
-        nodes, proj = self.surface.local_sets([(x, state.x_prev, self.depth),
-                                               (mid, mid_prev, self.depth + self.guard_allowance.max())], self.search)
+        nodes, proj = self.surface.local_sets(
+            [(x, state.x_prev, self.depth), (mid, mid_prev, self.depth + self.guard_allowance.max())], self.search
+        )
         self._projected = (x, state.x_prev, nodes)
         m = len(e)
         g = proj.g + self.guard_allowance
@@ -343,9 +366,12 @@ class ContactPair:
         Kv = Kx @ velocity
         if dpn == 2:  # P = [I I] / 2: the products are copies of force, Kx and Kx v
             half, quarter = 0.5 * force, 0.25 * Kx
-            return (np.concatenate((half, half), axis=1),
-                    np.broadcast_to(quarter[:, None, :, None, :], (m, 2, 2, 2, 2)).reshape(m, 4, 4),
-                    np.concatenate((0.5 * Kv,) * 2, axis=1), force)
+            return (
+                np.concatenate((half, half), axis=1),
+                np.broadcast_to(quarter[:, None, :, None, :], (m, 2, 2, 2, 2)).reshape(m, 4, 4),
+                np.concatenate((0.5 * Kv,) * 2, axis=1),
+                force,
+            )
         P = np.zeros((m, 2, 2, dpn))  # d x_m / d (node, dof)
         P[:, 0, :, 0] = P[:, 1, :, 1] = 0.5
         P[:, :, 0, 2], P[:, :, 1, 2] = self.guard_arm, -self.guard_arm
@@ -362,8 +388,7 @@ class ContactPair:
         out = trial.K @ velocity
         if trial.pole_rate is not None:
             q = np.arange(self.pole_edge.size)
-            np.add.at(out, self.edges[self.pole_edge][q, self.pole_corner],
-                      (trial.pole_rate @ velocity).sum(axis=1))
+            np.add.at(out, self.edges[self.pole_edge][q, self.pole_corner], (trial.pole_rate @ velocity).sum(axis=1))
         return out
 
     def _traction(self, x: np.ndarray, proj, state: ContactState, predicting: bool):
@@ -441,7 +466,7 @@ class ContactPair:
             s_new = np.where(z != zc, proj.s - zc * limit / np.maximum(self.kt0, 1e-300), s0)
             s_stick = np.where(contact, s_new, np.nan)
         if self.sticky:
-            new = (status == 1)
+            new = status == 1
             stuck_point = stuck_point.copy()
             stuck_point[new] = x[new] - proj.g[new, None] * proj.n[new]
             stuck = stuck | new
@@ -455,8 +480,14 @@ class ContactPair:
         first step (or after a restart, until the next step)."""
         if state.seen is None:
             return self._untouched(state)
-        proj, f, status, a, traction, guard = (state.seen.proj, state.seen.f, state.seen.status, state.seen.a,
-                                               state.seen.traction, state.seen.guard_force)
+        proj, f, status, a, traction, guard = (
+            state.seen.proj,
+            state.seen.f,
+            state.seen.status,
+            state.seen.a,
+            state.seen.traction,
+            state.seen.guard_force,
+        )
         in_contact = status > 0
         gap = np.where(proj.active, proj.g, np.nan)
         return {
@@ -471,14 +502,25 @@ class ContactPair:
             "force_r": float(f[:, 0].sum() + guard[:, 0].sum()),
             "force_z": float(f[:, 1].sum() + guard[:, 1].sum()),
             "contact_area": float(self.area0[in_contact].sum()),
-            "penetration": float(max(0.0, -np.nanmin(np.where(in_contact, gap, np.nan)))
-                                 if (in_contact & proj.active).any() else 0.0),
+            "penetration": float(
+                max(0.0, -np.nanmin(np.where(in_contact, gap, np.nan))) if (in_contact & proj.active).any() else 0.0
+            ),
         }
 
     def _untouched(self, state: ContactState) -> dict:
         """The report of a pair whose state holds no evaluation: no force, no contact."""
         n = len(self.nodes)
-        return {"node": self.nodes, "pressure": np.zeros(n), "gap": np.full(n, np.nan), "status": np.zeros(n, np.int8),
-                "force": np.zeros((n, 2)), "area": self.area0, "current_area": self.area0,
-                "first_contact": state.first_contact, "force_r": 0.0, "force_z": 0.0, "contact_area": 0.0,
-                "penetration": 0.0}
+        return {
+            "node": self.nodes,
+            "pressure": np.zeros(n),
+            "gap": np.full(n, np.nan),
+            "status": np.zeros(n, np.int8),
+            "force": np.zeros((n, 2)),
+            "area": self.area0,
+            "current_area": self.area0,
+            "first_contact": state.first_contact,
+            "force_r": 0.0,
+            "force_z": 0.0,
+            "contact_area": 0.0,
+            "penetration": 0.0,
+        }

@@ -22,7 +22,7 @@ def slave_edges(mesh: Mesh, nodes: np.ndarray) -> np.ndarray:
     return e[is_slave[e].all(axis=1)]
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _ring_weights(edge_nodes: int):
     """The constant matrices of `ring_areas` for edges of edge_nodes nodes k, from
     `edge_rule`: 2 pi w_p N_pi (p, k), 2 pi w_p N_pi N_pj (p, k k) and 2 pi w_p N_pi dN_pj
@@ -30,8 +30,11 @@ def _ring_weights(edge_nodes: int):
     _, wq, N, dN = edge_rule(edge_nodes, 3)
     k = N.shape[1]
     wN = 2 * np.pi * wq[:, None] * N
-    out = (wN, (wN[:, :, None] * N[:, None, :]).reshape(-1, k * k),
-           (wN[:, :, None] * dN[:, None, :]).reshape(-1, k * k))
+    out = (
+        wN,
+        (wN[:, :, None] * N[:, None, :]).reshape(-1, k * k),
+        (wN[:, :, None] * dN[:, None, :]).reshape(-1, k * k),
+    )
     for arr in out:
         arr.flags.writeable = False
     return out
@@ -124,7 +127,8 @@ def edge_heights(mesh: Mesh, edges: np.ndarray) -> np.ndarray:
     want = np.sort(edges[:, :2], axis=1)
     cell = order[np.searchsorted(keys[order], want[:, 0] * n + want[:, 1])] // 4
     c = mesh.points[mesh.cells[cell, :4]]  # corners, counter-clockwise
-    area = 0.5 * np.abs((c[..., 0] * np.roll(c[..., 1], -1, axis=1)
-                         - np.roll(c[..., 0], -1, axis=1) * c[..., 1]).sum(axis=1))
+    area = 0.5 * np.abs(
+        (c[..., 0] * np.roll(c[..., 1], -1, axis=1) - np.roll(c[..., 0], -1, axis=1) * c[..., 1]).sum(axis=1)
+    )
     chord = np.linalg.norm(mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]], axis=1)
     return area / chord

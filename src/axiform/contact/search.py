@@ -33,9 +33,13 @@ def brute_force(x: np.ndarray, a: np.ndarray, b: np.ndarray, widen: float) -> np
     found = []
     step = max(1, 2**22 // max(len(a), 1))
     for k in range(0, len(x), step):
-        p = x[k:k + step]
-        ok = ((p[:, None, 0] >= lo[None, :, 0]) & (p[:, None, 0] <= hi[None, :, 0])
-              & (p[:, None, 1] >= lo[None, :, 1]) & (p[:, None, 1] <= hi[None, :, 1]))
+        p = x[k : k + step]
+        ok = (
+            (p[:, None, 0] >= lo[None, :, 0])
+            & (p[:, None, 0] <= hi[None, :, 0])
+            & (p[:, None, 1] >= lo[None, :, 1])
+            & (p[:, None, 1] <= hi[None, :, 1])
+        )
         n, s = np.nonzero(ok)
         found.append(np.column_stack([n + k, s]))
     pairs = np.vstack(found) if found else np.zeros((0, 2), np.int64)
@@ -58,7 +62,7 @@ class Buckets:
             while np.prod(np.floor(span / bs) + 1) > cap:
                 bs *= 1.5
         self.bs = bs
-        self.SX, self.SY = (np.floor(span / bs).astype(np.int64) + 1)
+        self.SX, self.SY = np.floor(span / bs).astype(np.int64) + 1
         cell = np.floor((x - self.xmin) / bs).astype(np.int64)
         cell = np.minimum(cell, [self.SX - 1, self.SY - 1])
         self.lbox = cell[:, 1] * self.SX + cell[:, 0]  # code of each node
@@ -143,24 +147,37 @@ class PairCache:
         self.size = size
         self.entries: list[tuple] = []
 
-    def pairs(self, finder, x: np.ndarray, x_prev: np.ndarray, a: np.ndarray, b: np.ndarray, depth: float,
-              moved: float) -> np.ndarray:
+    def pairs(
+        self, finder, x: np.ndarray, x_prev: np.ndarray, a: np.ndarray, b: np.ndarray, depth: float, moved: float
+    ) -> np.ndarray:
         w = depth + moved
         need = w + moved
         # slack for the rounding of lo - w and of the coordinates (relative 1e-9 of the sizes)
-        scale = max(float(np.abs(a).max(initial=0.0)), float(np.abs(b).max(initial=0.0)),
-                    float(np.abs(x_prev).max(initial=0.0)), float(np.abs(x).max(initial=0.0)))
+        scale = max(
+            float(np.abs(a).max(initial=0.0)),
+            float(np.abs(b).max(initial=0.0)),
+            float(np.abs(x_prev).max(initial=0.0)),
+            float(np.abs(x).max(initial=0.0)),
+        )
         need_safe = need * (1.0 + 1e-9) + 1e-9 * scale
         for n, (f, ka, kb, kx, W, cached) in enumerate(self.entries):
-            if (f is finder and W >= need_safe and kx.shape == x_prev.shape and np.array_equal(kx, x_prev)
-                    and np.array_equal(ka, a) and np.array_equal(kb, b)):
+            if (
+                f is finder
+                and W >= need_safe
+                and kx.shape == x_prev.shape
+                and np.array_equal(kx, x_prev)
+                and np.array_equal(ka, a)
+                and np.array_equal(kb, b)
+            ):
                 self.entries.insert(0, self.entries.pop(n))
                 lo, hi = _boxes(a, b, w)
                 return cached[_inside(x, cached[:, 0], cached[:, 1], lo, hi)]
         W = 2.0 * need_safe
         cached = finder(x_prev, a, b, W)
         self.entries = [(finder, a.copy(), b.copy(), np.array(x_prev, float), W, cached)] + [
-            e for e in self.entries if not (e[0] is finder and e[3].shape == x_prev.shape
-                                            and np.array_equal(e[3], x_prev))][: self.size - 1]
+            e
+            for e in self.entries
+            if not (e[0] is finder and e[3].shape == x_prev.shape and np.array_equal(e[3], x_prev))
+        ][: self.size - 1]
         lo, hi = _boxes(a, b, w)
         return cached[_inside(x, cached[:, 0], cached[:, 1], lo, hi)]

@@ -49,7 +49,7 @@ class ContactState:
         """The history arrays (a checkpoint)."""
         return {k: np.array(getattr(self, k), copy=True) for k in self.HISTORY}
 
-    def from_dict(self, saved: dict[str, np.ndarray]) -> "ContactState":
+    def from_dict(self, saved: dict[str, np.ndarray]) -> ContactState:
         """This state with the history arrays of `saved` (ContactState.to_dict), checked."""
         values = {}
         for k in self.HISTORY:

@@ -45,8 +45,18 @@ class Projection:
     @classmethod
     def empty(cls, n: int) -> Projection:
         z = np.zeros(n)
-        return cls(np.zeros(n, bool), z.copy(), np.zeros((n, 2)), np.zeros((n, 2)), z.copy(), z.copy(),
-                   np.ones(n), np.zeros((n, 2)), z.copy(), np.zeros(n, np.int8))
+        return cls(
+            np.zeros(n, bool),
+            z.copy(),
+            np.zeros((n, 2)),
+            np.zeros((n, 2)),
+            z.copy(),
+            z.copy(),
+            np.ones(n),
+            np.zeros((n, 2)),
+            z.copy(),
+            np.zeros(n, np.int8),
+        )
 
     def rows(self, sl: slice) -> Projection:
         """The projections of the rows sl (views)."""
@@ -207,10 +217,20 @@ class Polyline(RigidSurface):
         # whether the mould turns towards the body there, and the mean normal
         arc = self.is_arc
         self._any_arc = bool(arc.any())
-        self._par = np.column_stack([self.a, self.tan_a, self.L, np.where(arc[:, None], self.c, 0.0),
-                                     np.where(arc, self.R, 1.0), np.where(arc, self.phi0, 0.0),
-                                     np.where(arc & (self.sweep > 0), self.sweep, 1.0), self.dir,
-                                     -self.tan_a[:, 1], self.tan_a[:, 0]])
+        self._par = np.column_stack(
+            [
+                self.a,
+                self.tan_a,
+                self.L,
+                np.where(arc[:, None], self.c, 0.0),
+                np.where(arc, self.R, 1.0),
+                np.where(arc, self.phi0, 0.0),
+                np.where(arc & (self.sweep > 0), self.sweep, 1.0),
+                self.dir,
+                -self.tan_a[:, 1],
+                self.tan_a[:, 0],
+            ]
+        )
         self._pair_cache = search.PairCache()  # `_candidates`: the pairs of a step reused
         self._previous_held = None  # `_previous`: the last converged positions' projections, for the next call
         self._cavity = np.zeros(m, bool)
@@ -234,9 +254,13 @@ class Polyline(RigidSurface):
 
     def reversed(self) -> Polyline:
         """The same pieces walked the other way: the body on the other side."""
-        centers = [None if not arc else tuple(c) for arc, c in zip(self.is_arc, self.c)][::-1]
-        return Polyline(motion=self.motion, points=self.points[::-1].copy(), centers=centers,
-                        ccw=[bool(d < 0) for d in self.dir[::-1]])
+        centers = [None if not arc else tuple(c) for arc, c in zip(self.is_arc, self.c, strict=False)][::-1]
+        return Polyline(
+            motion=self.motion,
+            points=self.points[::-1].copy(),
+            centers=centers,
+            ccw=[bool(d < 0) for d in self.dir[::-1]],
+        )
 
     def _arc_points(self, k: int, n: int) -> np.ndarray:
         phi = self.phi0[k] + self.dir[k] * np.linspace(0, self.sweep[k], n)
@@ -246,7 +270,7 @@ class Polyline(RigidSurface):
         """Points along the surface, arcs sampled finely (for pictures)."""
         out = [self.a[:1]]
         for k in range(len(self.a)):
-            out.append(self._arc_points(k, 25)[1:] if self.is_arc[k] else self.b[k:k + 1])
+            out.append(self._arc_points(k, 25)[1:] if self.is_arc[k] else self.b[k : k + 1])
         return np.vstack(out)
 
     def _project(self, k: np.ndarray, x: np.ndarray, full: bool = True, subset: bool = True):
@@ -273,7 +297,9 @@ class Polyline(RigidSurface):
             alpha = ((phi - phi0) * sgn) % (2 * np.pi)
             after = alpha - sweep
             before = 2 * np.pi - alpha
-            frac = np.where(alpha <= sweep, alpha / sweep, np.where(after < before, 1.0 + after / sweep, -before / sweep))
+            frac = np.where(
+                alpha <= sweep, alpha / sweep, np.where(after < before, 1.0 + after / sweep, -before / sweep)
+            )
             cos, sin = np.cos(phi), np.sin(phi)
             nar, naz = -(sgn * cos), sgn * -sin  # the arc's normal: its tangent sgn (-sin, cos) turned
             ga = (dr - R * dr / rho) * nar + (dh - R * dh / rho) * naz
@@ -322,8 +348,14 @@ class Polyline(RigidSurface):
         k), from `_project`; kept for the next call, which the iterations of a step make with
         the same x_prev and, mostly, the same pairs."""
         held = self._previous_held
-        if (held is None or len(held[1]) != len(i) or held[0].shape != x_prev.shape or not np.array_equal(held[1], i)
-                or not np.array_equal(held[2], k) or not np.array_equal(held[0], x_prev)):
+        if (
+            held is None
+            or len(held[1]) != len(i)
+            or held[0].shape != x_prev.shape
+            or not np.array_equal(held[1], i)
+            or not np.array_equal(held[2], k)
+            or not np.array_equal(held[0], x_prev)
+        ):
             held = self._previous_held = (x_prev.copy(), i, k) + self._project(k, x_prev[i], full=False)
         return held[3], held[4]
 
@@ -380,11 +412,11 @@ class Polyline(RigidSurface):
         x_prev = np.concatenate([xps for _, xps, _ in sets]) if len(sets) > 1 else sets[0][1]
         depth = np.repeat([float(ds) for _, _, ds in sets], sizes)  # per point
         if len(x) * len(self.a) <= DENSE_PAIRS:  # every point against every widened box at once
-            widen = np.repeat([float(ds) + mv for (_, _, ds), mv in zip(sets, moved)], sizes)[:, None]
+            widen = np.repeat([float(ds) + mv for (_, _, ds), mv in zip(sets, moved, strict=False)], sizes)[:, None]
             i, k = self._dense_candidates(x, widen)
         else:
             ii, kk, start = [], [], 0
-            for (xs, xps, ds), mv in zip(sets, moved):
+            for (xs, xps, ds), mv in zip(sets, moved, strict=False):
                 i, k = self._candidates(xs, xps, ds, mv, method)
                 ii.append(i + start)
                 kk.append(k)
@@ -392,10 +424,13 @@ class Polyline(RigidSurface):
             i, k = np.concatenate(ii), np.concatenate(kk)
         out = self._local_pairs(x, x_prev, i, k, depth[i])
         bounds = np.cumsum([0] + sizes)
-        return [out] if len(sets) == 1 else [out.rows(slice(a, b)) for a, b in zip(bounds[:-1], bounds[1:])]
+        return (
+            [out] if len(sets) == 1 else [out.rows(slice(a, b)) for a, b in zip(bounds[:-1], bounds[1:], strict=False)]
+        )
 
-    def _local_pairs(self, x: np.ndarray, x_prev: np.ndarray, i: np.ndarray, k: np.ndarray,
-                     depth: np.ndarray) -> Projection:
+    def _local_pairs(
+        self, x: np.ndarray, x_prev: np.ndarray, i: np.ndarray, k: np.ndarray, depth: np.ndarray
+    ) -> Projection:
         """Steps 1-3 of `local` over the candidate pairs (node i, piece k) sorted by node, with
         the depth of each pair's node."""
         nn = len(x)
@@ -449,8 +484,17 @@ class Polyline(RigidSurface):
             self._cavity_corners(out, x, i, k, g, xi, depth, tol)
         return out
 
-    def _cavity_corners(self, out: Projection, x: np.ndarray, i: np.ndarray, k: np.ndarray, g: np.ndarray,
-                        xi: np.ndarray, depth: float, tol: float) -> None:
+    def _cavity_corners(
+        self,
+        out: Projection,
+        x: np.ndarray,
+        i: np.ndarray,
+        k: np.ndarray,
+        g: np.ndarray,
+        xi: np.ndarray,
+        depth: float,
+        tol: float,
+    ) -> None:
         """Step 3 of `local`, in place on `out`: a node still without a contact point, behind
         piece k beyond its end and behind piece k+1 before its start, where the mould turns
         towards the body, touches the vertex, with the mean of the two normals.  Over the
@@ -476,7 +520,7 @@ class Polyline(RigidSurface):
         out.n[nb] = nv
         out.t[nb] = np.column_stack([nv[:, 1], -nv[:, 0]])
         # np.dot node by node, as ever (BLAS may round a dot product otherwise): few nodes
-        out.g[nb] = [float(np.dot(d, e)) for d, e in zip(x[nb] - v, nv)]
+        out.g[nb] = [float(np.dot(d, e)) for d, e in zip(x[nb] - v, nv, strict=False)]
         out.s[nb] = out.s_prev[nb] = self.s0[sb]
         out.point[nb] = v
         out.kind[nb] = 2

@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .elements import gauss_quad, gradient_operator
 from ..materials import InvertedElementError, deformation_gradient
 from ..materials.base import add_volumetric
 from ..materials.kinematics import from_rows, to_rows
 from ..materials.viscoelastic import Memory
+from .elements import gauss_quad, gradient_operator
 from .mesh import Mesh
 
 
@@ -91,8 +91,14 @@ class SolidAssembly:
         e, _, _, nd = self.G.shape
         return np.empty((e, nd)), np.empty((e, nd, nd)) if tangent else None
 
-    def evaluate(self, u_full: np.ndarray, tangent: bool = True, out: tuple | None = None,
-                 memory: Memory | None = None, temperature: np.ndarray | None = None):
+    def evaluate(
+        self,
+        u_full: np.ndarray,
+        tangent: bool = True,
+        out: tuple | None = None,
+        memory: Memory | None = None,
+        temperature: np.ndarray | None = None,
+    ):
         """Element internal forces fe (e, nd) and, if asked, element tangents Ke (e, nd, nd),
         written into out = (fe, Ke) when given (from `buffers`) and returned.  memory: the
         step of a law with a history per quadrature point (materials.viscoelastic.Memory),

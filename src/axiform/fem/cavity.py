@@ -66,15 +66,28 @@ class Cavity:
     off the axis must be one of them (it then closes the cavity along its plane z = const).
     """
 
-    def __init__(self, mesh: Mesh, edges: np.ndarray, name: str, control: str = "pressure",
-                 value: float = 0.0, ambient: float = 0.0, curve: Curve = PROPORTIONAL,
-                 held_z: np.ndarray | None = None):
+    def __init__(
+        self,
+        mesh: Mesh,
+        edges: np.ndarray,
+        name: str,
+        control: str = "pressure",
+        value: float = 0.0,
+        ambient: float = 0.0,
+        curve: Curve = PROPORTIONAL,
+        held_z: np.ndarray | None = None,
+    ):
         if control not in CONTROLS:
             raise ValueError(f"control must be one of {CONTROLS}, not {control!r}")
         if control == "gas" and not ambient > 0:
             raise ValueError("a gas cavity needs an absolute ambient pressure > 0")
-        self.name, self.control, self.value, self.ambient, self.curve = (name, control, float(value),
-                                                                         float(ambient), curve)
+        self.name, self.control, self.value, self.ambient, self.curve = (
+            name,
+            control,
+            float(value),
+            float(ambient),
+            curve,
+        )
         self.nodes = mesh.boundary_edges[np.asarray(edges)]
         if len(self.nodes) == 0:
             raise CavityError("the boundary holds no edge")
@@ -84,8 +97,10 @@ class Cavity:
             on_axis = abs(mesh.points[n, 0]) <= tol
             if not on_axis and (held_z is None or not held_z[n]):
                 r, z = mesh.points[n]
-                raise CavityError(f"the open end at (r, z) = ({r:.6g}, {z:.6g}) lies neither on the axis "
-                                  "nor on a plane z = const (its uz is not held)")
+                raise CavityError(
+                    f"the open end at (r, z) = ({r:.6g}, {z:.6g}) lies neither on the axis "
+                    "nor on a plane z = const (its uz is not held)"
+                )
         self.dofs = element_dofs(self.nodes, mesh.element.dofs_per_node)
         self.Xs, self.dXs, self.H, self.dH, self.w = edge_interpolation(mesh.element, mesh.points[self.nodes])
         # the boundary edges run counter-clockwise around the body, so clockwise around the
@@ -93,8 +108,10 @@ class Cavity:
         self.sign = -1.0
         self.V0 = self._volume(np.zeros(mesh.n_nodes * mesh.element.dofs_per_node))
         if control != "pressure" and not self.V0 > 0:
-            raise CavityError(f"the boundary encloses no volume on its gas side (V0 = {self.V0:.6g}): "
-                              "volume and gas control need V0 > 0")
+            raise CavityError(
+                f"the boundary encloses no volume on its gas side (V0 = {self.V0:.6g}): "
+                "volume and gas control need V0 > 0"
+            )
 
     @property
     def unknown(self) -> bool:
@@ -119,9 +136,11 @@ class Cavity:
         g = np.einsum("p,mpn->mn", c, 2.0 * (r * dz)[..., None] * Hr + (r * r)[..., None] * dHz)
         if not tangent:
             return V, g, None
-        He = (np.einsum("p,mp,mpi,mpj->mij", 2.0 * c, dz, Hr, Hr)
-              + np.einsum("p,mp,mpi,mpj->mij", 2.0 * c, r, Hr, dHz)
-              + np.einsum("p,mp,mpi,mpj->mij", 2.0 * c, r, dHz, Hr))
+        He = (
+            np.einsum("p,mp,mpi,mpj->mij", 2.0 * c, dz, Hr, Hr)
+            + np.einsum("p,mp,mpi,mpj->mij", 2.0 * c, r, Hr, dHz)
+            + np.einsum("p,mp,mpi,mpj->mij", 2.0 * c, r, dHz, Hr)
+        )
         return V, g, He
 
     def target(self, t: float) -> tuple[float, float]:

@@ -89,7 +89,7 @@ class SparsePattern:
 
     def _keys(self, dofs: np.ndarray) -> np.ndarray:
         eq = self.dofmap.eq[dofs]  # (m, k)
-        return (eq[:, :, None] * self.dofmap.n_eq + eq[:, None, :])
+        return eq[:, :, None] * self.dofmap.n_eq + eq[:, None, :]
 
     @staticmethod
     def _sub(rows, cols, nr, nc):
@@ -117,13 +117,13 @@ class SparsePattern:
 
     def fp_product(self, data: np.ndarray, v: np.ndarray) -> np.ndarray:
         """K_fp v (nf,) for v (np,) on the prescribed equations."""
-        w = data[self.n_ff: self.n_ff + self.n_fp] * v[self._fp_cols]
+        w = data[self.n_ff : self.n_ff + self.n_fp] * v[self._fp_cols]
         return np.bincount(self._fp_rows, weights=w, minlength=self.dofmap.nf)
 
     def blocks(self, data: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """K_ff and K_fp (free rows; free and prescribed columns) as CSR matrices."""
         i, p, s = self._fp_csr
-        K_fp = sp.csr_matrix((data[self.n_ff: self.n_ff + self.n_fp], i, p), shape=s)
+        K_fp = sp.csr_matrix((data[self.n_ff : self.n_ff + self.n_fp], i, p), shape=s)
         return self.free_block(data), K_fp
 
 
@@ -156,7 +156,7 @@ class BorderedPattern:
         with no stored zero in the border (a wall node on the axis, dV/du_r = 0; a volume
         constraint's dC/dp), as block assembly leaves them out: the same matrix."""
         g = [G[s, j] for j, s in enumerate(self.supports)]
-        border = np.concatenate(g + [c * v for c, v in zip(c_u, g)] + [c_p[self.diagonal]])
+        border = np.concatenate(g + [c * v for c, v in zip(c_u, g, strict=False)] + [c_p[self.diagonal]])
         if not border.all() or not np.array_equal(np.flatnonzero(c_p), self.diagonal):  # zeros: another pattern
             Cu = c_u[:, None] * G.T
             return sp.bmat([[K, sp.csr_matrix(-G)], [sp.csr_matrix(Cu), sp.csr_matrix(np.diag(c_p))]], format="csr")

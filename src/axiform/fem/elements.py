@@ -24,7 +24,7 @@ def _frozen(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
     return arrays
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def gauss_1d(n: int) -> tuple[np.ndarray, np.ndarray]:
     """Gauss-Legendre points and weights on [-1, 1].  Built once per n (numpy's leggauss
     costs ~0.4 ms, and contact asks for the rule at every evaluation): the arrays are shared
@@ -32,7 +32,7 @@ def gauss_1d(n: int) -> tuple[np.ndarray, np.ndarray]:
     return _frozen(*np.polynomial.legendre.leggauss(int(n)))
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def gauss_quad(n: int) -> tuple[np.ndarray, np.ndarray]:
     """n x n Gauss rule on the square [-1, 1]^2: points (n*n, 2) and weights (n*n,).  Built
     once per n, shared and read-only, as `gauss_1d`."""
@@ -125,8 +125,9 @@ def jacobian(kind: ElementKind, X: np.ndarray, xi: np.ndarray):
     return N, dNdX, detJ, Xq
 
 
-def gradient_operator(kind: ElementKind, X: np.ndarray, points: tuple[np.ndarray, np.ndarray] | None = None
-                      ) -> tuple[np.ndarray, np.ndarray]:
+def gradient_operator(
+    kind: ElementKind, X: np.ndarray, points: tuple[np.ndarray, np.ndarray] | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """G (e, q, 5, ndof_e) with g = G u_e, and dV = 2 pi R detJ w (e, q) (eq. 28), at the
     element's Gauss points, or at the points (xi (q, 2), w (q,)) given.
 
@@ -177,7 +178,7 @@ def edge_shape(n: int, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return N, dN
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def edge_rule(edge_nodes: int, npoints: int = 3) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The npoints Gauss rule on an edge of edge_nodes nodes with its shape functions there:
     points s (p,), weights w (p,), N (p, k) and dN/ds (p, k), exactly

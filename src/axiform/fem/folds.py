@@ -33,5 +33,5 @@ def folded_nodes(mesh: Mesh, u_full: np.ndarray) -> list[tuple[int, int, float]]
         g = np.einsum("eqin,en->eqi", G[:, :, :4], u_full[dofs[cells]])  # U,R, U,Z, W,R, W,Z at the nodes
         j = (1 + g[..., 0]) * (1 + g[..., 3]) - g[..., 1] * g[..., 2]
         e, k = np.nonzero(j <= 0)
-        found += [(start + int(a), int(mesh.cells[start + a, b]), float(j[a, b])) for a, b in zip(e, k)]
+        found += [(start + int(a), int(mesh.cells[start + a, b]), float(j[a, b])) for a, b in zip(e, k, strict=False)]
     return sorted(found, key=lambda f: f[2])

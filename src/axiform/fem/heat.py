@@ -67,8 +67,15 @@ class Conduction:
     """The heat equation of a mesh (module docstring): conductivity k, density rho0 and
     specific heat c as functions of T (`constant(v)` for numbers), films and conductances."""
 
-    def __init__(self, mesh: Mesh, conductivity: Property, density: Property, specific_heat: Property,
-                 films: list[Film] | None = None, conductances: list[Conductance] | None = None):
+    def __init__(
+        self,
+        mesh: Mesh,
+        conductivity: Property,
+        density: Property,
+        specific_heat: Property,
+        films: list[Film] | None = None,
+        conductances: list[Conductance] | None = None,
+    ):
         self.mesh = mesh
         self.k, self.rho, self.c = conductivity, density, specific_heat
         self.films = films or []

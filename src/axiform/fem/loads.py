@@ -20,8 +20,7 @@ class FollowerPressure:
         self.curve = curve  # the applied pressure is value * curve(t)
         self.nodes = mesh.boundary_edges[edges]  # (m, edge_nodes), owner orientation
         self.dofs = element_dofs(self.nodes, mesh.element.dofs_per_node)
-        self.Xs, self.dXs, self.H, self.dH, self.w = edge_interpolation(
-            mesh.element, mesh.points[self.nodes])
+        self.Xs, self.dXs, self.H, self.dH, self.w = edge_interpolation(mesh.element, mesh.points[self.nodes])
         m, p, _, nd = self.H.shape
         self._H2 = self.H.reshape(m, 2 * p, nd)
         self._dH2 = self.dH.reshape(m, 2 * p, nd)

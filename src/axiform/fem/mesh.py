@@ -71,7 +71,8 @@ class Mesh:
         if bad.size:
             raise MeshError(
                 f"inverted or degenerate element(s) {bad[:10].tolist()} (detJ <= 0; nodes must run "
-                f"counter-clockwise in the (r, z) plane): first one has nodes {self.cells[bad[0]].tolist()}")
+                f"counter-clockwise in the (r, z) plane): first one has nodes {self.cells[bad[0]].tolist()}"
+            )
 
     def set_wall(self, wall: str) -> None:
         """Rectangles: measure the thickness through "z" (a plate: fibres are the lines of
@@ -111,8 +112,18 @@ def _structured(grid: np.ndarray, kind: ElementKind):
         keep = ~((np.arange(ni + 1)[:, None] % 2 == 1) & (np.arange(nj + 1)[None, :] % 2 == 1))
         number[keep] = np.arange(keep.sum())
         i, j = (2 * a.ravel() for a in np.meshgrid(np.arange(ni // 2), np.arange(nj // 2), indexing="ij"))
-        cells = np.column_stack([number[i, j], number[i + 2, j], number[i + 2, j + 2], number[i, j + 2],
-                                 number[i + 1, j], number[i + 2, j + 1], number[i + 1, j + 2], number[i, j + 1]])
+        cells = np.column_stack(
+            [
+                number[i, j],
+                number[i + 2, j],
+                number[i + 2, j + 2],
+                number[i, j + 2],
+                number[i + 1, j],
+                number[i + 2, j + 1],
+                number[i + 1, j + 2],
+                number[i, j + 1],
+            ]
+        )
     points = grid.reshape(-1, 2)[number.ravel() >= 0]
     return points, cells, number
 
@@ -150,8 +161,14 @@ def graded(a: float, b: float, n: int, ratio: float = 1.0, per_division: int = 1
     return a + (b - a) * ends
 
 
-def rectangle(r: tuple[float, float], z: tuple[float, float], divisions: tuple[int, int],
-              element: str = "q4", grading: tuple[float, float] = (1.0, 1.0), wall: str = "z") -> Mesh:
+def rectangle(
+    r: tuple[float, float],
+    z: tuple[float, float],
+    divisions: tuple[int, int],
+    element: str = "q4",
+    grading: tuple[float, float] = (1.0, 1.0),
+    wall: str = "z",
+) -> Mesh:
     """Structured mesh of [r0, r1] x [z0, z1] with divisions (nr, nz); Q8 gets mid-side nodes.
     grading: size of the last element over the first, radially and axially (geometric).
 
@@ -162,12 +179,14 @@ def rectangle(r: tuple[float, float], z: tuple[float, float], divisions: tuple[i
     """
     kind = ELEMENTS[element]
     f = 2 if kind.nodes == 8 else 1
-    R, Z = np.meshgrid(graded(*r, divisions[0], grading[0], f), graded(*z, divisions[1], grading[1], f),
-                       indexing="ij")
+    R, Z = np.meshgrid(graded(*r, divisions[0], grading[0], f), graded(*z, divisions[1], grading[1], f), indexing="ij")
     points, cells, number = _structured(np.stack([R, Z], axis=-1), kind)
     mesh = Mesh(points, cells, kind)
-    _add_grid_sets(mesh, number, {"left": (0, slice(None)), "right": (-1, slice(None)),
-                                  "bottom": (slice(None), 0), "top": (slice(None), -1)})
+    _add_grid_sets(
+        mesh,
+        number,
+        {"left": (0, slice(None)), "right": (-1, slice(None)), "bottom": (slice(None), 0), "top": (slice(None), -1)},
+    )
     mesh._walls = {"z": (number, R[:, 0] - r[0]), "r": (number.T, Z[0, :] - z[0])}
     mesh.set_wall(wall)
     return mesh
@@ -199,8 +218,11 @@ def layered(profile, thickness, layers: int, element: str = "q4") -> Mesh:
     grid = mid[:, None, :] + (t * miter)[:, None, None] * offsets[None, :, None] * normal[:, None, :]
     points, cells, number = _structured(grid, kind)
     mesh = Mesh(points, cells, kind)
-    _add_grid_sets(mesh, number, {"start": (0, slice(None)), "end": (-1, slice(None)),
-                                  "bottom": (slice(None), 0), "top": (slice(None), -1)})
+    _add_grid_sets(
+        mesh,
+        number,
+        {"start": (0, slice(None)), "end": (-1, slice(None)), "bottom": (slice(None), 0), "top": (slice(None), -1)},
+    )
     rb, rt = grid[:, 0, 0].mean(), grid[:, -1, 0].mean()
     if abs(rb - rt) > 1e-9 * max(abs(rb), abs(rt), 1.0):
         inner, outer = ("bottom", "top") if rb < rt else ("top", "bottom")
@@ -241,9 +263,11 @@ def read_gmsh(path: str | Path, element: str | None = None) -> Mesh:
     if others:  # a surface meshed partly in triangles: those would be holes in the body
         held = ", ".join(f"{n} {t} cell{'s' * (n > 1)}" for t, n in sorted(others.items()))
         beside = f" beside {sum(len(d) for _, d in quads)} quadrilaterals" if quads else ""
-        raise MeshError(f"{path}: holds {held}{beside}; axiform takes quadrilaterals only (quad or quad8): "
-                        f"recombine the surfaces in gmsh (Mesh.RecombineAll = 1, or Recombine Surface{{...}}; "
-                        f"with Mesh.SubdivisionAlgorithm = 1 for quads only)")
+        raise MeshError(
+            f"{path}: holds {held}{beside}; axiform takes quadrilaterals only (quad or quad8): "
+            f"recombine the surfaces in gmsh (Mesh.RecombineAll = 1, or Recombine Surface{{...}}; "
+            f"with Mesh.SubdivisionAlgorithm = 1 for quads only)"
+        )
     if not quads:
         raise MeshError(f"{path}: no quadrilateral cells (quad or quad8) found")
     types = {t for t, _ in quads}
@@ -261,9 +285,11 @@ def read_gmsh(path: str | Path, element: str | None = None) -> Mesh:
     used = np.unique(cells)
     bad = used[~(np.abs(points[used]) <= MAX_COORDINATE).all(axis=1)]  # NaN compares False
     if len(bad):
-        raise MeshError(f"{path}: {len(bad)} node(s) with coordinates that are not finite numbers, or beyond "
-                        f"{MAX_COORDINATE:g} in magnitude "
-                        f"(the first: number {int(bad[0])} from 0 in the file's node list, at {points[bad[0]].tolist()})")
+        raise MeshError(
+            f"{path}: {len(bad)} node(s) with coordinates that are not finite numbers, or beyond "
+            f"{MAX_COORDINATE:g} in magnitude "
+            f"(the first: number {int(bad[0])} from 0 in the file's node list, at {points[bad[0]].tolist()})"
+        )
     # drop nodes that no quad uses (gmsh keeps geometry points)
     renumber = -np.ones(len(points), dtype=np.int64)
     renumber[used] = np.arange(len(used))
@@ -273,7 +299,7 @@ def read_gmsh(path: str | Path, element: str | None = None) -> Mesh:
     if phys is not None:
         groups: dict[str, list[np.ndarray]] = {}
         line_groups: dict[str, list[np.ndarray]] = {}
-        for block, tags in zip(m.cells, phys):
+        for block, tags in zip(m.cells, phys, strict=False):
             for tag in np.unique(tags):
                 name = names.get(int(tag), str(int(tag)))
                 nodes = renumber[np.unique(block.data[tags == tag])]

@@ -27,8 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .assembly import SolidAssembly
 from ..materials.kinematics import from_rows, to_rows
+from .assembly import SolidAssembly
 
 PRESSURE_SPACES = ("p0", "p1")
 
@@ -122,8 +122,14 @@ class MixedAssembly(SolidAssembly):
         P += p * dJ
         return from_rows(P, None, shape)[0]
 
-    def evaluate(self, u_full: np.ndarray, tangent: bool = True, out: tuple | None = None,
-                 memory=None, temperature: np.ndarray | None = None):
+    def evaluate(
+        self,
+        u_full: np.ndarray,
+        tangent: bool = True,
+        out: tuple | None = None,
+        memory=None,
+        temperature: np.ndarray | None = None,
+    ):
         """Element internal forces fe (e, nd) and, if asked, element tangents Ke (e, nd, nd),
         written into out = (fe, Ke) when given (from `buffers`) and returned (memory,
         temperature: as for SolidAssembly.evaluate).  The law's

@@ -72,8 +72,10 @@ class Profile:
                 c = np.array(piece.center, float)
                 rad = np.linalg.norm(p - c)
                 if abs(np.linalg.norm(q - c) - rad) > 1e-9 * max(rad, 1.0) or rad == 0:
-                    raise ProfileError(f"piece {k}: the arc's end {tuple(piece.to)} is not on the circle about "
-                                       f"{tuple(piece.center)} through {tuple(p)}")
+                    raise ProfileError(
+                        f"piece {k}: the arc's end {tuple(piece.to)} is not on the circle about "
+                        f"{tuple(piece.center)} through {tuple(p)}"
+                    )
                 a0 = np.arctan2(*(p - c)[::-1])
                 a1 = np.arctan2(*(q - c)[::-1])
                 sweep = (a1 - a0) % (2 * np.pi)

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -17,8 +18,9 @@ def describe(spec: Mapping[str, Any]) -> str:
     return "{" + ", ".join(f"{k} = {v!r}" for k, v in spec.items() if v is not None) + "}"
 
 
-def select_nodes(mesh: Mesh, spec: Mapping[str, Any], where: str = "selector",
-                 corners_only: bool = False) -> np.ndarray:
+def select_nodes(
+    mesh: Mesh, spec: Mapping[str, Any], where: str = "selector", corners_only: bool = False
+) -> np.ndarray:
     """Indices of the nodes matching every given criterion of spec:
     r / z (coordinate within tol, default 1e-3 of the smallest element edge), box
     [[r0, z0], [r1, z1]] (inclusive, same tolerance), set (a named node set of the mesh)."""

@@ -148,7 +148,7 @@ def check_like(saved: Any, template: Any, where: str = "checkpoint") -> None:
     elif isinstance(template, (list, tuple)):
         if not isinstance(saved, (list, tuple)) or len(saved) != len(template):
             raise ValueError(f"{where}: {len(template)} entries were expected")
-        for i, (a, b) in enumerate(zip(saved, template)):
+        for i, (a, b) in enumerate(zip(saved, template, strict=False)):
             check_like(a, b, f"{where}[{i}]")
     elif isinstance(template, np.ndarray):
         if not isinstance(saved, np.ndarray) or saved.shape != template.shape:

@@ -50,7 +50,7 @@ def series_times(entries: list[tuple[int, float, str]]) -> list[float]:
     step when the times increase strictly along the series (a reader orders the frames by
     it); else (arc length past a limit point, where the load factor goes back) the step numbers."""
     times = [t for _, t, _ in entries]
-    if all(a < b for a, b in zip(times, times[1:])):
+    if all(a < b for a, b in zip(times, times[1:], strict=False)):
         return times
     return [float(step) for step, _, _ in entries]
 
@@ -60,7 +60,7 @@ def write_pvd(path: Path, entries: list[tuple[int, float, str]]) -> None:
     file), in their order, with their timesteps (series_times)."""
     root = ET.Element("VTKFile", type="Collection", version="0.1")
     coll = ET.SubElement(root, "Collection")
-    for (_, _, name), t in zip(entries, series_times(entries)):
+    for (_, _, name), t in zip(entries, series_times(entries), strict=False):
         ET.SubElement(coll, "DataSet", timestep=repr(t), part="0", file=name)
     with atomic(path) as tmp:
         ET.ElementTree(root).write(tmp)
@@ -92,6 +92,8 @@ def contact_table(reports: list[dict], x: np.ndarray, status_names: dict[int, st
         pressure = [f"{p:.6g}" for p in np.asarray(rep["pressure"], float).tolist()]
         status = [status_names[s] for s in np.asarray(rep["status"]).astype(int).tolist()]
         first = ["" if t != t else repr(t) for t in np.asarray(rep["first_contact"], float).tolist()]
-        lines += [f"{k},{n},{a:.10g},{b:.10g},{g},{p},{s},{t}"
-                  for n, a, b, g, p, s, t in zip(node.tolist(), r, z, gap, pressure, status, first)]
+        lines += [
+            f"{k},{n},{a:.10g},{b:.10g},{g},{p},{s},{t}"
+            for n, a, b, g, p, s, t in zip(node.tolist(), r, z, gap, pressure, status, first, strict=False)
+        ]
     return "\n".join(lines) + "\n"

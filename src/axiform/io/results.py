@@ -26,10 +26,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import gid
 from ..post.fields import point_fields, with_components
 from ..post.results_folder import HISTORY_COLUMNS
 from ..post.thickness import thickness_table, write_thickness_csv
+from . import gid
 from .files import atomic, contact_table, mould_outlines, write_atomic, write_pvd, write_vtu
 from .run_report import RunRecord, column_units, thickness_summary
 
@@ -73,8 +73,17 @@ def _read_summary(out: Path) -> dict:
         return {}
 
 
-STALE = ("thickness.csv", "contact.csv", "surfaces.csv", "fields.pvd", "revolved.vtu", "load_curve.png",
-         "thickness.png", "deformed.png", "forming.gif")
+STALE = (
+    "thickness.csv",
+    "contact.csv",
+    "surfaces.csv",
+    "fields.pvd",
+    "revolved.vtu",
+    "load_curve.png",
+    "thickness.png",
+    "deformed.png",
+    "forming.gif",
+)
 
 
 def clear_folder(out: Path, times: dict[int, float], vtu: bool, thickness_steps: bool) -> list[tuple[int, float, str]]:
@@ -87,8 +96,11 @@ def clear_folder(out: Path, times: dict[int, float], vtu: bool, thickness_steps:
         tmp.unlink()
     if vtu:
         (out / "fields").mkdir(exist_ok=True)
-    for old in [*(out / "fields").glob("step_*.vtu"), *(out / "fields").glob("surfaces_*.csv"),
-                *(out / "thickness").glob("step_*.csv")]:
+    for old in [
+        *(out / "fields").glob("step_*.vtu"),
+        *(out / "fields").glob("surfaces_*.csv"),
+        *(out / "thickness").glob("step_*.csv"),
+    ]:
         if int(old.stem.split("_")[-1]) > kept:
             old.unlink()
     if thickness_steps:
@@ -105,11 +117,26 @@ class ResultsWriter:
     """Writes the results folder step by step, so that a run stopped midway keeps every
     converged step."""
 
-    def __init__(self, out: str | Path, model, monitors=(), title: str = "", every: int = 1,
-                 vtu: bool = True, gid_files: bool = False, revolved: int = 0, plots: bool = True,
-                 thickness_every: int | None = None, labels: dict | None = None,
-                 case: dict | None = None, restart_every: int = 0, restart_meta: dict | None = None,
-                 resume: dict | None = None, flush_every_s: float = 0.0, warnings: Sequence[str] = ()):
+    def __init__(
+        self,
+        out: str | Path,
+        model,
+        monitors=(),
+        title: str = "",
+        every: int = 1,
+        vtu: bool = True,
+        gid_files: bool = False,
+        revolved: int = 0,
+        plots: bool = True,
+        thickness_every: int | None = None,
+        labels: dict | None = None,
+        case: dict | None = None,
+        restart_every: int = 0,
+        restart_meta: dict | None = None,
+        resume: dict | None = None,
+        flush_every_s: float = 0.0,
+        warnings: Sequence[str] = (),
+    ):
         """labels: units, load and monitor_quantities for summary.json (labels.case_labels);
         case: where the case came from and its fingerprint.  restart_every: write the step's
         checkpoint to restart/ every k steps (and at the end of the run, whatever stopped it),
@@ -161,7 +188,9 @@ class ResultsWriter:
         times = self._resume(resume, header) if resume is not None else {}
         self.record = RunRecord(self.model, earlier if times else None)
         write_atomic(self.out / "history.csv", self._history.getvalue())
-        self._pvd = clear_folder(self.out, times, self.vtu, bool(self.thickness_every and self.model.mesh.fibres is not None))
+        self._pvd = clear_folder(
+            self.out, times, self.vtu, bool(self.thickness_every and self.model.mesh.fibres is not None)
+        )
         if self.gid:
             with atomic(self.out / "axiform.post.msh") as tmp:
                 gid.write_mesh(tmp, self.model.mesh.points, self.model.mesh.cells)
@@ -210,8 +239,10 @@ class ResultsWriter:
         if bad.size:
             node, k = divmod(int(bad[0]), self.model.dpn)
             element = int(np.argmax((self.model.mesh.cells == node).any(axis=1)))
-            raise NonFiniteResult(f"step {step.number}: the displacement {('ur', 'uz', 'rot')[k]} of node {node} "
-                                  f"(element {element}) is {step.u[bad[0]]}: not written")
+            raise NonFiniteResult(
+                f"step {step.number}: the displacement {('ur', 'uz', 'rot')[k]} of node {node} "
+                f"(element {element}) is {step.u[bad[0]]}: not written"
+            )
         if not np.isfinite(step.lam):
             raise NonFiniteResult(f"step {step.number}: the load factor is {step.lam}: not written")
         for name, v in values.items():
@@ -243,18 +274,22 @@ class ResultsWriter:
         self._wait_for_vtu(wait=False)
         values = {m.name: m.value(step) for m in self.monitors}
         self._guard(step, values)
-        self._csv.writerow([step.number, repr(float(step.lam)), repr(float(step.lam)), step.iterations]
-                           + [repr(v) for v in values.values()])
+        self._csv.writerow(
+            [step.number, repr(float(step.lam)), repr(float(step.lam)), step.iterations]
+            + [repr(v) for v in values.values()]
+        )
         if self.model.contacts:
             self._record_contact(step)
         self.steps = step.number
         self.newton_iterations += step.iterations
-        self.summary.update(steps=self.steps, newton_iterations=self.newton_iterations,
-                            load_factor=float(step.lam), monitors=values)
+        self.summary.update(
+            steps=self.steps, newton_iterations=self.newton_iterations, load_factor=float(step.lam), monitors=values
+        )
         if self.model.cavities:
-            self.summary["cavities"] = {c.name: {"pressure": float(held.pressure), "volume": float(held.volume),
-                                                 "initial_volume": float(c.V0)}
-                                        for c, held in zip(self.model.cavities, step.state.cavities)}
+            self.summary["cavities"] = {
+                c.name: {"pressure": float(held.pressure), "volume": float(held.volume), "initial_volume": float(c.V0)}
+                for c, held in zip(self.model.cavities, step.state.cavities, strict=False)
+            }
         if step.number % self.every == 0:
             self._write_fields(step)
         if self.thickness_every and step.number % self.thickness_every == 0:
@@ -275,14 +310,18 @@ class ResultsWriter:
         are written by the next `_flush`."""
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
         x = self.model.mesh.points + u
-        reports = [pair.report(held) for pair, held in zip(self.model.contacts, step.state.contacts)]
+        reports = [pair.report(held) for pair, held in zip(self.model.contacts, step.state.contacts, strict=False)]
         self._contact = (reports, x, float(step.lam))
-        self.record.contact_step(step, reports, x, thickness_table(self.model.mesh, u) if self.model.mesh.fibres
-                                 is not None else None)
-        self.summary["contact"] = [{"name": rec.name} | {q: rep[q] for q in ("force_r", "force_z", "contact_area",
-                                                                           "penetration")}
-                                   | rec.summary() | {"touched": rec.touched}
-                                   for rec, rep in zip(self.record.pairs, reports)]
+        self.record.contact_step(
+            step, reports, x, thickness_table(self.model.mesh, u) if self.model.mesh.fibres is not None else None
+        )
+        self.summary["contact"] = [
+            {"name": rec.name}
+            | {q: rep[q] for q in ("force_r", "force_z", "contact_area", "penetration")}
+            | rec.summary()
+            | {"touched": rec.touched}
+            for rec, rep in zip(self.record.pairs, reports, strict=False)
+        ]
 
     def _write_contact(self) -> None:
         """contact.csv and surfaces.csv of the last recorded step, if not yet written."""
@@ -307,8 +346,10 @@ class ResultsWriter:
         if T is not None:
             self.summary["temperature"] = {"min": float(T.min()), "max": float(T.max())}
         if self.vtu and self.model.contacts:
-            write_atomic(self.out / "fields" / f"surfaces_{step.number:04d}.csv",
-                         mould_outlines(self.model.contacts, float(step.lam)))
+            write_atomic(
+                self.out / "fields" / f"surfaces_{step.number:04d}.csv",
+                mould_outlines(self.model.contacts, float(step.lam)),
+            )
         if not (self.vtu or self.gid):
             return
         data = point_fields(self.model, step.u, step.state)

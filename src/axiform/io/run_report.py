@@ -25,16 +25,23 @@ def thickness_summary(table: dict[str, np.ndarray]) -> dict[str, float]:
     """{min, max, s_min, r_min, z_min} of a thickness table (post.thickness.thickness_table)."""
     t = table["thickness"]
     k = int(np.argmin(t))
-    return {"min": float(t[k]), "max": float(t.max()), "s_min": float(table["s"][k]),
-            "r_min": float(table["r"][k]), "z_min": float(table["z"][k])}
+    return {
+        "min": float(t[k]),
+        "max": float(t.max()),
+        "s_min": float(table["s"][k]),
+        "r_min": float(table["r"][k]),
+        "z_min": float(table["z"][k]),
+    }
 
 
 def element_heights(mesh, x: np.ndarray) -> np.ndarray:
     """(n,) the height of the thinnest element around every node at the positions x (n, 2):
     the area of its corner quadrilateral over its longest side."""
     c = x[mesh.cells[:, :4]]
-    area = 0.5 * np.abs(np.einsum("ei,ei->e", c[..., 0], np.roll(c[..., 1], -1, axis=1))
-                        - np.einsum("ei,ei->e", c[..., 1], np.roll(c[..., 0], -1, axis=1)))
+    area = 0.5 * np.abs(
+        np.einsum("ei,ei->e", c[..., 0], np.roll(c[..., 1], -1, axis=1))
+        - np.einsum("ei,ei->e", c[..., 1], np.roll(c[..., 0], -1, axis=1))
+    )
     longest = np.linalg.norm(c - np.roll(c, -1, axis=1), axis=-1).max(axis=1)
     height = np.full(mesh.n_nodes, np.inf)
     np.minimum.at(height, mesh.cells.ravel(), np.repeat(area / longest, mesh.cells.shape[1]))
@@ -53,8 +60,11 @@ class PairRecord:
     at: dict = field(default_factory=dict)  # where and when: penetration, wall, r, z, step
 
     def summary(self) -> dict:
-        return {"max_force_r": self.max_force_r, "max_force_z": self.max_force_z,
-                "max_penetration_ratio": self.max_penetration_ratio}
+        return {
+            "max_force_r": self.max_force_r,
+            "max_force_z": self.max_force_z,
+            "max_penetration_ratio": self.max_penetration_ratio,
+        }
 
 
 class RunRecord:
@@ -65,7 +75,7 @@ class RunRecord:
         """earlier: the `contact` entries of the summary.json a resumed run continues."""
         self.model = model
         self.pairs = [PairRecord(p.name or f"contact[{k}]") for k, p in enumerate(model.contacts)]
-        for rec, old in zip(self.pairs, earlier or []):
+        for rec, old in zip(self.pairs, earlier or [], strict=False):
             rec.touched = bool(old.get("touched", False))
             for key in ("max_force_r", "max_force_z", "max_penetration_ratio"):
                 setattr(rec, key, float(old.get(key, 0.0)))
@@ -75,7 +85,7 @@ class RunRecord:
         nodes x (n, 2) and the thickness table of the step (None without a wall)."""
         mesh = self.model.mesh
         wall = nodal_thickness(mesh, table) if table is not None else element_heights(mesh, x)
-        for rec, rep in zip(self.pairs, reports):
+        for rec, rep in zip(self.pairs, reports, strict=False):
             rec.touched |= bool(np.any(rep["status"] > 0))
             rec.max_force_r = max(rec.max_force_r, abs(rep["force_r"]))
             rec.max_force_z = max(rec.max_force_z, abs(rep["force_z"]))
@@ -85,8 +95,13 @@ class RunRecord:
             if len(ratio) and ratio[k] > rec.max_penetration_ratio:
                 node = rep["node"][k]
                 rec.max_penetration_ratio = float(ratio[k])
-                rec.at = {"penetration": float(-gap[k]), "wall": float(wall[node]), "r": float(x[node, 0]),
-                          "z": float(x[node, 1]), "step": int(step.number)}
+                rec.at = {
+                    "penetration": float(-gap[k]),
+                    "wall": float(wall[node]),
+                    "r": float(x[node, 0]),
+                    "z": float(x[node, 1]),
+                    "step": int(step.number),
+                }
 
     def stabilization(self, step) -> dict | None:
         """{work, strain_energy, ratio} of the last step where a pair is stabilized, else None."""
@@ -101,26 +116,32 @@ class RunRecord:
         above PENETRATION_LIMIT of the wall, stabilization work above STABILIZATION_LIMIT of
         the strain energy."""
         lines = []
-        for k, (rec, held) in enumerate(zip(self.pairs, step.state.contacts)):
+        for k, (rec, held) in enumerate(zip(self.pairs, step.state.contacts, strict=False)):
             touched = rec.touched or bool(np.isfinite(np.asarray(held.first_contact, float)).any())
             if not touched:
                 lines.append(f'contact[{k}] ("{rec.name}") never touched the body')
             if rec.max_penetration_ratio > PENETRATION_LIMIT:
                 a = rec.at
-                lines.append(f'contact[{k}] ("{rec.name}") penetrates {100 * rec.max_penetration_ratio:.1f} % of the '
-                             f"local wall thickness ({a['penetration']:.4g} of {a['wall']:.4g} at r = {a['r']:.4g}, "
-                             f"z = {a['z']:.4g}, step {a['step']}; above {100 * PENETRATION_LIMIT:g} %): "
-                             "raise its penalty or refine the steps")
+                lines.append(
+                    f'contact[{k}] ("{rec.name}") penetrates {100 * rec.max_penetration_ratio:.1f} % of the '
+                    f"local wall thickness ({a['penetration']:.4g} of {a['wall']:.4g} at r = {a['r']:.4g}, "
+                    f"z = {a['z']:.4g}, step {a['step']}; above {100 * PENETRATION_LIMIT:g} %): "
+                    "raise its penalty or refine the steps"
+                )
         if stabilization and stabilization["ratio"] > STABILIZATION_LIMIT:
-            lines.append(f"contact stabilization dissipated {stabilization['work']:.4g}, "
-                         f"{100 * stabilization['ratio']:.1f} % of the strain energy {stabilization['strain_energy']:.4g} "
-                         f"(above {100 * STABILIZATION_LIMIT:g} %): the result leans on the damping; "
-                         "lower contact stabilization or support the body")
+            lines.append(
+                f"contact stabilization dissipated {stabilization['work']:.4g}, "
+                f"{100 * stabilization['ratio']:.1f} % of the strain energy {stabilization['strain_energy']:.4g} "
+                f"(above {100 * STABILIZATION_LIMIT:g} %): the result leans on the damping; "
+                "lower contact stabilization or support the body"
+            )
         return lines
 
 
-LENGTH_COLUMNS = {"thickness.csv": ("s", "r", "z", "thickness", "initial_thickness", "s_current"),
-                  "contact.csv": ("r", "z", "gap")}
+LENGTH_COLUMNS = {
+    "thickness.csv": ("s", "r", "z", "thickness", "initial_thickness", "s_current"),
+    "contact.csv": ("r", "z", "gap"),
+}
 
 
 def column_units(summary: dict) -> dict[str, dict[str, str]]:
@@ -130,8 +151,11 @@ def column_units(summary: dict) -> dict[str, dict[str, str]]:
     keys on them); this map is where a reader finds the units."""
     units = summary.get("units") or {}
     length = units.get("length")
-    derived = {"area": f"{length}^2" if length else None, "volume": f"{length}^3" if length else None,
-               "rotation": "rad"}
+    derived = {
+        "area": f"{length}^2" if length else None,
+        "volume": f"{length}^3" if length else None,
+        "rotation": "rad",
+    }
     history = {"time": units["time"]} if units.get("time") else {}
     for name, quantity in (summary.get("monitor_quantities") or {}).items():
         unit = derived.get(quantity) if quantity in derived else units.get(QUANTITY_UNIT.get(quantity, ""))

@@ -13,6 +13,17 @@ from .ogden import Ogden
 from .yeoh import Yeoh
 
 __all__ = [
-    "ArrudaBoyce", "Gent", "Hyperelastic", "InvariantLaw", "InvertedElementError", "MooneyRivlin",
-    "NeoHooke", "Ogden", "ReducedLaw", "Yeoh", "cauchy_stress", "deformation_gradient", "invariants",
+    "ArrudaBoyce",
+    "Gent",
+    "Hyperelastic",
+    "InvariantLaw",
+    "InvertedElementError",
+    "MooneyRivlin",
+    "NeoHooke",
+    "Ogden",
+    "ReducedLaw",
+    "Yeoh",
+    "cauchy_stress",
+    "deformation_gradient",
+    "invariants",
 ]

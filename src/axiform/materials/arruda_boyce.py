@@ -22,7 +22,6 @@ class ArrudaBoyce(InvariantLaw):
     lambda_m: float
     kappa: float
 
-
     def coefficients(self) -> list:
         """a_i = mu c_i / lambda_m^(2i-2), i = 1..5, so that W_iso = sum a_i (I1_bar^i - 3^i)
         (numbers, or arrays where mu or lambda_m are one per point)."""

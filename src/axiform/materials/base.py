@@ -34,7 +34,8 @@ class Hyperelastic(ABC):
     """Decoupled law W = W_iso(F_bar) + kappa/2 (J - 1)^2; kappa the bulk modulus.
 
     Subclasses give `stress_rows(xt, kappa, tangent)` (the mixed elements call it with kappa
-    = 0): P rows (5, n) and, if asked, A rows (5, 5, n) of W_iso + kappa/2 (J - 1)^2 at x rows xt (5, n) (kappa = 0: the isochoric part alone),
+    = 0): P rows (5, n) and, if asked, A rows (5, 5, n) of W_iso + kappa/2 (J - 1)^2 at x rows xt (5, n) (kappa =
+    0: the isochoric part alone),
     `iso_energy` and `shear_modulus`.
     """
 

@@ -19,7 +19,6 @@ class Gent(InvariantLaw):
     Jm: float
     kappa: float
 
-
     @property
     def shear_modulus(self) -> float:
         """Initial shear modulus mu."""

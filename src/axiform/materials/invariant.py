@@ -51,24 +51,37 @@ class InvariantLaw(ReducedLaw):
         if self.uses_I2:
             L = K * K  # J^(-4/3)
             I2b = (j2 * j2 + ff * s) * L
-            d2 = np.stack([ff * L, 2.0 * j2 * L - 4.0 / 3.0 * I2b * i_j,
-                           2.0 * f * s * L - 4.0 / 3.0 * I2b * i_f])
+            d2 = np.stack([ff * L, 2.0 * j2 * L - 4.0 / 3.0 * I2b * i_j, 2.0 * f * s * L - 4.0 / 3.0 * I2b * i_f])
         W1, W2, W11, W12, W22 = self.psi_derivatives(I1b, I2b, tangent)
         g = W1 * d1 if W2 is None else W1 * d1 + W2 * d2
         if not tangent:
             return g, None
         # Hessians of I1_bar and I2_bar in (s, j2, f), entries ss, sj, sf, jj, jf, ff
         zero = np.zeros_like(K)
-        h1 = np.stack([zero, -2.0 / 3.0 * K * i_j, -2.0 / 3.0 * K * i_f, 10.0 / 9.0 * I1b * i_j**2,
-                       -2.0 / 3.0 * d1[2] * i_j, -2.0 / 3.0 * K + 10.0 / 9.0 * I1b * i_f**2])
+        h1 = np.stack(
+            [
+                zero,
+                -2.0 / 3.0 * K * i_j,
+                -2.0 / 3.0 * K * i_f,
+                10.0 / 9.0 * I1b * i_j**2,
+                -2.0 / 3.0 * d1[2] * i_j,
+                -2.0 / 3.0 * K + 10.0 / 9.0 * I1b * i_f**2,
+            ]
+        )
         H = W1 * h1
         if W11 is not None:
             H += W11 * (d1[PAIR_K] * d1[PAIR_L])
         if W2 is not None:
-            h2 = np.stack([zero, -4.0 / 3.0 * ff * L * i_j, 2.0 / 3.0 * f * L,
-                           -10.0 / 3.0 * L + 28.0 / 9.0 * I2b * i_j**2,
-                           -8.0 / 3.0 * j2 * L * i_f - 4.0 / 3.0 * d2[2] * i_j,
-                           -10.0 / 3.0 * s * L + 28.0 / 9.0 * I2b * i_f**2])
+            h2 = np.stack(
+                [
+                    zero,
+                    -4.0 / 3.0 * ff * L * i_j,
+                    2.0 / 3.0 * f * L,
+                    -10.0 / 3.0 * L + 28.0 / 9.0 * I2b * i_j**2,
+                    -8.0 / 3.0 * j2 * L * i_f - 4.0 / 3.0 * d2[2] * i_j,
+                    -10.0 / 3.0 * s * L + 28.0 / 9.0 * I2b * i_f**2,
+                ]
+            )
             H += W2 * h2
         if W12 is not None:
             H += W12 * sym_outer(d1, d2)

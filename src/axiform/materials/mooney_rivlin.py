@@ -35,7 +35,7 @@ class MooneyRivlin(InvariantLaw):
         return 2.0 * (self.C1 + self.C2)
 
     @classmethod
-    def from_E_nu(cls, C1: float, C2: float, E: float, nu: float) -> "MooneyRivlin":
+    def from_E_nu(cls, C1: float, C2: float, E: float, nu: float) -> MooneyRivlin:
         """kappa = E / (3 (1 - 2 nu)) (eq. 13)."""
         return cls(C1, C2, E / (3.0 * (1.0 - 2.0 * nu)))
 

@@ -77,7 +77,6 @@ class Ogden(ReducedLaw):
     alpha: tuple[float, ...]
     kappa: float
 
-
     def __post_init__(self):
         object.__setattr__(self, "mu", tuple(float(v) for v in np.atleast_1d(self.mu)))
         object.__setattr__(self, "alpha", tuple(float(v) for v in np.atleast_1d(self.alpha)))
@@ -124,23 +123,29 @@ class Ogden(ReducedLaw):
         t1 = A1 * T
         a6, a3 = al / 6.0, al / 3.0
         Gj1 = A1 * i_j * (a6 * T - w * T1)  # d(A1 T)/dj2
-        g = np.stack([
-            (cw * A1 * T1).sum(axis=0) * (0.5 * i_j),
-            (cw * (Gj1 - a3 * t2 * i_j)).sum(axis=0),
-            (cw * (-a3 * t1 + 2.0 * a3 * t2)).sum(axis=0) * i_f,
-        ])
+        g = np.stack(
+            [
+                (cw * A1 * T1).sum(axis=0) * (0.5 * i_j),
+                (cw * (Gj1 - a3 * t2 * i_j)).sum(axis=0),
+                (cw * (-a3 * t1 + 2.0 * a3 * t2)).sum(axis=0) * i_f,
+            ]
+        )
         if not tangent:
             return g, None
         T2 = beta * beta * R2  # T''(w)
         Gs = A1 * T1 * (0.5 * i_j)
         q, p = -a3, 2.0 * a3  # powers of j2 and f in t2
-        H = np.stack([
-            (cw * A1 * T2).sum(axis=0) * (0.25 * i_j * i_j),
-            (cw * A1 * ((a6 - 1.0) * T1 - w * T2)).sum(axis=0) * (0.5 * i_j * i_j),
-            (cw * (-a3 * Gs)).sum(axis=0) * i_f,
-            (cw * (A1 * (a6 * (a6 - 1.0) * T + (2.0 - 2.0 * a6) * w * T1 + w * w * T2)
-                   + q * (q - 1.0) * t2)).sum(axis=0) * (i_j * i_j),
-            (cw * (-a3 * Gj1 + p * q * t2 * i_j)).sum(axis=0) * i_f,
-            (cw * (a3 * (a3 + 1.0) * t1 + p * (p - 1.0) * t2)).sum(axis=0) * (i_f * i_f),
-        ])
+        H = np.stack(
+            [
+                (cw * A1 * T2).sum(axis=0) * (0.25 * i_j * i_j),
+                (cw * A1 * ((a6 - 1.0) * T1 - w * T2)).sum(axis=0) * (0.5 * i_j * i_j),
+                (cw * (-a3 * Gs)).sum(axis=0) * i_f,
+                (cw * (A1 * (a6 * (a6 - 1.0) * T + (2.0 - 2.0 * a6) * w * T1 + w * w * T2) + q * (q - 1.0) * t2)).sum(
+                    axis=0
+                )
+                * (i_j * i_j),
+                (cw * (-a3 * Gj1 + p * q * t2 * i_j)).sum(axis=0) * i_f,
+                (cw * (a3 * (a3 + 1.0) * t1 + p * (p - 1.0) * t2)).sum(axis=0) * (i_f * i_f),
+            ]
+        )
         return g, H

@@ -36,7 +36,7 @@ class Table:
             raise ValueError("the temperatures of a table must increase")
 
     @classmethod
-    def of(cls, rows) -> "Table":
+    def of(cls, rows) -> Table:
         """A table from its rows [[T, value], ...]."""
         rows = np.asarray(rows, float)
         return cls(tuple(rows[:, 0]), tuple(rows[:, 1]))
@@ -58,8 +58,10 @@ class WLF:
         """ValueError where T (any shape) lies at or beyond the pole T = T_ref - C2."""
         T = np.asarray(T, float)
         if T.size and not (self.C2 + T - self.reference > 0).all():
-            raise ValueError(f"a temperature of {float(T.min()):.6g} is at or below the WLF pole T_ref - C2 = "
-                             f"{self.reference - self.C2:.6g} (C2 + T - T_ref must be > 0)")
+            raise ValueError(
+                f"a temperature of {float(T.min()):.6g} is at or below the WLF pole T_ref - C2 = "
+                f"{self.reference - self.C2:.6g} (C2 + T - T_ref must be > 0)"
+            )
 
     def shift(self, T: np.ndarray | float) -> np.ndarray:
         """a_T (same shape as T)."""
@@ -92,8 +94,9 @@ class TemperatureDependent:
     """A law whose constants are tables of T (`tables`: name -> Table; `fixed`: name ->
     number), built by `make(constants)` from one value (or one array of values) per name."""
 
-    def __init__(self, make: Callable[[dict], object], tables: dict[str, Table], fixed: dict[str, float],
-                 reference: float):
+    def __init__(
+        self, make: Callable[[dict], object], tables: dict[str, Table], fixed: dict[str, float], reference: float
+    ):
         self.make = make
         self.tables = tables
         self.fixed = fixed

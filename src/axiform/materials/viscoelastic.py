@@ -80,12 +80,26 @@ def second_piola_rows(xt: np.ndarray, P: np.ndarray) -> np.ndarray:
 def f_times(x: np.ndarray, H: np.ndarray) -> np.ndarray:
     """F H (..., 5) for a symmetric H (..., 4)."""
     RR, RZ, ZZ, TT = (H[..., k] for k in range(4))
-    return np.stack([x[..., 0] * RR + x[..., 1] * RZ, x[..., 0] * RZ + x[..., 1] * ZZ,
-                     x[..., 2] * RR + x[..., 3] * RZ, x[..., 2] * RZ + x[..., 3] * ZZ, x[..., 4] * TT], axis=-1)
+    return np.stack(
+        [
+            x[..., 0] * RR + x[..., 1] * RZ,
+            x[..., 0] * RZ + x[..., 1] * ZZ,
+            x[..., 2] * RR + x[..., 3] * RZ,
+            x[..., 2] * RZ + x[..., 3] * ZZ,
+            x[..., 4] * TT,
+        ],
+        axis=-1,
+    )
 
 
-def viscous_rows(xt: np.ndarray, P: np.ndarray, A: np.ndarray | None, h: np.ndarray, S_n: np.ndarray,
-                 factors: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+def viscous_rows(
+    xt: np.ndarray,
+    P: np.ndarray,
+    A: np.ndarray | None,
+    h: np.ndarray,
+    S_n: np.ndarray,
+    factors: tuple[np.ndarray, np.ndarray, np.ndarray],
+) -> tuple[np.ndarray, np.ndarray]:
     """Add the Prony series to the law's isochoric P rows (5, n) and A rows (5, 5, n), in
     place, at F rows xt (5, n) over a step (`factors` e, a, b: (m, 1) for every point or
     (m, n) one set per point) from the committed history h (m, 4, n) and S_n (4, n); return
@@ -126,7 +140,7 @@ class Viscoelastic:
         self.law = law
         self.prony = prony
 
-    def at(self, T: np.ndarray) -> "Viscoelastic":
+    def at(self, T: np.ndarray) -> Viscoelastic:
         """The same series on the law at the temperatures T of a batch of points (where its
         constants are tables of T: materials.temperature.TemperatureDependent)."""
         return Viscoelastic(self.law.at(T), self.prony) if hasattr(self.law, "at") else self

@@ -117,21 +117,30 @@ def fit_prony(basis, x: np.ndarray, data: np.ndarray, span: tuple[float, float],
     moduli, _ = nnls(A * w[:, None], np.full(len(data), 1.0), maxiter=50 * (n + 1))
 
     def residual(p):
-        A, _ = basis(x, np.exp(p[n + 1:]))
-        return A @ p[:n + 1] * w - 1.0
+        A, _ = basis(x, np.exp(p[n + 1 :]))
+        return A @ p[: n + 1] * w - 1.0
 
     def jacobian(p):
-        A, dA = basis(x, np.exp(p[n + 1:]))
-        return np.hstack([A, dA * p[1:n + 1]]) * w[:, None]
+        A, dA = basis(x, np.exp(p[n + 1 :]))
+        return np.hstack([A, dA * p[1 : n + 1]]) * w[:, None]
 
     p0 = np.concatenate([moduli, np.log(tau0)])
     lo = np.concatenate([np.zeros(n + 1), np.full(n, np.log(span[0]))])
     hi = np.concatenate([np.full(n + 1, np.inf), np.full(n, np.log(span[1]))])
-    sol = least_squares(residual, p0, jac=jacobian, bounds=(lo, hi), x_scale="jac",
-                        xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200 * (n + 1))
+    sol = least_squares(
+        residual,
+        p0,
+        jac=jacobian,
+        bounds=(lo, hi),
+        x_scale="jac",
+        xtol=1e-15,
+        ftol=1e-15,
+        gtol=1e-15,
+        max_nfev=200 * (n + 1),
+    )
     p = sol.x if sol.cost <= 0.5 * np.sum(residual(p0) ** 2) else p0
-    E0 = float(p[:n + 1].sum())
-    g, tau = p[1:n + 1] / E0, np.exp(p[n + 1:])
+    E0 = float(p[: n + 1].sum())
+    g, tau = p[1 : n + 1] / E0, np.exp(p[n + 1 :])
     keep = g >= G_MIN
     order = np.argsort(tau[keep])
     g, tau = g[keep][order], tau[keep][order]
@@ -193,7 +202,16 @@ def fit_wlf(T: np.ndarray, log_shift: np.ndarray, reference: float, offset: bool
 
     p0 = np.array([C1, C2, b0] if offset else [C1, C2])
     lo = np.array([0.0, pole, -np.inf] if offset else [0.0, pole])
-    sol = least_squares(residual, p0, jac=jacobian, bounds=(lo, np.full(len(p0), np.inf)), x_scale="jac",
-                        xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=2000)
+    sol = least_squares(
+        residual,
+        p0,
+        jac=jacobian,
+        bounds=(lo, np.full(len(p0), np.inf)),
+        x_scale="jac",
+        xtol=1e-15,
+        ftol=1e-15,
+        gtol=1e-15,
+        max_nfev=2000,
+    )
     p = sol.x
     return WLFFit(float(p[0]), float(p[1]), reference, float(p[2]) if offset else 0.0, residual(p))

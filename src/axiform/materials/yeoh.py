@@ -18,7 +18,6 @@ class Yeoh(InvariantLaw):
     C30: float
     kappa: float
 
-
     @property
     def shear_modulus(self) -> float:
         """Initial shear modulus mu = 2 C10."""

@@ -153,8 +153,10 @@ def evaluation_fault(model, r_full: np.ndarray, K: sp.spmatrix | None) -> str | 
     if bad.size:
         node, k = divmod(int(bad[0]), model.dpn)
         element = int(np.argmax((model.mesh.cells == node).any(axis=1)))
-        return (f"the residual is not finite at node {node} ({('ur', 'uz', 'rot')[k]}, element {element}): "
-                "an overflow of the material law or a collapsed element")
+        return (
+            f"the residual is not finite at node {node} ({('ur', 'uz', 'rot')[k]}, element {element}): "
+            "an overflow of the material law or a collapsed element"
+        )
     if K is None or not K.nnz:
         return None
     modes = rigid_translations(model)
@@ -166,6 +168,8 @@ def evaluation_fault(model, r_full: np.ndarray, K: sp.spmatrix | None) -> str | 
     size = abs(K).sum(axis=0).max() * np.asarray(modes.sum(axis=0)).ravel()
     free = np.flatnonzero(force <= 1e-9 * size)
     if free.size:
-        return ("a mechanism: the tangent has no stiffness against a rigid translation along z of "
-                f"{free.size} bod{'y' if free.size == 1 else 'ies'} (hold uz somewhere: a [[fix]], or contact)")
+        return (
+            "a mechanism: the tangent has no stiffness against a rigid translation along z of "
+            f"{free.size} bod{'y' if free.size == 1 else 'ies'} (hold uz somewhere: a [[fix]], or contact)"
+        )
     return None

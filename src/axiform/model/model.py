@@ -6,22 +6,22 @@ of the follower pressure, so it is not symmetric.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import Iterable, Sequence
 
 import numpy as np
 import scipy.sparse as sp
 
+from ..contact.pair import STABILIZATION
 from ..fem.assembly import SolidAssembly
-from ..fem.constraints import BorderedPattern, DofMap, SparsePattern
 from ..fem.cavity import Cavity
+from ..fem.constraints import BorderedPattern, DofMap, SparsePattern
 from ..fem.curves import PROPORTIONAL, Curve
 from ..fem.graphs import connected_components
 from ..fem.loads import FollowerPressure
-from ..fem.mixed import MixedAssembly
 from ..fem.mesh import Mesh
-from ..contact.pair import STABILIZATION
+from ..fem.mixed import MixedAssembly
 from .guards import bodies, free_to_slide
 from .state import CavityState, ModelState
 from .terms import CavityTerm, Constraint, ContactTerm, PointLoadTerm, PressureTerm, SolidTerm
@@ -117,8 +117,9 @@ class Model:
         """Full dof numbers of a named dof ("ur", "uz", "rot") at nodes."""
         return np.asarray(nodes) * self.dpn + DOF_NAMES[name]
 
-    def prescribe(self, nodes: Iterable[int], dofs: Sequence[str], value: float = 0.0,
-                  curve: Curve = PROPORTIONAL) -> None:
+    def prescribe(
+        self, nodes: Iterable[int], dofs: Sequence[str], value: float = 0.0, curve: Curve = PROPORTIONAL
+    ) -> None:
         """Prescribe dofs at nodes to value * f(t) (value 0: fixed; f(t) = t without a curve).
         "rot" is ignored by elements without rotations."""
         for name in dofs:
@@ -176,8 +177,15 @@ class Model:
             self.point_loads.append((int(d), float(value), curve))
         self.dofmap = None
 
-    def cavity(self, edges: np.ndarray, name: str, control: str = "pressure", value: float = 0.0,
-               ambient: float = 0.0, curve: Curve = PROPORTIONAL) -> Cavity:
+    def cavity(
+        self,
+        edges: np.ndarray,
+        name: str,
+        control: str = "pressure",
+        value: float = 0.0,
+        ambient: float = 0.0,
+        curve: Curve = PROPORTIONAL,
+    ) -> Cavity:
         """A gas cavity bounded by boundary edges (axiform.fem.cavity): control "pressure" (value:
         the gauge pressure), "volume" (value: the volume at f = 1) or "gas" (value: the
         content p_abs V at f = 1, ambient: the absolute ambient pressure).  Add the supports
@@ -222,8 +230,7 @@ class Model:
         # one theta per connected body, unless some theta of that body is already held
         cells = self.mesh.cells
         rows = np.repeat(cells[:, 0], cells.shape[1])
-        graph = sp.coo_matrix((np.ones(rows.size), (rows, cells.ravel())),
-                              shape=(self.mesh.n_nodes, self.mesh.n_nodes))
+        graph = sp.coo_matrix((np.ones(rows.size), (rows, cells.ravel())), shape=(self.mesh.n_nodes, self.mesh.n_nodes))
         _, body = connected_components(graph, directed=False)
         held = {body[d // self.dpn] for d in fixed if d % self.dpn == 2}
         for b in np.unique(body[cells[:, 0]]):
@@ -237,14 +244,16 @@ class Model:
         STABILIZATION on the pairs whose slaves lie on a body that no prescribed uz holds
         (held only by contact), none elsewhere."""
         held_uz = [d // self.dpn for d in self.fixed if d % self.dpn == 1]
-        free = set(free_to_slide(self.mesh.n_nodes, self.mesh.cells, np.array(held_uz, np.int64), np.zeros(0, np.int64)))
+        free = set(
+            free_to_slide(self.mesh.n_nodes, self.mesh.cells, np.array(held_uz, np.int64), np.zeros(0, np.int64))
+        )
         body = bodies(self.mesh.n_nodes, self.mesh.cells) if free else None
         for pair in self.contacts:
             if pair.stabilization is None:
                 on_free = free and bool(set(body[pair.nodes].tolist()) & free)
                 pair.stabilization = STABILIZATION if on_free else 0.0
 
-    def finalize(self) -> "Model":
+    def finalize(self) -> Model:
         """Number the equations, make the terms of the residual (model.terms) and build the
         sparse pattern (once)."""
         fixed = dict(self.fixed)
@@ -261,12 +270,16 @@ class Model:
         by_curve: dict[Curve, np.ndarray] = {}  # point loads grouped by curve
         for d, v, c in self.point_loads:
             by_curve.setdefault(c, np.zeros(n))[d] += v
-        self.loads = ([SolidTerm(self.solid, n, self.shift)] + [PressureTerm(p, n) for p in self.pressures]
-                      + ([PointLoadTerm(by_curve, n)] if by_curve else []))
+        self.loads = (
+            [SolidTerm(self.solid, n, self.shift)]
+            + [PressureTerm(p, n) for p in self.pressures]
+            + ([PointLoadTerm(by_curve, n)] if by_curve else [])
+        )
         self.contact_terms = [ContactTerm(pair, self.dpn, n) for pair in self.contacts]
         self.cavity_terms = [CavityTerm(c, n) for c in self.cavities]
-        self.pattern = SparsePattern(self.dofmap, [self.solid.dofs] + [p.dofs for p in self.pressures]
-                                     + [c.dofs for c in self.cavities])
+        self.pattern = SparsePattern(
+            self.dofmap, [self.solid.dofs] + [p.dofs for p in self.pressures] + [c.dofs for c in self.cavities]
+        )
         terms = self.loads + self.contact_terms + self.cavity_terms
         self._positions = {id(term): [self.pattern.positions(b) for b in term.blocks] for term in terms}
         self._point_curves = list(by_curve)
@@ -278,8 +291,9 @@ class Model:
         self._presc_curve = np.array([index[curve_of_eq[k]] for k in range(dm.np)], dtype=np.int64)
         self._unknown = [c for c in self.cavities if c.unknown]  # cavities whose pressure is solved for
         walls = [dm.eq[c.dofs].ravel() for c in self._unknown]  # their constraints' support
-        self._border = BorderedPattern(self.pattern, [np.unique(eq[eq < dm.nf]) for eq in walls],
-                                       [c.control == "gas" for c in self._unknown])
+        self._border = BorderedPattern(
+            self.pattern, [np.unique(eq[eq < dm.nf]) for eq in walls], [c.control == "gas" for c in self._unknown]
+        )
         # round-off floor of the residual from the model's own force scale 2 pi k L R, which
         # is not zero at u = 0 (a state in equilibrium converges whatever the load); k the
         # larger of the shear and bulk moduli: the stresses carry kappa (J - 1), J to round-off
@@ -302,16 +316,24 @@ class Model:
 
     def knots(self) -> np.ndarray:
         """Every time at which some curve of the model changes its slope (sorted)."""
-        curves = ([p.curve for p in self.pressures] + self._point_curves + self._presc_curves
-                  + [c.curve for c in self.cavities] + [getattr(c.surface, "curve", PROPORTIONAL) for c in self.contacts])
+        curves = (
+            [p.curve for p in self.pressures]
+            + self._point_curves
+            + self._presc_curves
+            + [c.curve for c in self.cavities]
+            + [getattr(c.surface, "curve", PROPORTIONAL) for c in self.contacts]
+        )
         return np.unique(np.concatenate([np.empty(0)] + [c.knots() for c in curves]))
 
     def timed(self) -> bool:
         """Whether the load factor is the process time: load curves with knots, moving tools,
         or a law with memory follow it."""
-        return (bool(self.knots().size) or getattr(self.material, "prony", None) is not None
-                or self.conduction is not None
-                or any(np.any(np.asarray(c.surface.motion, float) != 0) for c in self.contacts))
+        return (
+            bool(self.knots().size)
+            or getattr(self.material, "prony", None) is not None
+            or self.conduction is not None
+            or any(np.any(np.asarray(c.surface.motion, float) != 0) for c in self.contacts)
+        )
 
     def prescribed(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         """Values of the prescribed equations at time t and their rates (np,)."""
@@ -322,15 +344,19 @@ class Model:
 
     def cavity_pressures(self, u_f: np.ndarray, t: float) -> list[float]:
         """The gauge pressure of every cavity at the state (u_f, t)."""
-        it = iter(u_f[self.dofmap.nf:])
+        it = iter(u_f[self.dofmap.nf :])
         return [float(next(it)) if c.unknown else c.target(t)[0] for c in self.cavities]
 
     def initial_state(self) -> ModelState:
         """The history before the first step (t = 0): contact pairs untouched, cavities at
         their initial volume and no gauge pressure."""
-        return ModelState(0.0, tuple(pair.initial_state() for pair in self.contacts),
-                          tuple(CavityState(0.0, c.V0) for c in self.cavities), self.loads[0].initial_state(),
-                          None if self.temperature is None else self.temperature.copy())
+        return ModelState(
+            0.0,
+            tuple(pair.initial_state() for pair in self.contacts),
+            tuple(CavityState(0.0, c.V0) for c in self.cavities),
+            self.loads[0].initial_state(),
+            None if self.temperature is None else self.temperature.copy(),
+        )
 
     def restore(self, saved: dict) -> ModelState:
         """The state saved by ModelState.to_dict (a checkpoint), checked against this model."""
@@ -343,10 +369,13 @@ class Model:
         if ("temperature" in saved) != (start.temperature is not None):
             raise ValueError("the saved state has another temperature field than this model")
         temperature = np.asarray(saved["temperature"], float) if "temperature" in saved else None
-        return ModelState(float(saved.get("t", 0.0)),
-                          tuple(s.from_dict(d) for s, d in zip(start.contacts, saved["contacts"])),
-                          tuple(CavityState(float(d["pressure"]), float(d["volume"])) for d in saved["cavities"]),
-                          solid, temperature)
+        return ModelState(
+            float(saved.get("t", 0.0)),
+            tuple(s.from_dict(d) for s, d in zip(start.contacts, saved["contacts"], strict=False)),
+            tuple(CavityState(float(d["pressure"]), float(d["volume"])) for d in saved["cavities"]),
+            solid,
+            temperature,
+        )
 
     # ---- evaluation ------------------------------------------------------------------------
     def expand(self, u_f: np.ndarray, t: float) -> np.ndarray:
@@ -388,8 +417,9 @@ class Model:
                 df -= part.dr_dt
         return f, df
 
-    def evaluate(self, u_f: np.ndarray, t: float, state: ModelState | None = None, tangent: bool = True,
-                 predicting: bool = False) -> Evaluation:
+    def evaluate(
+        self, u_f: np.ndarray, t: float, state: ModelState | None = None, tangent: bool = True, predicting: bool = False
+    ) -> Evaluation:
         """Residual R = f_int - f_ext(t) - f_contact - sum p g (cavities) on the free
         equations, then the cavity constraints; dR/dt; the (bordered) tangent: the sum of the
         terms' contributions (model.terms) at u_f (n_free,) and time t, from the committed
@@ -404,10 +434,12 @@ class Model:
         u = dm.expand(u_f, presc)
         parts = [(self.loads[0], self.loads[0].evaluate(u, t, state.solid, tangent, state.temperature))]
         parts += [(term, term.evaluate(u, t, None, tangent)) for term in self.loads[1:]]
-        parts += [(term, term.evaluate(u, t, held, tangent, predicting))
-                  for term, held in zip(self.contact_terms, state.contacts)]
+        parts += [
+            (term, term.evaluate(u, t, held, tangent, predicting))
+            for term, held in zip(self.contact_terms, state.contacts, strict=False)
+        ]
         constraints = []
-        for term, held, p in zip(self.cavity_terms, state.cavities, self.cavity_pressures(u_f, t)):
+        for term, held, p in zip(self.cavity_terms, state.cavities, self.cavity_pressures(u_f, t), strict=False):
             part, constraint = term.evaluate(u, t, held, tangent, p)
             parts.append((term, part))
             if constraint is not None:
@@ -427,7 +459,7 @@ class Model:
         if tangent:
             data = None
             for term, part in parts:
-                for pos, Ke in zip(self._positions[id(term)], part.K):
+                for pos, Ke in zip(self._positions[id(term)], part.K, strict=False):
                     if Ke is not None:
                         data = self.pattern.accumulate(pos, Ke, data)
             K = self.pattern.free_block(data)
@@ -439,14 +471,25 @@ class Model:
             r, dr_dt, K = self._bordered(r, dr_dt, K, constraints, dpresc)
             constraint_error = float(np.max([abs(c.value) / c.scale for c in constraints]))
         scale = float(np.linalg.norm(parts[0][1].magnitude) + np.linalg.norm(f_ext))
-        trial = ModelState(float(t), tuple(part.trial for term, part in parts if isinstance(term, ContactTerm)),
-                           tuple(part.trial for term, part in parts if isinstance(term, CavityTerm)),
-                           parts[0][1].trial, state.temperature)
-        return Evaluation(r, dr_dt, K, r_full, f_ext, scale, self._noise_floor, nf, constraint_error,
-                          float(np.linalg.norm(u)), trial)
+        trial = ModelState(
+            float(t),
+            tuple(part.trial for term, part in parts if isinstance(term, ContactTerm)),
+            tuple(part.trial for term, part in parts if isinstance(term, CavityTerm)),
+            parts[0][1].trial,
+            state.temperature,
+        )
+        return Evaluation(
+            r, dr_dt, K, r_full, f_ext, scale, self._noise_floor, nf, constraint_error, float(np.linalg.norm(u)), trial
+        )
 
-    def _bordered(self, r: np.ndarray, dr_dt: np.ndarray, K: sp.csr_matrix | None, constraints: list[Constraint],
-                  dpresc: np.ndarray):
+    def _bordered(
+        self,
+        r: np.ndarray,
+        dr_dt: np.ndarray,
+        K: sp.csr_matrix | None,
+        constraints: list[Constraint],
+        dpresc: np.ndarray,
+    ):
         """The system bordered by the constraints of the cavities whose pressure is unknown:
         [[K, -G], [dC/du, dC/dp]], r and dR/dt followed by C and dC/dt."""
         nf = self.dofmap.nf
@@ -454,9 +497,11 @@ class Model:
         G = np.column_stack([g[:nf] for g in g_eq])  # (nf, m)
         C = np.array([c.value for c in constraints])
         # prescribed displacements move the wall: dC/dt += dC/du_p du_p/dt
-        dC_dt = np.array([c.rate + c.c_u * (g[nf:] @ dpresc) for c, g in zip(constraints, g_eq)])
+        dC_dt = np.array([c.rate + c.c_u * (g[nf:] @ dpresc) for c, g in zip(constraints, g_eq, strict=False)])
         if K is not None:
-            K = self._border.matrix(K, G, np.array([c.c_u for c in constraints]), np.array([c.c_p for c in constraints]))
+            K = self._border.matrix(
+                K, G, np.array([c.c_u for c in constraints]), np.array([c.c_p for c in constraints])
+            )
         return np.concatenate([r, C]), np.concatenate([dr_dt, dC_dt]), K
 
 
@@ -472,6 +517,7 @@ def contact_conductance(k: int, gap: float = 0.0):
     (nodes (m,), weighted areas (m,)) for fem.heat.Conductance.  The nodes in contact take it
     whole; with gap > 0 a node at a gap g < gap from the surface takes (1 - g / gap) of it
     (heat across a thin layer of air: the wall cools as it comes, not only once it touches)."""
+
     def in_contact(state: ModelState) -> tuple[np.ndarray, np.ndarray]:
         held = state.contacts[k]
         if held.seen is None:
@@ -482,4 +528,5 @@ def contact_conductance(k: int, gap: float = 0.0):
             share = np.maximum(share, np.clip(1.0 - g / gap, 0.0, 1.0))
         flowing = share > 0
         return held.nodes[flowing], held.seen.a[flowing] * share[flowing]
+
     return in_contact

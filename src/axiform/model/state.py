@@ -40,9 +40,12 @@ class ModelState:
 
     def to_dict(self) -> dict:
         """Plain arrays and numbers (a checkpoint)."""
-        out = {"t": float(self.t), "contacts": [c.to_dict() for c in self.contacts],
-               "cavities": [{"pressure": c.pressure, "volume": c.volume} for c in self.cavities],
-               "solid": {k: np.array(v, copy=True) for k, v in self.solid.items()}}
+        out = {
+            "t": float(self.t),
+            "contacts": [c.to_dict() for c in self.contacts],
+            "cavities": [{"pressure": c.pressure, "volume": c.volume} for c in self.cavities],
+            "solid": {k: np.array(v, copy=True) for k, v in self.solid.items()},
+        }
         if self.temperature is not None:
             out["temperature"] = np.array(self.temperature, copy=True)
         return out

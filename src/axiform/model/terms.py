@@ -32,7 +32,8 @@ from .state import CavityState
 class Contribution:
     """One term at one state: its part r (n_full,) of the residual R, of dR/dt at fixed u
     (n_full,) or None, of the tangent dR/du as element matrices K (one (m, k, k) array per
-    block of the term, or None for a block that adds nothing; empty when not asked), the applied external load it holds (n_full,)
+    block of the term, or None for a block that adds nothing; empty when not asked), the applied external load it
+    holds (n_full,)
     or None, the assembled magnitudes of its element forces (n_full,) or None (the scale
     of the residual), and its trial state."""
 
@@ -81,8 +82,14 @@ class SolidTerm:
             return {}
         return prony.initial(self.assembly.dV.shape) | {"t": np.zeros(())}
 
-    def evaluate(self, u: np.ndarray, t: float, state: dict | None = None, tangent: bool = True,
-                 temperature: np.ndarray | None = None) -> Contribution:
+    def evaluate(
+        self,
+        u: np.ndarray,
+        t: float,
+        state: dict | None = None,
+        tangent: bool = True,
+        temperature: np.ndarray | None = None,
+    ) -> Contribution:
         """state: the solid's history per point (or None); temperature: the nodes' T (n,) or None."""
         if tangent not in self._scratch:
             self._scratch[tangent] = self.assembly.buffers(tangent)
@@ -98,8 +105,12 @@ class SolidTerm:
         fe, Ke = self.assembly.evaluate(u, tangent, self._scratch[tangent], memory, T)
         dofs = self.assembly.dofs
         trial = {} if memory is None else memory.trial | {"t": np.asarray(float(t))}
-        return Contribution(assemble(dofs, fe, self.n_full), K=(Ke,) if tangent else (),
-                            magnitude=assemble(dofs, np.abs(fe), self.n_full), trial=trial)
+        return Contribution(
+            assemble(dofs, fe, self.n_full),
+            K=(Ke,) if tangent else (),
+            magnitude=assemble(dofs, np.abs(fe), self.n_full),
+            trial=trial,
+        )
 
     def step_factors(self, dt: float, temperature_key: bytes | None) -> tuple[np.ndarray, ...]:
         """The Prony factors of a step dt (each point's reduced time dt / a_T under a shift, at
@@ -167,8 +178,9 @@ class ContactTerm:
         self.guard_dofs = pair.guard_dofs(dpn) if pair.guarded else None  # (m, 2 dpn)
         self.blocks = (self.node_dofs, pair.edge_dofs(dpn)) + ((self.guard_dofs,) if pair.guarded else ())
 
-    def evaluate(self, u: np.ndarray, t: float, state: ContactState, tangent: bool = True,
-                 predicting: bool = False) -> Contribution:
+    def evaluate(
+        self, u: np.ndarray, t: float, state: ContactState, tangent: bool = True, predicting: bool = False
+    ) -> Contribution:
         pair = self.pair
         velocity = pair.surface.velocity(t)
         moving = bool(velocity.any())
@@ -220,8 +232,14 @@ class CavityTerm:
         self.n_full = n_full
         self.blocks = (cavity.dofs,)
 
-    def evaluate(self, u: np.ndarray, t: float, state: CavityState | None = None, tangent: bool = True,
-                 pressure: float | None = None) -> tuple[Contribution, Constraint | None]:
+    def evaluate(
+        self,
+        u: np.ndarray,
+        t: float,
+        state: CavityState | None = None,
+        tangent: bool = True,
+        pressure: float | None = None,
+    ) -> tuple[Contribution, Constraint | None]:
         cav = self.cavity
         p = cav.target(t)[0] if pressure is None else pressure
         V, ge, He = cav.evaluate(u, tangent)

@@ -21,8 +21,15 @@ from .section_plot import finish_axes
 # them, the normal ticks along a mould and their spacing
 ARROW, ARROW_GAP = 0.045, 0.035
 TICK, TICK_SPACING = 0.02, 0.03
-COLOURS = {"mesh": "0.55", "held": "tab:blue", "prescribed": "tab:purple", "pressure": "tab:orange",
-           "point": "tab:pink", "cavity": "tab:cyan", "monitor": "tab:green"}
+COLOURS = {
+    "mesh": "0.55",
+    "held": "tab:blue",
+    "prescribed": "tab:purple",
+    "pressure": "tab:orange",
+    "point": "tab:pink",
+    "cavity": "tab:cyan",
+    "monitor": "tab:green",
+}
 MOULD_COLOURS = ["tab:red", "tab:brown", "tab:olive", "tab:gray", "firebrick", "darkgoldenrod"]
 
 
@@ -37,8 +44,10 @@ def _is_thin(x: np.ndarray, cells: np.ndarray, extent: float) -> bool:
     """True when the typical cell is thinner than about 2 pixels of the drawing (its area over
     its longest side below 0.4 % of the drawing's size): its edges are then drawn wide."""
     c = x[cells[:, :4]]
-    area = 0.5 * np.abs(np.einsum("ei,ei->e", c[..., 0], np.roll(c[..., 1], -1, axis=1))
-                        - np.einsum("ei,ei->e", c[..., 1], np.roll(c[..., 0], -1, axis=1)))
+    area = 0.5 * np.abs(
+        np.einsum("ei,ei->e", c[..., 0], np.roll(c[..., 1], -1, axis=1))
+        - np.einsum("ei,ei->e", c[..., 1], np.roll(c[..., 0], -1, axis=1))
+    )
     longest = np.linalg.norm(c - np.roll(c, -1, axis=1), axis=-1).max(axis=1)
     return bool(np.median(area / longest) < 4e-3 * extent)
 
@@ -176,9 +185,15 @@ def _draw_mesh(ax, mesh, size: float) -> None:
 
     X = mesh.points
     thin = _is_thin(X, mesh.cells, size)
-    ax.add_collection(PolyCollection(X[_outline(mesh)], facecolor="0.85" if thin else "0.93",
-                                     edgecolor="0.4" if thin else COLOURS["mesh"], lw=1.2 if thin else 0.3,
-                                     label=f"mesh: {mesh.n_cells} {mesh.element.name} cells, {mesh.n_nodes} nodes"))
+    ax.add_collection(
+        PolyCollection(
+            X[_outline(mesh)],
+            facecolor="0.85" if thin else "0.93",
+            edgecolor="0.4" if thin else COLOURS["mesh"],
+            lw=1.2 if thin else 0.3,
+            label=f"mesh: {mesh.n_cells} {mesh.element.name} cells, {mesh.n_nodes} nodes",
+        )
+    )
 
 
 def _draw_supports(ax, model) -> None:
@@ -195,12 +210,28 @@ def _draw_supports(ax, model) -> None:
     for (r, z), marker, label in kinds:
         nodes = np.flatnonzero((held[:, 0] == r) & (held[:, 1] == z) & ~moved)
         if nodes.size:
-            ax.plot(X[nodes, 0], X[nodes, 1], marker, ls="none", ms=4.5, mfc="none", mec=COLOURS["held"],
-                    label=label + (" (and the fibre rotation)" if held[nodes, 2].all() and model.dpn == 3 else ""))
+            ax.plot(
+                X[nodes, 0],
+                X[nodes, 1],
+                marker,
+                ls="none",
+                ms=4.5,
+                mfc="none",
+                mec=COLOURS["held"],
+                label=label + (" (and the fibre rotation)" if held[nodes, 2].all() and model.dpn == 3 else ""),
+            )
     nodes = np.flatnonzero(moved)
     if nodes.size:
-        ax.plot(X[nodes, 0], X[nodes, 1], "D", ls="none", ms=4.5, mfc="none", mec=COLOURS["prescribed"],
-                label="displacement prescribed")
+        ax.plot(
+            X[nodes, 0],
+            X[nodes, 1],
+            "D",
+            ls="none",
+            ms=4.5,
+            mfc="none",
+            mec=COLOURS["prescribed"],
+            label="displacement prescribed",
+        )
 
 
 def _draw_pressures(ax, case, model, size: float, units: dict[str, str]) -> None:
@@ -210,7 +241,7 @@ def _draw_pressures(ax, case, model, size: float, units: dict[str, str]) -> None
 
     X = model.mesh.points
     arrow = ARROW * size
-    for i, (spec, p) in enumerate(zip(case.pressure, model.pressures)):
+    for i, (spec, p) in enumerate(zip(case.pressure, model.pressures, strict=False)):
         a, b = X[p.nodes[:, 0]], X[p.nodes[:, 1]]
         ax.add_collection(LineCollection(_face(X, p.nodes), colors=COLOURS["pressure"], lw=2.0))
         mid = X[p.nodes[:, 2]] if p.nodes.shape[1] == 3 else 0.5 * (a + b)
@@ -219,9 +250,20 @@ def _draw_pressures(ax, case, model, size: float, units: dict[str, str]) -> None
         push = -np.sign(spec.value or 1.0) * out
         k = _spaced(mid, ARROW_GAP * size)
         tail = mid[k] - push[k] * arrow if spec.value >= 0 else mid[k]
-        ax.quiver(tail[:, 0], tail[:, 1], push[k, 0] * arrow, push[k, 1] * arrow, angles="xy", scale_units="xy",
-                  scale=1.0, color=COLOURS["pressure"], width=0.004, headwidth=4, headlength=5,
-                  label=f"pressure[{i}] = {_value(spec.value, 'pressure', units)}{_times(spec.curve)}")
+        ax.quiver(
+            tail[:, 0],
+            tail[:, 1],
+            push[k, 0] * arrow,
+            push[k, 1] * arrow,
+            angles="xy",
+            scale_units="xy",
+            scale=1.0,
+            color=COLOURS["pressure"],
+            width=0.004,
+            headwidth=4,
+            headlength=5,
+            label=f"pressure[{i}] = {_value(spec.value, 'pressure', units)}{_times(spec.curve)}",
+        )
 
 
 def _draw_point_loads(ax, case, mesh, size: float, units: dict[str, str]) -> None:
@@ -234,9 +276,18 @@ def _draw_point_loads(ax, case, mesh, size: float, units: dict[str, str]) -> Non
         nodes = select_nodes(mesh, spec.at.model_dump(), f"point_load[{i}].at")
         e = np.array([1.0, 0.0]) if spec.dof == "ur" else np.array([0.0, 1.0])
         d = np.sign(spec.value) * e * arrow
-        ax.quiver(X[nodes, 0] - d[0], X[nodes, 1] - d[1], np.full(len(nodes), d[0]), np.full(len(nodes), d[1]),
-                  angles="xy", scale_units="xy", scale=1.0, color=COLOURS["point"], width=0.005,
-                  label=f"point_load[{i}] = {_value(spec.value, 'force', units)}{_times(spec.curve)} along {spec.dof}")
+        ax.quiver(
+            X[nodes, 0] - d[0],
+            X[nodes, 1] - d[1],
+            np.full(len(nodes), d[0]),
+            np.full(len(nodes), d[1]),
+            angles="xy",
+            scale_units="xy",
+            scale=1.0,
+            color=COLOURS["point"],
+            width=0.005,
+            label=f"point_load[{i}] = {_value(spec.value, 'force', units)}{_times(spec.curve)} along {spec.dof}",
+        )
 
 
 def _draw_cavities(ax, case, model) -> None:
@@ -244,9 +295,16 @@ def _draw_cavities(ax, case, model) -> None:
     from matplotlib.collections import LineCollection
 
     X = model.mesh.points
-    for spec, cav in zip(case.cavity, model.cavities):
-        ax.add_collection(LineCollection(_face(X, cav.nodes), colors=COLOURS["cavity"], lw=3.5, alpha=0.8,
-                                         label=f'cavity "{spec.name}" ({spec.control} control)'))
+    for spec, cav in zip(case.cavity, model.cavities, strict=False):
+        ax.add_collection(
+            LineCollection(
+                _face(X, cav.nodes),
+                colors=COLOURS["cavity"],
+                lw=3.5,
+                alpha=0.8,
+                label=f'cavity "{spec.name}" ({spec.control} control)',
+            )
+        )
 
 
 def _draw_moulds(ax, model, moulds, size: float, t_end: float) -> None:
@@ -254,7 +312,7 @@ def _draw_moulds(ax, model, moulds, size: float, t_end: float) -> None:
     run (dotted)."""
     from matplotlib.collections import LineCollection
 
-    for i, (pair, (pts, end, _)) in enumerate(zip(model.contacts, moulds)):
+    for i, (pair, (pts, end, _)) in enumerate(zip(model.contacts, moulds, strict=False)):
         colour = MOULD_COLOURS[i % len(MOULD_COLOURS)]
         name = f"contact[{i}]" + (f" {pair.name}" if pair.name else "")
         ax.plot(pts[:, 0], pts[:, 1], "-", color=colour, lw=1.8, label=f"{name}, ticks towards its body")
@@ -276,11 +334,19 @@ def _draw_monitors(ax, case, built) -> None:
         nodes = np.unique(monitor.dofs // model.dpn)
         marker = "*" if m.at is not None else "x"
         what = "monitor" if m.at is not None else "reaction monitor"
-        ax.plot(X[nodes, 0], X[nodes, 1], marker, ls="none", ms=10 if marker == "*" else 6, color=COLOURS["monitor"],
-                label=f"{what} {m.name} ({m.dof})")
+        ax.plot(
+            X[nodes, 0],
+            X[nodes, 1],
+            marker,
+            ls="none",
+            ms=10 if marker == "*" else 6,
+            color=COLOURS["monitor"],
+            label=f"{what} {m.name} ({m.dof})",
+        )
         if m.at is not None:
-            ax.annotate(m.name, X[nodes[0]], xytext=(5, 5), textcoords="offset points", fontsize=7,
-                        color=COLOURS["monitor"])
+            ax.annotate(
+                m.name, X[nodes[0]], xytext=(5, 5), textcoords="offset points", fontsize=7, color=COLOURS["monitor"]
+            )
 
 
 def plot_check(built, path: str | Path) -> Path:

@@ -23,7 +23,8 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
     """Nodal fields (n,) or (n, k) of the state u_full (all dofs) with the committed history
     `state` (model.state.ModelState; None: the initial one): displacement (ur, uz, 0),
     J, cauchy_stress (rr, zz, tt, rz), von_mises, principal_stretches (in-plane major, minor,
-    hoop), hydrostatic_pressure (-tr sigma / 3); fibre_rotation (SFR); temperature (with one); thickness (meshes with fibres); contact_pressure and
+    hoop), hydrostatic_pressure (-tr sigma / 3); fibre_rotation (SFR); temperature (with one); thickness (meshes
+    with fibres); contact_pressure and
     first_contact (the time a slave node first touched, -1 where never) with contact, and
     first_contact_K per piece K where several record it."""
     mesh = model.mesh
@@ -73,7 +74,7 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
     if model.contacts:
         history = (state or model.initial_state()).contacts
         pressure = np.zeros(mesh.n_nodes)
-        for pair, held in zip(model.contacts, history):
+        for pair, held in zip(model.contacts, history, strict=False):
             rep = pair.report(held)
             pressure[rep["node"]] += rep["pressure"]
         out["contact_pressure"] = pressure
@@ -92,4 +93,6 @@ def with_components(data: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     if "cauchy_stress" not in data:
         return data
     sig = data["cauchy_stress"]
-    return data | {f"cauchy_stress_{c}": np.ascontiguousarray(sig[:, k]) for k, c in enumerate(("rr", "zz", "tt", "rz"))}
+    return data | {
+        f"cauchy_stress_{c}": np.ascontiguousarray(sig[:, k]) for k, c in enumerate(("rr", "zz", "tt", "rz"))
+    }

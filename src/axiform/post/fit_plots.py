@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -13,8 +14,9 @@ if TYPE_CHECKING:
     from ..app.fit import Data, FitResult
 
 
-def plot_fit(result: FitResult, data: Data, mode: str, path: Path, modes: tuple[str, ...],
-             stress: Callable[..., np.ndarray]) -> None:
+def plot_fit(
+    result: FitResult, data: Data, mode: str, path: Path, modes: tuple[str, ...], stress: Callable[..., np.ndarray]
+) -> None:
     """Data as markers, the model as a line, for one mode.  modes: the modes data.mode
     indexes (axiform.app.fit.MODES); stress(law, mode, stretches): the law's nominal stress
     in the loading direction (axiform.app.fit.nominal_stress) - passed in: post/ does not

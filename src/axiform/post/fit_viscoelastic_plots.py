@@ -101,8 +101,13 @@ def plot_wlf(T: np.ndarray, log_shift: np.ndarray, fit: WLFFit, path: Path) -> N
     grid = np.linspace(lo, T.max() + pad, 400)
     ax.plot(T, log_shift, "o", mfc="none", color=DATA, label="data")
     shifted = f"\n+ {fit.offset:.4g} (the data's log10 a_T at T_ref)" if fit.offset else ""
-    ax.plot(grid, wlf_shift(grid, fit.C1, fit.C2, fit.reference) + fit.offset, "-", color=FIT,
-            label=f"WLF: C1 = {fit.C1:.4g}, C2 = {fit.C2:.4g}{shifted}")
+    ax.plot(
+        grid,
+        wlf_shift(grid, fit.C1, fit.C2, fit.reference) + fit.offset,
+        "-",
+        color=FIT,
+        label=f"WLF: C1 = {fit.C1:.4g}, C2 = {fit.C2:.4g}{shifted}",
+    )
     ax.axvline(fit.reference, color="0.6", ls="--", lw=0.9, label=f"T_ref = {fit.reference:.5g}")
     ax.axhline(0.0, color="0.8", lw=0.8)
     ax.set_ylabel("log10 a_T")

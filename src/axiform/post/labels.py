@@ -25,31 +25,43 @@ from typing import Any
 
 import numpy as np
 
-QUANTITY_UNIT = {"pressure": "pressure", "stress": "pressure", "force": "force", "displacement": "length",
-                 "length": "length", "time": "time", "temperature": "temperature"}  # quantity -> key of [units]
+QUANTITY_UNIT = {
+    "pressure": "pressure",
+    "stress": "pressure",
+    "force": "force",
+    "displacement": "length",
+    "length": "length",
+    "time": "time",
+    "temperature": "temperature",
+}  # quantity -> key of [units]
 
 
 def case_labels(case: Any) -> dict[str, Any]:
     """units, load, monitor_quantities, applied, process and real_time of a validated case
     (axiform.case.schema.Case)."""
     applied = applied_quantities(case)
-    return {"units": {k: v for k, v in case.units.model_dump().items() if v},
-            "load": loaded_quantity(case),
-            "monitor_quantities": {m.name: monitor_quantity(m) for m in case.monitor},
-            "applied": applied, "process": is_process(applied, getattr(case, "cavity", [])),
-            "real_time": time_is_real(case)}
+    return {
+        "units": {k: v for k, v in case.units.model_dump().items() if v},
+        "load": loaded_quantity(case),
+        "monitor_quantities": {m.name: monitor_quantity(m) for m in case.monitor},
+        "applied": applied,
+        "process": is_process(applied, getattr(case, "cavity", [])),
+        "real_time": time_is_real(case),
+    }
 
 
 def time_is_real(case: Any) -> bool:
     """Whether the load factor of a validated case is a physical time (its result depends on
     how fast the loads come): a material with a Prony series (`[material] viscoelastic`), or
     heat conduction (`[thermal]`)."""
-    return (getattr(getattr(case, "material", None), "viscoelastic", None) is not None
-            or getattr(case, "thermal", None) is not None)
+    return (
+        getattr(getattr(case, "material", None), "viscoelastic", None) is not None
+        or getattr(case, "thermal", None) is not None
+    )
 
 
 def monitor_quantity(m: Any) -> str:
-    """"displacement", "rotation", "force", "area", "pressure", "volume" or "temperature" of a
+    """ "displacement", "rotation", "force", "area", "pressure", "volume" or "temperature" of a
     monitor spec."""
     if getattr(m, "quantity", None) == "temperature":
         return "temperature"
@@ -121,8 +133,13 @@ def applied_quantities(case: Any) -> list[dict[str, Any]]:
         elif c.control == "volume":
             out.append({**_scaled("volume", c.volume, f"{c.name} volume", _curve(c)), "cavity": c.name})
         elif c.control == "gas":
-            out.append({**_scaled("content", c.content, f"{c.name} gas content p·V", _curve(c)), "cavity": c.name,
-                        "ambient": float(c.ambient)})
+            out.append(
+                {
+                    **_scaled("content", c.content, f"{c.name} gas content p·V", _curve(c)),
+                    "cavity": c.name,
+                    "ambient": float(c.ambient),
+                }
+            )
     for kind, specs in (("pressure", case.pressure), ("force", case.point_load)):
         seen = []
         for k, p in enumerate(specs):

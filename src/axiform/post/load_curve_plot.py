@@ -69,8 +69,11 @@ def _process_panels(h, info: FolderInfo) -> list[Panel]:
     from t = 0."""
     t = np.r_[0.0, _time(h)]
     xlabel = info.time_label()
-    panels = [Panel(t, info.applied_values(a, t), xlabel, with_unit(a["name"], a["quantity"], info.units), "C1")
-              for a in info.applied if "cavity" not in a or a["cavity"] in info.cavities]
+    panels = [
+        Panel(t, info.applied_values(a, t), xlabel, with_unit(a["name"], a["quantity"], info.units), "C1")
+        for a in info.applied
+        if "cavity" not in a or a["cavity"] in info.cavities
+    ]
     own = (info.load or {}).get("monitor")
     for name in ([own] if own in h else []) + _monitors(h, info):
         panels.append(Panel(_time(h), h[name], xlabel, _label(name, info)))
@@ -121,8 +124,9 @@ def _alone_panels(h, info: FolderInfo) -> list[Panel]:
     lam = _time(h)
     for a in info.applied:
         if a.get("quantity") == "volume" and a.get("cavity") in info.cavities and info.load.get("monitor"):
-            return [Panel(info.applied_values(a, lam), load, with_unit(a["name"], "volume", info.units),
-                          info.load_label())]
+            return [
+                Panel(info.applied_values(a, lam), load, with_unit(a["name"], "volume", info.units), info.load_label())
+            ]
     if info.load.get("monitor") is None:
         lam, load = np.r_[0.0, lam], np.r_[float(load_values(info.load, np.zeros(1))[0]), load]
     return [Panel(lam, load, info.time_label(), info.load_label())]
@@ -166,7 +170,7 @@ def load_curve_figure(history: Path, info: FolderInfo):
     nrows = -(-n // ncols)
     fig = new_figure((4.6 * ncols, 3.6 * nrows + 0.5 + 0.3 * bool(dropped)))
     axes = fig.subplots(nrows, ncols, squeeze=False, sharex=timed)
-    for ax, p in zip(axes.flat, panels):
+    for ax, p in zip(axes.flat, panels, strict=False):
         ax.plot(p.x, p.y, "o-", ms=2.5, lw=1.2, color=p.colour)
         for t in knots:
             ax.axvline(t, color="0.55", ls=":", lw=1.0, zorder=0)
@@ -180,7 +184,9 @@ def load_curve_figure(history: Path, info: FolderInfo):
         ax.set_visible(False)
     text = info.title or "load curve"
     if any(p.colour == "C1" for p in panels):
-        legend = "orange: applied, by the case's curves; blue: results" + ("; dotted: the curves' knots" if knots else "")
+        legend = "orange: applied, by the case's curves; blue: results" + (
+            "; dotted: the curves' knots" if knots else ""
+        )
         text += f"\n({legend})"
     if dropped:
         text += f"\n({', '.join(dropped)} follows {info.load['name']}: not drawn)"

@@ -17,8 +17,9 @@ if TYPE_CHECKING:
 GREY, BLUE = "0.55", "C0"
 
 
-def plot_optimization(path: Path, design: ThicknessDesign, result: OptimizeResult,
-                      target: tuple[np.ndarray, np.ndarray]) -> None:
+def plot_optimization(
+    path: Path, design: ThicknessDesign, result: OptimizeResult, target: tuple[np.ndarray, np.ndarray]
+) -> None:
     """optimize.png: the section (initial parison filled, optimized parison outlined, their
     final mid-surfaces and the moulds), the initial and optimized wall straightened (faces at
     +-t/2 about the mid-surface against s, the same way), the final thickness of both against
@@ -51,7 +52,9 @@ def _section(ax, design, result, runs, length: str) -> None:
         a, b = model.mesh.points[f[:, 0]], model.mesh.points[f[:, -1]]
         ring = np.vstack([a, b[::-1], a[:1]])
         if it is result.initial:
-            ax.fill(ring[:, 0], ring[:, 1], color=colour, alpha=0.5, lw=0, label="parison" if same else f"{name} parison")
+            ax.fill(
+                ring[:, 0], ring[:, 1], color=colour, alpha=0.5, lw=0, label="parison" if same else f"{name} parison"
+            )
         elif not same:
             ax.plot(ring[:, 0], ring[:, 1], "-", color=colour, lw=0.9, label=f"{name} parison")
         if it.thickness is not None:
@@ -117,8 +120,9 @@ def _final_thickness(ax, design, result, runs, target, length: str) -> None:
     ax.set_ylim(0, 1.1 * max(top))
     ax.set_xlabel("reference arc length s" + length)
     ax.set_ylabel("final thickness" + length)
-    ax.set_title(f"final wall: max deviation {100 * result.initial.deviation:.3g} % -> "
-                 f"{100 * result.best.deviation:.3g} %")
+    ax.set_title(
+        f"final wall: max deviation {100 * result.initial.deviation:.3g} % -> {100 * result.best.deviation:.3g} %"
+    )
     ax.legend(fontsize=8)
 
 

@@ -11,9 +11,9 @@ and keeps their names importable from one place.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import partial
 from pathlib import Path
-from typing import Callable
 
 from .figures import DPI
 from .load_curve_plot import load_curve_figure, load_curve_reason, plot_load_curves
@@ -21,9 +21,28 @@ from .results_folder import FieldError, FolderInfo, last_vtu, read_history, surf
 from .section_plot import COMPONENTS, FIELD_NAMES, animate, deformed_figure, field_values, plot_deformed
 from .thickness_plot import plot_thickness, thickness_figure
 
-__all__ = ["COMPONENTS", "DPI", "FIELD_NAMES", "FieldError", "FolderInfo", "Plots", "animate", "deformed_figure",
-           "field_values", "last_vtu", "load_curve_figure", "missing_plots", "plot_deformed", "plot_folder",
-           "plot_jobs", "plot_load_curves", "plot_thickness", "read_history", "thickness_figure", "written_steps"]
+__all__ = [
+    "COMPONENTS",
+    "DPI",
+    "FIELD_NAMES",
+    "FieldError",
+    "FolderInfo",
+    "Plots",
+    "animate",
+    "deformed_figure",
+    "field_values",
+    "last_vtu",
+    "load_curve_figure",
+    "missing_plots",
+    "plot_deformed",
+    "plot_folder",
+    "plot_jobs",
+    "plot_load_curves",
+    "plot_thickness",
+    "read_history",
+    "thickness_figure",
+    "written_steps",
+]
 
 
 class Plots(list):
@@ -66,12 +85,15 @@ def missing_plots(folder: str | Path, made: list[Path] = ()) -> dict[str, str]:
     missing = {}
     if "load_curve.png" not in names:
         history = folder / "history.csv"
-        missing["load_curve.png"] = (load_curve_reason(history, FolderInfo.read(folder)) if history.exists()
-                                     else "no history.csv") or "nothing to draw"
+        missing["load_curve.png"] = (
+            load_curve_reason(history, FolderInfo.read(folder)) if history.exists() else "no history.csv"
+        ) or "nothing to draw"
     if "thickness.png" not in names:
-        missing["thickness.png"] = ("thickness.csv has no station" if (folder / "thickness.csv").exists() else
-                                    "no thickness.csv: the mesh has no through-thickness fibres (a rectangle or "
-                                    "a layered mesh has them)")
+        missing["thickness.png"] = (
+            "thickness.csv has no station"
+            if (folder / "thickness.csv").exists()
+            else "no thickness.csv: the mesh has no through-thickness fibres (a rectangle or a layered mesh has them)"
+        )
     if "deformed.png" not in names:
         missing["deformed.png"] = "no field output (output.vtu = false)"
     return missing

@@ -6,7 +6,8 @@ from __future__ import annotations
 
 import csv
 import json
-from dataclasses import dataclass, field as dc_field
+from dataclasses import dataclass
+from dataclasses import field as dc_field
 from pathlib import Path
 from typing import Any
 from xml.etree import ElementTree as ET
@@ -39,15 +40,23 @@ class FolderInfo:
     real_time: bool = False  # the load factor is a physical time (labels.time_is_real)
 
     @classmethod
-    def read(cls, folder: Path) -> "FolderInfo":
+    def read(cls, folder: Path) -> FolderInfo:
         path = Path(folder) / "summary.json"
         if not path.exists():
             return cls()
         s = json.loads(path.read_text())
         contacts = [c.get("name", f"contact[{k}]") for k, c in enumerate(s.get("contact") or [])]
-        return cls(s.get("title", ""), s.get("units") or {}, s.get("load"), s.get("monitor_quantities") or {},
-                   contacts, s.get("applied") or [], bool(s.get("process")), s.get("cavities") or {},
-                   bool(s.get("real_time")))
+        return cls(
+            s.get("title", ""),
+            s.get("units") or {},
+            s.get("load"),
+            s.get("monitor_quantities") or {},
+            contacts,
+            s.get("applied") or [],
+            bool(s.get("process")),
+            s.get("cavities") or {},
+            bool(s.get("real_time")),
+        )
 
     @property
     def timed(self) -> bool:

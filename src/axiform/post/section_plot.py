@@ -11,19 +11,29 @@ from .figures import colormap, new_figure, save, title, wrapped
 from .labels import with_unit
 from .results_folder import FieldError, FolderInfo, read_history, surfaces_of, written_steps
 
-FIELD_NAMES = {"von_mises": ("von Mises stress", "stress"), "J": ("J = det F", ""),
-               "cauchy_stress": ("Cauchy stress", "stress"), "principal_stretches": ("principal stretch", ""),
-               "displacement": ("displacement", "length"), "thickness": ("thickness", "length"),
-               "contact_pressure": ("contact pressure", "pressure"), "fibre_rotation": ("fibre rotation", "rotation"),
-               "first_contact": ("time of first contact", "time"), "temperature": ("temperature", "temperature"),
-               "pressure": ("hydrostatic pressure −tr σ / 3", "stress"),
-               "hydrostatic_pressure": ("hydrostatic pressure −tr σ / 3", "stress"),
-               # the components the VTU files hold besides as scalars (fields.with_components)
-               **{f"cauchy_stress_{c}": (f"Cauchy stress {c}", "stress") for c in ("rr", "zz", "tt", "rz")}}
+FIELD_NAMES = {
+    "von_mises": ("von Mises stress", "stress"),
+    "J": ("J = det F", ""),
+    "cauchy_stress": ("Cauchy stress", "stress"),
+    "principal_stretches": ("principal stretch", ""),
+    "displacement": ("displacement", "length"),
+    "thickness": ("thickness", "length"),
+    "contact_pressure": ("contact pressure", "pressure"),
+    "fibre_rotation": ("fibre rotation", "rotation"),
+    "first_contact": ("time of first contact", "time"),
+    "temperature": ("temperature", "temperature"),
+    "pressure": ("hydrostatic pressure −tr σ / 3", "stress"),
+    "hydrostatic_pressure": ("hydrostatic pressure −tr σ / 3", "stress"),
+    # the components the VTU files hold besides as scalars (fields.with_components)
+    **{f"cauchy_stress_{c}": (f"Cauchy stress {c}", "stress") for c in ("rr", "zz", "tt", "rz")},
+}
 # the same field under an older or a newer name: either is accepted for the other
 ALIASES = {"pressure": "hydrostatic_pressure", "hydrostatic_pressure": "pressure"}
-COMPONENTS = {"displacement": ("ur", "uz"), "cauchy_stress": ("rr", "zz", "tt", "rz"),
-              "principal_stretches": ("major", "minor", "hoop")}
+COMPONENTS = {
+    "displacement": ("ur", "uz"),
+    "cauchy_stress": ("rr", "zz", "tt", "rz"),
+    "principal_stretches": ("major", "minor", "hoop"),
+}
 
 
 def field_values(point_data: dict[str, np.ndarray], spec: str, units: dict[str, str]) -> tuple[np.ndarray, str]:
@@ -80,8 +90,10 @@ def _is_thin(x: np.ndarray, cells: np.ndarray, extent: float) -> bool:
     """True when the typical cell is thinner than about 2 pixels of the drawing: its area
     over its longest side below 0.4 % of the part's extent."""
     c = x[cells[:, :4]]
-    area = 0.5 * np.abs(np.einsum("ei,ei->e", c[..., 0], np.roll(c[..., 1], -1, axis=1))
-                        - np.einsum("ei,ei->e", c[..., 1], np.roll(c[..., 0], -1, axis=1)))
+    area = 0.5 * np.abs(
+        np.einsum("ei,ei->e", c[..., 0], np.roll(c[..., 1], -1, axis=1))
+        - np.einsum("ei,ei->e", c[..., 1], np.roll(c[..., 0], -1, axis=1))
+    )
     longest = np.linalg.norm(c - np.roll(c, -1, axis=1), axis=-1).max(axis=1)
     return bool(np.median(area / longest) < 4e-3 * extent)
 
@@ -129,12 +141,14 @@ def _draw(ax, X, x, outline, cell_values, norm, cmap, moulds, thin: bool) -> Non
     cells get a wide edge of their own colour, so that the colour shows), the moulds in red."""
     from matplotlib.collections import PolyCollection
 
-    ax.add_collection(PolyCollection(X[outline], facecolor="0.85" if thin else "none", edgecolor="0.75",
-                                     lw=1.5 if thin else 0.4))
+    ax.add_collection(
+        PolyCollection(X[outline], facecolor="0.85" if thin else "none", edgecolor="0.75", lw=1.5 if thin else 0.4)
+    )
     colours = cmap(norm(cell_values))
     colours[~np.isfinite(cell_values)] = (0.8, 0.8, 0.8, 1.0)
-    ax.add_collection(PolyCollection(x[outline], facecolors=colours, edgecolors=colours if thin else "k",
-                                     lw=3.0 if thin else 0.2))
+    ax.add_collection(
+        PolyCollection(x[outline], facecolors=colours, edgecolors=colours if thin else "k", lw=3.0 if thin else 0.2)
+    )
     for pts in moulds:
         ax.plot(pts[:, 0], pts[:, 1], "-", color="tab:red", lw=1.5)
 
@@ -152,15 +166,25 @@ def finish_axes(ax, lo, hi, units) -> None:
 def _colourbar(fig, ax, norm, cmap, label, beside):
     from matplotlib.cm import ScalarMappable
 
-    bar = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, label=label,
-                       orientation="vertical" if beside else "horizontal", shrink=0.9 if beside else 0.7)
+    bar = fig.colorbar(
+        ScalarMappable(norm=norm, cmap=cmap),
+        ax=ax,
+        label=label,
+        orientation="vertical" if beside else "horizontal",
+        shrink=0.9 if beside else 0.7,
+    )
     bar.formatter.set_useOffset(False)
     bar.update_ticks()
     return bar
 
 
-def deformed_figure(vtu: Path, info: FolderInfo, field: str = "von_mises", surfaces: Path | None = None,
-                    history: dict[str, np.ndarray] | None = None):
+def deformed_figure(
+    vtu: Path,
+    info: FolderInfo,
+    field: str = "von_mises",
+    surfaces: Path | None = None,
+    history: dict[str, np.ndarray] | None = None,
+):
     """The deformed meridian section over the initial one (grey), coloured by a nodal field
     (field_values), with the moulds (red); framed on the part with a margin."""
     X, x, cells, outline, data = _section(vtu)
@@ -185,8 +209,14 @@ def deformed_figure(vtu: Path, info: FolderInfo, field: str = "von_mises", surfa
     return fig
 
 
-def plot_deformed(vtu: Path, out: Path, field: str = "von_mises", surfaces: Path | None = None,
-                  info: FolderInfo | None = None, history: dict[str, np.ndarray] | None = None) -> Path | None:
+def plot_deformed(
+    vtu: Path,
+    out: Path,
+    field: str = "von_mises",
+    surfaces: Path | None = None,
+    info: FolderInfo | None = None,
+    history: dict[str, np.ndarray] | None = None,
+) -> Path | None:
     """deformed.png of one VTU file."""
     return save(deformed_figure(vtu, info or FolderInfo(), field, surfaces, history), out)
 
@@ -218,7 +248,7 @@ def animate(folder: Path, out: Path, info: FolderInfo | None = None, fps: float 
     _colourbar(fig, ax, norm, cmap, values[0][1], beside)
     writer = PillowWriter(fps=fps)
     with writer.saving(fig, out, dpi=80):
-        for f, (X, x, cells, outline, _), (v, _), mould in zip(files, frames, values, moulds):
+        for f, (X, x, cells, outline, _), (v, _), mould in zip(files, frames, values, moulds, strict=False):
             ax.clear()
             _draw(ax, X, x, outline, v[cells].mean(axis=1), norm, cmap, mould, thin)
             finish_axes(ax, lo, hi, info.units)

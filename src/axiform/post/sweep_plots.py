@@ -88,7 +88,7 @@ def sweep_points(sweep: Sweep, rows: list[dict | None]) -> tuple[str, list[str],
     values = {_text(case.get(first)): case.get(first) for case in cases}
     numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values.values())
     groups: dict[str, list[tuple[float, float, float]]] = {}
-    for case, row in zip(cases, rows):
+    for case, row in zip(cases, rows, strict=False):
         found = peak_and_end(row, sweep.report)
         if found is not None:
             x = _text(case.get(first))
@@ -118,15 +118,23 @@ def sweep_figure(sweep: Sweep, rows: list[dict | None]):
         prefix = f"{label}: " if label else ""
         (line,) = ax.plot(x, [p[1] for p in points], marker="o", label=f"{prefix}peak (largest |value|) over the run")
         if ends:
-            ax.plot(x, [p[2] for p in points], marker="s", linestyle="--", color=line.get_color(), alpha=0.7,
-                    label=f"{prefix}at the end of the run")
+            ax.plot(
+                x,
+                [p[2] for p in points],
+                marker="s",
+                linestyle="--",
+                color=line.get_color(),
+                alpha=0.7,
+                label=f"{prefix}at the end of the run",
+            )
     if not numeric:
         ax.set_xticks(range(len(xs)), xs)
     finished = sum(1 for r in rows if r and r.get("status") == "finished")
     ax.set_xlabel(first)
     ax.set_ylabel(f"{sweep.report}: peak over the run" + (" and at the end" if ends else ""))
-    ax.set_title(wrapped(f"{sweep.report} against {first}: {finished} of {len(rows)} cases finished", 6.0, 10),
-                 fontsize=10)
+    ax.set_title(
+        wrapped(f"{sweep.report} against {first}: {finished} of {len(rows)} cases finished", 6.0, 10), fontsize=10
+    )
     ax.grid(True, alpha=0.3)
     if groups:
         ax.legend(fontsize=8)

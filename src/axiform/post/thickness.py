@@ -15,8 +15,8 @@ temperature (mid-wall) after s_current.
 from __future__ import annotations
 
 import csv
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 
@@ -25,8 +25,9 @@ from ..fem.mesh import Mesh
 COLUMNS = ("s", "r", "z", "thickness", "initial_thickness", "ratio", "first_contact", "s_current")
 
 
-def thickness_table(mesh: Mesh, u: np.ndarray, contacts: Sequence = (),
-                    temperature: np.ndarray | None = None) -> dict[str, np.ndarray] | None:
+def thickness_table(
+    mesh: Mesh, u: np.ndarray, contacts: Sequence = (), temperature: np.ndarray | None = None
+) -> dict[str, np.ndarray] | None:
     """Per station (arrays of shape (stations,)): reference arc length s, current r, z of the
     fibre's middle, current and initial thickness, their ratio, the time of first contact
     of the station's faces (NaN where never) and the current arc length s_current.
@@ -41,9 +42,16 @@ def thickness_table(mesh: Mesh, u: np.ndarray, contacts: Sequence = (),
     t0, _ = _normal_thickness(mesh.points, f, corners)
     t, mid = _normal_thickness(mesh.points + u, f, corners)
     s_current = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(mid, axis=0), axis=1))])
-    table = {"s": mesh.fibre_s, "r": mid[:, 0], "z": mid[:, 1], "thickness": t,
-             "initial_thickness": t0, "ratio": t / t0,
-             "first_contact": first_contact(mesh, contacts), "s_current": s_current}
+    table = {
+        "s": mesh.fibre_s,
+        "r": mid[:, 0],
+        "z": mid[:, 1],
+        "thickness": t,
+        "initial_thickness": t0,
+        "ratio": t / t0,
+        "first_contact": first_contact(mesh, contacts),
+        "s_current": s_current,
+    }
     if temperature is not None:
         table["temperature"] = 0.5 * (temperature[f[:, 0]] + temperature[f[:, -1]])
     for k, pair in pieces(contacts):
@@ -78,8 +86,10 @@ def _normal_thickness(x: np.ndarray, fibres: np.ndarray, corners: np.ndarray):
         seg = np.diff(mid, axis=0)
         seg_normal = np.column_stack([-seg[:, 1], seg[:, 0]]) / np.linalg.norm(seg, axis=1)[:, None]
         k = np.flatnonzero(corners)
-        t[k] = 0.5 * (np.abs(np.einsum("ij,ij->i", chord[k], seg_normal[k - 1]))
-                      + np.abs(np.einsum("ij,ij->i", chord[k], seg_normal[k])))
+        t[k] = 0.5 * (
+            np.abs(np.einsum("ij,ij->i", chord[k], seg_normal[k - 1]))
+            + np.abs(np.einsum("ij,ij->i", chord[k], seg_normal[k]))
+        )
     return t, mid
 
 
@@ -139,7 +149,8 @@ def default_wall(points: np.ndarray, loaded_edges: Sequence[np.ndarray]) -> str:
 
 def write_thickness_csv(path: str | Path, table: dict[str, np.ndarray]) -> None:
     """thickness.csv: the header row first, one row per station, the COLUMNS
-    then temperature (where the table has it) and any per-piece first_contact_K; the step and load factor are in summary.json; the
+    then temperature (where the table has it) and any per-piece first_contact_K; the step and load factor are in
+    summary.json; the
     contact times are left empty where never."""
     names = list(COLUMNS) + [n for n in table if n not in COLUMNS]
     rows = np.column_stack([table[n] for n in names])

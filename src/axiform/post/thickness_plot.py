@@ -49,7 +49,7 @@ def z_runs(z: np.ndarray, tolerance: float = 0.03) -> list[slice]:
             cuts.append(extreme)
             direction, extreme = -direction, k
     cuts.append(max(n - 1, 0))
-    return [slice(a, b + 1) for a, b in zip(cuts[:-1], cuts[1:])]
+    return [slice(a, b + 1) for a, b in zip(cuts[:-1], cuts[1:], strict=False)]
 
 
 def _against_z(ax, t: dict[str, np.ndarray], length: str | None) -> None:
@@ -91,8 +91,13 @@ def thickness_figure(thickness: Path, info: FolderInfo, history: dict[str, np.nd
         a_s.plot(t["s"], t0, "--", color="C1", label="initial")
     else:
         span = short(t0.mean()) if np.ptp(t0) < 0.01 * t0.max() else f"{short(t0.min())} to {short(t0.max())}"
-        a_s.text(0.02, 0.04, f"initial thickness {span}" + (f" {length}" if length else ""),
-                 transform=a_s.transAxes, fontsize=8)
+        a_s.text(
+            0.02,
+            0.04,
+            f"initial thickness {span}" + (f" {length}" if length else ""),
+            transform=a_s.transAxes,
+            fontsize=8,
+        )
     a_s.legend(fontsize=8)
     _against_z(a_z, t, length)
     a_ratio.plot(t["s"], t["ratio"], "o-", ms=2.5, color="C2")
@@ -102,9 +107,11 @@ def thickness_figure(thickness: Path, info: FolderInfo, history: dict[str, np.nd
     arc = with_unit("reference arc length s", "length", info.units)
     s_top = max(t_top, t0.max() if t0.max() <= 3 * t["thickness"].max() else 0.0)
     z_top = max(t["thickness"].max(), s_top if s_top <= 3 * t["thickness"].max() else 0.0)
-    for ax, xlabel, ylabel, top in ((a_s, arc, thick_label, s_top),
-                                    (a_z, with_unit("current z", "length", info.units), thick_label, z_top),
-                                    (a_ratio, arc, "thickness ratio t / t0", max(t["ratio"].max(), float(one)))):
+    for ax, xlabel, ylabel, top in (
+        (a_s, arc, thick_label, s_top),
+        (a_z, with_unit("current z", "length", info.units), thick_label, z_top),
+        (a_ratio, arc, "thickness ratio t / t0", max(t["ratio"].max(), float(one))),
+    ):
         ax.set_ylim(0.0, 1.1 * top)
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
@@ -133,8 +140,9 @@ def _earlier_steps(ax, thickness: Path, step: int) -> float:
     blues, top = colormap("Blues"), 0.0
     for k, path in enumerate(earlier):
         e, e_step = _read_thickness(path)
-        ax.plot(e["s"], e["thickness"], "-", lw=1.2, color=blues(0.25 + 0.45 * k / len(earlier)),
-                label=f"step {e_step}")
+        ax.plot(
+            e["s"], e["thickness"], "-", lw=1.2, color=blues(0.25 + 0.45 * k / len(earlier)), label=f"step {e_step}"
+        )
         top = max(top, e["thickness"].max())
     return top
 
@@ -144,20 +152,28 @@ def _first_contact(ax, t: dict[str, np.ndarray], info: FolderInfo, arc: str, xli
     (the earliest marked the largest)."""
     per_piece = [n for n in t if n.startswith("first_contact_") and np.isfinite(t[n]).any()]
     for k, name in enumerate(per_piece):
-        ax.plot(t["s"], t[name], "o", ms=6 - 2.5 * k / len(per_piece), color=f"C{3 + k}",
-                label=info.contact_name(int(name.rsplit('_', 1)[1])))
+        ax.plot(
+            t["s"],
+            t[name],
+            "o",
+            ms=6 - 2.5 * k / len(per_piece),
+            color=f"C{3 + k}",
+            label=info.contact_name(int(name.rsplit("_", 1)[1])),
+        )
     if per_piece:
         ax.legend(fontsize=8)
     else:
         ax.plot(t["s"], t["first_contact"], "o", ms=3, color="C3")
     ax.set_xlabel(arc)
-    ax.set_ylabel(with_unit("time of first contact t", "time", info.units) if info.timed
-                  else "load factor λ at first contact")
+    ax.set_ylabel(
+        with_unit("time of first contact t", "time", info.units) if info.timed else "load factor λ at first contact"
+    )
     ax.set_xlim(xlim)
     ax.grid(True, alpha=0.3)
 
 
-def plot_thickness(thickness: Path, out: Path, info: FolderInfo | None = None,
-                   history: dict[str, np.ndarray] | None = None) -> Path | None:
+def plot_thickness(
+    thickness: Path, out: Path, info: FolderInfo | None = None, history: dict[str, np.ndarray] | None = None
+) -> Path | None:
     """thickness.png; None for an empty table."""
     return save(thickness_figure(thickness, info or FolderInfo.read(Path(thickness).parent), history), out)

@@ -7,10 +7,16 @@ import numpy as np
 
 from .controls import ArcLengthControl
 from .linsolve import factorize_signed
-from .newton import (PathEnded, StepFailed, converged, evaluate_checked, factorize_checked, newton_displacement,
-                     newton_load)
+from .newton import (
+    PathEnded,
+    StepFailed,
+    converged,
+    evaluate_checked,
+    factorize_checked,
+    newton_displacement,
+    newton_load,
+)
 from .paths import PathFollowing
-
 
 MAX_TURN = np.radians(45.0)  # arc length: the most a step's increment may turn from its predictor
 RATE_GROWTH = 4.0  # arc length: the arc per 1 / steps of the way, at most this times its mean so far
@@ -86,22 +92,31 @@ class ArcLengthPath(PathFollowing):
             # no measure of the load: a load step instead, of the size load control takes
             dlam = np.copysign(self.load_step, lam_new - self.lam)
             guess = self.u_f + dlam / (lam_new - self.lam) * (u_new - self.u_f)
-            u_new, lam_new, its, res, ev = newton_load(self.model, self.history, self.u_f, self.lam + dlam, self.opts, self.floor, guess)
-        if not self.loaded and self.previous is not None and np.dot(self.weight * (u_new - self.u_f), self.previous) < 0:
+            u_new, lam_new, its, res, ev = newton_load(
+                self.model, self.history, self.u_f, self.lam + dlam, self.opts, self.floor, guess
+            )
+        if (
+            not self.loaded
+            and self.previous is not None
+            and np.dot(self.weight * (u_new - self.u_f), self.previous) < 0
+        ):
             raise StepFailed("the path turned back")
         if not self.loaded and self.branch_check and abs(lam_new - self.lam) <= self.load_step:
             self._check_branch(u_new, ev)
         self._check_not_unloaded(u_new, lam_new)
         if self.timed and (lam_new - self.lam) * np.sign(self.control.target) < 0:
-            raise StepFailed("the load factor is the process time here (tools or curves follow it): it cannot "
-                             "run backwards")
+            raise StepFailed(
+                "the load factor is the process time here (tools or curves follow it): it cannot run backwards"
+            )
         c = self.control
         if self._crossed(self.lam, lam_new, c.target):
             out = newton_load(self.model, self.history, self.u_f, c.target, self.opts, self.floor)
             self._landed = True
             return out
         if self.stop is not None and self._crossed(self.u_f[self.stop], u_new[self.stop], c.stop_value):
-            out = newton_displacement(self.model, self.history, self.u_f, self.lam, self.stop, c.stop_value, self.opts, self.floor)
+            out = newton_displacement(
+                self.model, self.history, self.u_f, self.lam, self.stop, c.stop_value, self.opts, self.floor
+            )
             self._landed = True
             return out
         self._landed = False
@@ -153,10 +168,12 @@ class ArcLengthPath(PathFollowing):
         loaded state."""
         target = self.control.target
         if self.lam * target > 0 and lam_new * target <= 0 and self._fraction(u_new, lam_new) < 0.5 * self.progress:
-            raise PathEnded(f"the path came back to zero load (lambda from {self.lam:.6g} to {lam_new:.6g}) "
-                            f"at {100 * self._fraction(u_new, lam_new):.3g} % of the way, having reached "
-                            f"{100 * self.progress:.3g} %: it has run back down the loaded branch, a step having "
-                            "landed on it from a branch close to it")
+            raise PathEnded(
+                f"the path came back to zero load (lambda from {self.lam:.6g} to {lam_new:.6g}) "
+                f"at {100 * self._fraction(u_new, lam_new):.3g} % of the way, having reached "
+                f"{100 * self.progress:.3g} %: it has run back down the loaded branch, a step having "
+                "landed on it from a branch close to it"
+            )
 
     def _check_branch(self, u_new, ev):
         """Fail a converged step that ends on another branch of equilibrium.  Along one
@@ -178,8 +195,10 @@ class ArcLengthPath(PathFollowing):
         if self.orientation == 0:
             self.orientation = orientation
         elif orientation != self.orientation:
-            raise StepFailed("the step ended on another branch of equilibrium (det K and the direction of the "
-                             "path disagree at its end)")
+            raise StepFailed(
+                "the step ended on another branch of equilibrium (det K and the direction of the "
+                "path disagree at its end)"
+            )
 
     def _arc_step(self, dl):
         model, opts, W = self.model, self.opts, self.weight
@@ -193,8 +212,11 @@ class ArcLengthPath(PathFollowing):
             return self._load_step(dl)
         self.loaded = False
         # a process runs forward in time; elsewhere the path keeps its direction
-        sign = (np.sign(np.dot(W * t, self.previous)) if self.previous is not None and not self.timed
-                else np.sign(self.control.target))
+        sign = (
+            np.sign(np.dot(W * t, self.previous))
+            if self.previous is not None and not self.timed
+            else np.sign(self.control.target)
+        )
         dlam = (sign or 1.0) * dl / max(self._norm(t), 1e-300)
         du = predictor = dlam * t
         residuals = [start]

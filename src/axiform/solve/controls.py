@@ -54,7 +54,8 @@ class ArcLengthControl:
     A converged arc step is refused (and cut back) where it left the path: its increment
     more than 45 degrees from its predictor, or, where the path is smooth (no contact, no
     tools or curves) and the system has at most BRANCH_CHECK_MAX unknowns, sign(d lambda /
-    ds) sign(det K) changed at its end (it landed on another branch).  A step that takes lambda through zero with less than half the
+    ds) sign(det K) changed at its end (it landed on another branch).  A step that takes lambda through zero with
+    less than half the
     largest way done left ends the run: the path has run back down the loaded branch."""
 
     target: float = 1.0

@@ -36,7 +36,7 @@ import glob
 import os
 import sys
 import threading
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 import scipy.sparse as sp
@@ -100,8 +100,24 @@ def _mkl() -> ctypes.CDLL | None:
         #              const void *a, const MKL_INT *ia, *ja, MKL_INT *perm, const MKL_INT *nrhs,
         #              MKL_INT *iparm, const MKL_INT *msglvl, void *b, void *x, MKL_INT *error)
         # with MKL_INT 32-bit (mkl_rt's default LP64 interface)
-        pardiso.argtypes = [ctypes.POINTER(ctypes.c_void_p), _I32P, _I32P, _I32P, _I32P, _I32P,
-                            _F64P, _I32P, _I32P, _I32P, _I32P, _I32P, _I32P, _F64P, _F64P, _I32P]
+        pardiso.argtypes = [
+            ctypes.POINTER(ctypes.c_void_p),
+            _I32P,
+            _I32P,
+            _I32P,
+            _I32P,
+            _I32P,
+            _F64P,
+            _I32P,
+            _I32P,
+            _I32P,
+            _I32P,
+            _I32P,
+            _I32P,
+            _F64P,
+            _F64P,
+            _I32P,
+        ]
         pardiso.restype = None
         threads.argtypes = [ctypes.c_int]  # int MKL_Set_Num_Threads_Local(int): this thread only
         threads.restype = ctypes.c_int
@@ -169,9 +185,20 @@ class _Pardiso:
         self.phase.value, self.error.value = phase, 0
         b = self._dummy if b is None else b
         x = self._dummy if x is None else x
-        self.lib.pardiso(self.pt, *self._scalars, data.ctypes.data_as(_F64P), self._p_indptr, self._p_indices, None,
-                         self._p_nrhs, self._p_iparm, self._p_msglvl, b.ctypes.data_as(_F64P),
-                         x.ctypes.data_as(_F64P), self._p_error)
+        self.lib.pardiso(
+            self.pt,
+            *self._scalars,
+            data.ctypes.data_as(_F64P),
+            self._p_indptr,
+            self._p_indices,
+            None,
+            self._p_nrhs,
+            self._p_iparm,
+            self._p_msglvl,
+            b.ctypes.data_as(_F64P),
+            x.ctypes.data_as(_F64P),
+            self._p_error,
+        )
         return self.error.value
 
     def same_pattern(self, K: sp.csr_matrix) -> bool:
@@ -217,7 +244,7 @@ class _Pardiso:
         if columns.shape[1] != self.n.value or len(columns) > _INT32_MAX:
             raise ValueError(f"right-hand sides of shape {b.shape} for K with {self.n.value} unknowns")
         x = np.empty_like(columns)
-        blocks = zip(columns, x) if self.n.value < PARALLEL_MIN else ((columns, x),)
+        blocks = zip(columns, x, strict=False) if self.n.value < PARALLEL_MIN else ((columns, x),)
         for bk, xk in blocks:
             self.nrhs.value = 1 if bk.ndim == 1 else len(bk)
             error = self._call(33, data, bk, xk)

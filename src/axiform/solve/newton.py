@@ -34,7 +34,6 @@ def force_floor(model: Model) -> float:
     return 1e-12 * mu * model.ring_size() * 2 * np.pi
 
 
-
 def converged(ev: Evaluation, lam: float, opts: NewtonOptions, floor: float, residuals: list[float]) -> bool:
     norm = ev.force_norm
     if not np.isfinite(norm) or not np.isfinite(ev.constraint_error):

@@ -43,8 +43,10 @@ class PathFollowing:
     def restore(self, state: dict) -> None:
         missing = [key for key in self._state_keys if key not in state]
         if missing:
-            raise ValueError(f"the checkpoint lacks the path's {', '.join(missing)} (written by another version "
-                             "of axiform, or for another control): run the case again from its start")
+            raise ValueError(
+                f"the checkpoint lacks the path's {', '.join(missing)} (written by another version "
+                "of axiform, or for another control): run the case again from its start"
+            )
         for key in self._state_keys:
             v = state[key]
             setattr(self, key, v.copy() if isinstance(v, np.ndarray) else v)
@@ -61,7 +63,7 @@ class PathFollowing:
         free within an element of that end: the body is sliding off that end."""
         size = self.model.mesh.size()
         u = self.model.expand(self.u_f, self.lam).reshape(-1, self.model.dpn)
-        for k, (pair, held) in enumerate(zip(self.model.contacts, self.history.contacts)):
+        for k, (pair, held) in enumerate(zip(self.model.contacts, self.history.contacts, strict=False)):
             ends = _open_ends(pair.surface)
             # an end on the axis is no end a body slides off: the outline goes on mirrored
             ends = ends[np.abs(ends[:, 0] + pair.surface.offset(self.lam)[0]) > 1e-9 * size]
@@ -76,8 +78,10 @@ class PathFollowing:
                 i = int(np.flatnonzero(off)[0])
                 r, z = pair.X[i] + u[pair.nodes[i], :2]
                 name = pair.name or f"contact[{k}]"
-                return (f"the body reached the end of the mould {name} at (r, z) = ({r:.6g}, {z:.6g}) and slid "
-                        "off it: extend the mould's outline past where the body goes")
+                return (
+                    f"the body reached the end of the mould {name} at (r, z) = ({r:.6g}, {z:.6g}) and slid "
+                    "off it: extend the mould's outline past where the body goes"
+                )
         return ""
 
     def _folded(self) -> str:
@@ -88,9 +92,11 @@ class PathFollowing:
         element, node, j = folds[0]
         r, z = self.model.mesh.points[node]
         more = f" ({len(folds)} element nodes folded in all)" if len(folds) > 1 else ""
-        return (f"element {element} is folded at its node {node} (r, z = {r:.6g}, {z:.6g}; in-plane J = {j:.2g} "
-                f"there at the last converged step){more}: the mesh there no longer maps the body one to one, "
-                "and other elements there (larger or finer) move the stop")
+        return (
+            f"element {element} is folded at its node {node} (r, z = {r:.6g}, {z:.6g}; in-plane J = {j:.2g} "
+            f"there at the last converged step){more}: the mesh there no longer maps the body one to one, "
+            "and other elements there (larger or finer) move the stop"
+        )
 
     def _stiffness_ratio(self) -> float | None:
         """The current stiffness parameter: ||du/dlambda|| at the start over ||du/dlambda|| at
@@ -191,9 +197,11 @@ class LoadPath(PathFollowing):
     def diagnosis(self):
         ratio = self._stiffness_ratio() if self.lam != 0 else None
         if ratio is not None and ratio < 0.05:
-            return (f"the load passed the largest the structure carries (a limit point of the load: its stiffness "
-                    f"against it has fallen to {100 * ratio:.2g} % of its initial value); follow the path past it "
-                    "with control = \"arc-length\" or \"displacement\", or a cavity under volume control")
+            return (
+                f"the load passed the largest the structure carries (a limit point of the load: its stiffness "
+                f"against it has fallen to {100 * ratio:.2g} % of its initial value); follow the path past it "
+                'with control = "arc-length" or "displacement", or a cavity under volume control'
+            )
         return super().diagnosis()
 
 
@@ -218,13 +226,17 @@ class DisplacementPath(PathFollowing):
         return remaining if abs(size) > abs(remaining) else size
 
     def attempt(self, size):
-        goal = self.target if abs(self.target - self.reached - size) <= 1e-12 * abs(self.target) else self.reached + size
+        goal = (
+            self.target if abs(self.target - self.reached - size) <= 1e-12 * abs(self.target) else self.reached + size
+        )
         guess = None
         if self.previous is not None:  # secant predictor, as under load control
             du, dlam, dprev = self.previous
             ratio = (goal - self.reached) / dprev
             guess = (self.u_f + ratio * du, self.lam + ratio * dlam)
-        return newton_displacement(self.model, self.history, self.u_f, self.lam, self.c, goal, self.opts, self.floor, guess)
+        return newton_displacement(
+            self.model, self.history, self.u_f, self.lam, self.c, goal, self.opts, self.floor, guess
+        )
 
     def accept(self, u_f, lam, size):
         self.previous = (u_f - self.u_f, lam - self.lam, size)

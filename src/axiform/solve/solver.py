@@ -11,7 +11,7 @@ their public names are importable from here too.
 from __future__ import annotations
 
 import time
-from typing import Callable
+from collections.abc import Callable
 
 from ..model.model import Model
 from .arc_length import ArcLengthPath
@@ -19,14 +19,27 @@ from .controls import ArcLengthControl, DisplacementControl, LoadControl, Newton
 from .newton import PathEnded, StepFailed
 from .paths import DisplacementPath, LoadPath
 
-__all__ = ["ArcLengthControl", "DisplacementControl", "LoadControl", "NewtonOptions", "PathEnded", "SolveResult",
-           "Step", "StepFailed", "solve"]
+__all__ = [
+    "ArcLengthControl",
+    "DisplacementControl",
+    "LoadControl",
+    "NewtonOptions",
+    "PathEnded",
+    "SolveResult",
+    "Step",
+    "StepFailed",
+    "solve",
+]
 
 
-def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthControl,
-          options: NewtonOptions | None = None,
-          on_step: Callable[[Step], None] | None = None, keep: int | None = None,
-          resume: dict | None = None) -> SolveResult:
+def solve(
+    model: Model,
+    control: LoadControl | DisplacementControl | ArcLengthControl,
+    options: NewtonOptions | None = None,
+    on_step: Callable[[Step], None] | None = None,
+    keep: int | None = None,
+    resume: dict | None = None,
+) -> SolveResult:
     """Run the load stepping to the end or until the step would fall below the minimum.
     Every converged step is handed to on_step as it comes, with its `checkpoint`: the whole
     state after it (path, step size, counts, contact and cavity history).  The result keeps
@@ -64,8 +77,11 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
             size = trial / 2.0
             if abs(size) < opts.min_step * abs(path.nominal):
                 result.status = "stopped"
-                result.message = _stop_message(first + result.n_steps, "no convergence with the step cut below the "
-                                               f"minimum ({exc})", path.diagnosis())
+                result.message = _stop_message(
+                    first + result.n_steps,
+                    f"no convergence with the step cut below the minimum ({exc})",
+                    path.diagnosis(),
+                )
                 break
             continue
         path.accept(u_new, lam_new, trial)
@@ -77,10 +93,14 @@ def solve(model: Model, control: LoadControl | DisplacementControl | ArcLengthCo
         size = min(size, path.nominal, key=abs)  # the nominal step may change (arc length)
         result.n_steps += 1
         number = first + result.n_steps - 1
-        checkpoint = {"path": path.state(), "model": path.history.to_dict(), "size": size, "step": number,
-                      "newton_iterations": result.newton_iterations}
-        step = Step(number, lam_new, its, res, u_new, u_full, ev.r_full, checkpoint,
-                    path.history)
+        checkpoint = {
+            "path": path.state(),
+            "model": path.history.to_dict(),
+            "size": size,
+            "step": number,
+            "newton_iterations": result.newton_iterations,
+        }
+        step = Step(number, lam_new, its, res, u_new, u_full, ev.r_full, checkpoint, path.history)
         del ev  # the tangent goes now, not at the next step
         result.steps.append(step)
         if keep is not None and len(result.steps) > keep:
