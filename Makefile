@@ -19,7 +19,7 @@ demo: $(STAMP)
 	$(BIN)/axiform run examples/hughes_carnoy_plate.toml --out results/hughes_carnoy_plate
 
 test: $(STAMP)
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n 2
 
 clean:
 	rm -rf $(VENV) results
