@@ -51,7 +51,7 @@ class Hyperelastic(ABC):
         """W_iso(F_bar(F)) (...) per unit reference volume at x (..., 5)."""
 
     @abstractmethod
-    def stress_rows(self, xt: np.ndarray, kappa: float, tangent: bool):
+    def stress_rows(self, xt: np.ndarray, kappa: float, tangent: bool) -> tuple[np.ndarray, np.ndarray | None]:
         """P (5, n) and A (5, 5, n) or None of W_iso + kappa/2 (J - 1)^2 at rows xt (5, n)."""
 
     def energy(self, x: np.ndarray) -> np.ndarray:
@@ -67,7 +67,9 @@ class Hyperelastic(ABC):
     def stress_tangent(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """P (..., 5) and A = dP/dF (..., 5, 5) of the whole W."""
         xt, shape = to_rows(x)
-        return from_rows(*self.stress_rows(xt, self.kappa, True), shape)
+        P, A = self.stress_rows(xt, self.kappa, True)
+        assert A is not None, "stress_rows gives A when the tangent is asked for"
+        return from_rows(P, A, shape)
 
     def iso_stress(self, x: np.ndarray) -> np.ndarray:
         """P_iso = dW_iso(F_bar(F))/dF (..., 5)."""
@@ -77,7 +79,9 @@ class Hyperelastic(ABC):
     def iso_stress_tangent(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """P_iso (..., 5) and A_iso = dP_iso/dF (..., 5, 5) of W_iso(F_bar(F)) alone."""
         xt, shape = to_rows(x)
-        return from_rows(*self.stress_rows(xt, 0.0, True), shape)
+        P, A = self.stress_rows(xt, 0.0, True)
+        assert A is not None, "stress_rows gives A when the tangent is asked for"
+        return from_rows(P, A, shape)
 
     def volumetric_stress_tangent(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """P_vol = kappa (J - 1) dJ (..., 5) and A_vol = kappa (dJ dJ^T + (J - 1) d2J)
@@ -119,10 +123,12 @@ class ReducedLaw(Hyperelastic):
     """
 
     @abstractmethod
-    def _reduced(self, xt: np.ndarray, s: np.ndarray, j2: np.ndarray, tangent: bool):
+    def _reduced(
+        self, xt: np.ndarray, s: np.ndarray, j2: np.ndarray, tangent: bool
+    ) -> tuple[np.ndarray, np.ndarray | None]:
         """g (3, n) and H (6, n) or None of W_iso in (s, j2, f)."""
 
-    def stress_rows(self, xt: np.ndarray, kappa: float, tangent: bool):
+    def stress_rows(self, xt: np.ndarray, kappa: float, tangent: bool) -> tuple[np.ndarray, np.ndarray | None]:
         a, b, c, d, f = xt
         s = a * a + b * b + c * c + d * d
         j2 = a * d - b * c
@@ -133,6 +139,7 @@ class ReducedLaw(Hyperelastic):
         P[4] = g[2]
         A = None
         if tangent:
+            assert H is not None, "_reduced gives H when the tangent is asked for"
             ds = 2.0 * xt[:4]
             A = np.empty((5, 5, xt.shape[1]))
             v = H[0] * ds + H[1] * dj

@@ -9,6 +9,8 @@ with I1 = s + f^2, I2 = j2^2 + f^2 s and J = det F = f j2.
 
 from __future__ import annotations
 
+from typing import overload
+
 import numpy as np
 
 # x = (a, b, c, d, f) = (F_rR, F_rZ, F_zR, F_zZ, F_tT);  J = f (a d - b c)
@@ -68,7 +70,15 @@ def to_rows(x: np.ndarray) -> tuple[np.ndarray, tuple[int, ...]]:
     return np.ascontiguousarray(x.reshape(-1, 5).T), x.shape[:-1]
 
 
-def from_rows(P: np.ndarray, A: np.ndarray | None, shape: tuple[int, ...]):
+@overload
+def from_rows(P: np.ndarray, A: np.ndarray, shape: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]: ...
+@overload
+def from_rows(P: np.ndarray, A: None, shape: tuple[int, ...]) -> tuple[np.ndarray, None]: ...
+@overload
+def from_rows(P: np.ndarray, A: np.ndarray | None, shape: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray | None]: ...
+
+
+def from_rows(P: np.ndarray, A: np.ndarray | None, shape: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray | None]:
     """P rows (5, n) and A rows (5, 5, n) back to (..., 5) and (..., 5, 5)."""
     P = P.T.reshape(*shape, 5)
     if A is None:

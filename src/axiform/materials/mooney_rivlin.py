@@ -40,12 +40,13 @@ class MooneyRivlin(InvariantLaw):
         return cls(C1, C2, E / (3.0 * (1.0 - 2.0 * nu)))
 
     def psi(self, I1b: np.ndarray, I2b: np.ndarray | None) -> np.ndarray:
+        assert I2b is not None, "Mooney-Rivlin uses I2_bar (uses_I2)"
         return self.C1 * (I1b - 3.0) + self.C2 * (I2b - 3.0)
 
     def psi_derivatives(self, I1b: np.ndarray, I2b: np.ndarray | None, tangent: bool) -> tuple:
         return np.full_like(I1b, self.C1), np.full_like(I1b, self.C2), None, None, None
 
-    def stress_rows(self, xt: np.ndarray, kappa: float, tangent: bool):
+    def stress_rows(self, xt: np.ndarray, kappa: float, tangent: bool) -> tuple[np.ndarray, np.ndarray | None]:
         """P (5, n) and A = dP/dF (5, 5, n) at x rows xt (5, n), volumetric kappa included.
 
         A = 2 W1 I + W2 d2I2 + WJ d2J + W1J (dI1 dJ + dJ dI1) + W2J (dI2 dJ + dJ dI2)

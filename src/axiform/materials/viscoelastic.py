@@ -173,9 +173,9 @@ class Memory:
         h_rows = np.ascontiguousarray(h.reshape(n, m, 4).transpose(1, 2, 0))
         S_rows = np.ascontiguousarray(self.committed["S"][sl].reshape(n, 4).T)
         if self.factors[0].ndim == 1:
-            factors = tuple(f[:, None] for f in self.factors)
+            e, a, b = (f[:, None] for f in self.factors)
         else:
-            factors = tuple(f[sl].reshape(n, m).T for f in self.factors)
-        trial, S = viscous_rows(xt, P, A, h_rows, S_rows, factors)
+            e, a, b = (f[sl].reshape(n, m).T for f in self.factors)
+        trial, S = viscous_rows(xt, P, A, h_rows, S_rows, (e, a, b))
         self.trial["h"][sl] = trial.transpose(2, 0, 1).reshape(mc, q, m, 4)
         self.trial["S"][sl] = S.T.reshape(mc, q, 4)
