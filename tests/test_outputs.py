@@ -12,7 +12,7 @@ import pytest
 from axiform import rectangle
 from axiform.cli import main
 from axiform.fem.mesh import layered
-from axiform.fem.profile import Arc, Line, Profile
+from axiform.fem.profile import Arc, Line, Profile, ProfileError
 from axiform.post.thickness import thickness_table
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -47,6 +47,11 @@ def test_layered_profile_geometry():
     assert mesh.fibres.shape == (17, 3)
     t = thickness_table(mesh, np.zeros((mesh.n_nodes, 2)))
     assert np.allclose(t["thickness"], 0.1, rtol=2e-2)
+
+
+def test_a_profile_without_pieces_is_refused():
+    with pytest.raises(ProfileError, match="at least one piece"):
+        Profile((1.0, 0.0), ()).sample()
 
 
 def test_graded_wall_from_a_table():

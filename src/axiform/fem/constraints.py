@@ -8,6 +8,8 @@ load factor lambda.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -18,7 +20,7 @@ class DofMap:
     """Map full dofs to equations.  fixed: {full dof: reference value}; ties: groups of full
     dofs that share one value."""
 
-    def __init__(self, n_full: int, fixed: dict[int, float], ties: list[np.ndarray] = ()):
+    def __init__(self, n_full: int, fixed: dict[int, float], ties: Sequence[np.ndarray] = ()):
         root = np.arange(n_full)
         if len(ties):
             pairs = np.vstack([np.column_stack([g[:-1], g[1:]]) for g in map(np.asarray, ties) if len(g) > 1])
@@ -27,7 +29,7 @@ class DofMap:
             first = np.full(label.max() + 1, n_full)
             np.minimum.at(first, label, np.arange(n_full))
             root = first[label]
-        value = {}
+        value: dict[int, float] = {}  # root dof -> reference value
         for dof, v in fixed.items():
             r = root[dof]
             if r in value and abs(value[r] - v) > 1e-14 * max(1.0, abs(v)):

@@ -15,6 +15,9 @@ import numpy as np
 class Curve:
     """f(t) through the knots (t increasing), constant outside; `Curve()` is f(t) = t."""
 
+    t: np.ndarray | None  # knot times (m,), None for f(t) = t
+    f: np.ndarray | None  # knot values (m,), None exactly when t is
+
     def __init__(self, knots: Sequence[Sequence[float]] | None = None):
         if knots is None:
             self.t = self.f = None
@@ -33,13 +36,13 @@ class Curve:
         return self.t is None
 
     def __call__(self, t: float) -> float:
-        if self.t is None:
+        if self.t is None or self.f is None:
             return float(t)
         return float(np.interp(t, self.t, self.f))
 
     def slope(self, t: float) -> float:
         """df/dt; at a knot, the slope of the piece that starts there (time runs forward)."""
-        if self.t is None:
+        if self.t is None or self.f is None:
             return 1.0
         if len(self.t) < 2 or t < self.t[0] or t >= self.t[-1]:
             return 0.0
@@ -53,12 +56,12 @@ class Curve:
     def __eq__(self, other) -> bool:
         if not isinstance(other, Curve):
             return NotImplemented
-        if self.t is None or other.t is None:
+        if self.t is None or self.f is None or other.t is None or other.f is None:
             return self.t is None and other.t is None
         return np.array_equal(self.t, other.t) and np.array_equal(self.f, other.f)
 
     def __hash__(self) -> int:
-        return 0 if self.t is None else hash((self.t.tobytes(), self.f.tobytes()))
+        return 0 if self.t is None or self.f is None else hash((self.t.tobytes(), self.f.tobytes()))
 
 
 PROPORTIONAL = Curve()

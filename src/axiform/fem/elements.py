@@ -18,10 +18,10 @@ QUAD_EDGES = np.array([[0, 1], [1, 2], [2, 3], [3, 0]])
 Q8_EDGE_MIDS = np.array([4, 5, 6, 7])
 
 
-def _frozen(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
-    for a in arrays:
-        a.flags.writeable = False
-    return arrays
+def _frozen(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    a.flags.writeable = False
+    b.flags.writeable = False
+    return a, b
 
 
 @functools.cache

@@ -27,7 +27,7 @@ class Mesh:
     node_sets: dict[str, np.ndarray] = field(default_factory=dict)
     edge_sets: dict[str, np.ndarray] = field(default_factory=dict)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         self.fibres: np.ndarray | None = None  # (stations, corner nodes through the thickness)
         self.fibre_s: np.ndarray | None = None  # reference arc length of each station
         self.node_s: np.ndarray | None = None  # (n,) reference arc length of each node's station
@@ -256,7 +256,7 @@ def read_gmsh(path: str | Path, element: str | None = None) -> Mesh:
 
     m = meshio.read(path)
     quads = [(b.type, b.data) for b in m.cells if b.type in _MESHIO_QUADS]
-    others = Counter()
+    others: Counter[str] = Counter()
     for b in m.cells:
         if b.type in _SURFACE_CELLS:
             others[b.type] += len(b.data)

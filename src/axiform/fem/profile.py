@@ -42,24 +42,28 @@ class Profile:
     def length(self) -> float:
         return float(self.sample(1)[2][-1])
 
-    def sample(self, per_division: int = 1):
+    def sample(self, per_division: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Points (n, 2), unit tangents (n, 2), arc lengths (n,) and miter factors (n,) at every
         division end, with per_division - 1 extra points inside each division (2 for Q8).
         Where two pieces meet at an angle phi the tangent is their mean and an offset along
         the normal must be stretched by the miter factor 1 / cos(phi / 2) to keep the wall
         thickness."""
-        pts, tans, arcs = [np.array(self.start, float)], [], [0.0]
+        if not self.pieces:
+            raise ProfileError("a profile needs at least one piece")
+        pts: list[np.ndarray] = [np.array(self.start, float)]
+        tans: list[np.ndarray] = []
+        arcs: list[float] = [0.0]
         miter = [1.0]
         p = np.array(self.start, float)
         s0 = 0.0
-        first_tangent = None
+        first_tangent: np.ndarray | None = None
         for k, piece in enumerate(self.pieces):
             n = piece.divisions * per_division
             if piece.divisions < 1:
                 raise ProfileError(f"piece {k}: divisions must be >= 1")
             q = np.array(piece.to, float)
             if isinstance(piece, Line):
-                L = np.linalg.norm(q - p)
+                L = float(np.linalg.norm(q - p))
                 if L == 0:
                     raise ProfileError(f"piece {k}: a line of zero length")
                 t = (q - p) / L
@@ -70,7 +74,7 @@ class Profile:
                 news = s0 + f * L
             else:
                 c = np.array(piece.center, float)
-                rad = np.linalg.norm(p - c)
+                rad = float(np.linalg.norm(p - c))
                 if abs(np.linalg.norm(q - c) - rad) > 1e-9 * max(rad, 1.0) or rad == 0:
                     raise ProfileError(
                         f"piece {k}: the arc's end {tuple(piece.to)} is not on the circle about "
@@ -97,11 +101,12 @@ class Profile:
                 if np.linalg.norm(avg) < 1e-6:
                     raise ProfileError(f"piece {k}: the profile turns back on itself")
                 tans[-1] = avg / np.linalg.norm(avg)
-                miter[-1] = 2.0 / np.linalg.norm(avg)
+                miter[-1] = 2.0 / float(np.linalg.norm(avg))
             pts.extend(new)
             miter.extend([1.0] * n)
             tans.extend(newt)
             arcs.extend(news)
             p, s0 = q, news[-1]
+        assert first_tangent is not None  # set by the first piece
         tans.insert(0, first_tangent)
         return np.array(pts), np.array(tans), np.array(arcs), np.array(miter)
