@@ -38,7 +38,9 @@ class CavitySpec(CurveMixin):
 
     @property
     def value(self) -> float:
-        return {"pressure": self.pressure, "volume": self.volume, "gas": self.content}[self.control]
+        value = {"pressure": self.pressure, "volume": self.volume, "gas": self.content}[self.control]
+        assert value is not None, f"control = {self.control} has its value (_control)"
+        return value
 
 
 def build_cavities(model: Model, mesh: Mesh, specs: list[CavitySpec]) -> dict[str, Cavity]:

@@ -18,6 +18,8 @@ from ..fem.mesh import Mesh
 from ..fem.profile import Arc, Line, Profile, ProfileError
 from ..fem.selectors import select_nodes
 from ..materials import Hyperelastic
+from ..materials.temperature import TemperatureDependent
+from ..materials.viscoelastic import Viscoelastic
 from ..model.guards import chain_crossing
 from ..model.model import Model
 from .base import CaseError, CurveKnots, CurveMixin, PositiveFloat, Selector, Strict
@@ -50,6 +52,13 @@ class SurfacePiece(Strict):
         if (self.line is None) == (self.arc is None):
             raise ValueError("a surface piece is either { line = ... } or { arc = ... }")
         return self
+
+    def build(self) -> Line | Arc:
+        """The piece, of one division (a mould's lines and arcs are exact, not sampled)."""
+        if self.line is not None:
+            return Line(self.line.to, 1)
+        assert self.arc is not None, "a piece is a line or an arc (_one)"
+        return Arc(self.arc.center, self.arc.to, 1, self.arc.ccw)
 
 
 class ProfileSurfaceSpec(Strict):
@@ -125,7 +134,7 @@ class ContactSpec(Strict):
         return self
 
 
-def youngs_modulus(material: Hyperelastic) -> float:
+def youngs_modulus(material: Hyperelastic | Viscoelastic | TemperatureDependent) -> float:
     """The small-strain Young's modulus E = 9 kappa mu / (3 kappa + mu) of the material (for
     the default contact penalty)."""
     mu, k = material.shear_modulus, material.kappa
@@ -148,9 +157,7 @@ def _path_surface(spec: SurfaceSpec, motion: tuple[float, float], base: Path, wh
     if spec.polyline is not None:
         points = np.asarray(spec.polyline, float)
     elif spec.profile is not None:
-        pieces = tuple(
-            Line(p.line.to, 1) if p.line else Arc(p.arc.center, p.arc.to, 1, p.arc.ccw) for p in spec.profile.pieces
-        )
+        pieces = tuple(p.build() for p in spec.profile.pieces)
         try:
             profile = Profile(spec.profile.start, pieces)
             profile.sample(1)  # checks the arcs
@@ -166,6 +173,7 @@ def _path_surface(spec: SurfaceSpec, motion: tuple[float, float], base: Path, wh
         except DxfError as exc:
             raise CaseError(f"{where}.surface.dxf: {exc}") from None
     else:
+        assert spec.file is not None, "a surface is a circle, polyline, profile, dxf or file (_one)"
         path = Path(spec.file)
         path = path if path.is_absolute() else base / path
         try:

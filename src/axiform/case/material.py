@@ -137,8 +137,10 @@ class MaterialSpec(BaseModel):
     @field_validator(*_RANGE)
     @classmethod
     def _number(cls, value: float, info: ValidationInfo) -> float:
-        _belongs(info.field_name, info)
-        return _check_number(value, *_RANGE[info.field_name])
+        name = info.field_name
+        assert name is not None, "a field validator is called for a field"
+        _belongs(name, info)
+        return _check_number(value, *_RANGE[name])
 
     @field_validator("mu", mode="before")
     @classmethod
@@ -203,6 +205,7 @@ class MaterialSpec(BaseModel):
         tables of T, a TemperatureDependent law whose scales are taken at `temperature`
         (ValueError naming the key when it is None)."""
         tables = self.tables()
+        law: Hyperelastic | TemperatureDependent
         if not tables:
             law = self.elastic_law()
         elif temperature is None:
@@ -221,20 +224,25 @@ class MaterialSpec(BaseModel):
         c = constants if constants is not None else {k: getattr(self, k) for k in CONSTANTS}
         E, nu = c["E"], c["nu"]
         kappa = c["kappa"] if c["kappa"] is not None else E / (3.0 * (1.0 - 2.0 * nu))
-        mu0 = E / (2.0 * (1.0 + nu)) if E is not None else None
+
+        def mu0(key: str) -> Any:
+            """The initial shear modulus from E and nu, for the shear constant `key` left out."""
+            assert E is not None, f"{key} is left out only where E and nu are given (_constants)"
+            return E / (2.0 * (1.0 + nu))
+
         m = self.model
         if m in ("neo-hooke", "mooney-rivlin"):
             return MooneyRivlin(
-                c["C1"] if c["C1"] is not None else mu0 / 2.0, c["C2"] if c["C2"] is not None else 0.0, kappa
+                c["C1"] if c["C1"] is not None else mu0("C1") / 2.0, c["C2"] if c["C2"] is not None else 0.0, kappa
             )
         if m == "yeoh":
-            return Yeoh(c["C10"] if c["C10"] is not None else mu0 / 2.0, c["C20"], c["C30"], kappa)
+            return Yeoh(c["C10"] if c["C10"] is not None else mu0("C10") / 2.0, c["C20"], c["C30"], kappa)
         if m == "ogden":
             return Ogden(tuple(c["mu"]), tuple(c["alpha"]), kappa)
         if m == "gent":
-            return Gent(c["mu"] if c["mu"] is not None else mu0, c["Jm"], kappa)
+            return Gent(c["mu"] if c["mu"] is not None else mu0("mu"), c["Jm"], kappa)
         # Abaqus' mu from the initial shear modulus: mu0 / mu depends on lambda_m alone
-        mu = c["mu"] if c["mu"] is not None else mu0 / ArrudaBoyce(1.0, c["lambda_m"], kappa).shear_modulus
+        mu = c["mu"] if c["mu"] is not None else mu0("mu") / ArrudaBoyce(1.0, c["lambda_m"], kappa).shear_modulus
         return ArrudaBoyce(mu, c["lambda_m"], kappa)
 
 

@@ -41,6 +41,12 @@ class PieceSpec(Strict):
             raise ValueError("a profile piece is either { line = ... } or { arc = ... }")
         return self
 
+    def build(self) -> Line | Arc:
+        if self.line is not None:
+            return Line(self.line.to, self.line.divisions)
+        assert self.arc is not None, "a piece is a line or an arc (_one)"
+        return Arc(self.arc.center, self.arc.to, self.arc.divisions, self.arc.ccw)
+
 
 _GRID_KEYS = {
     "rectangle": ("r", "z", "divisions"),
@@ -89,12 +95,9 @@ class MeshSpec(Strict):
                 raise ValueError("thickness table: arc lengths must increase")
         return self
 
-    def build_profile(self):
-        pieces = tuple(
-            Line(p.line.to, p.line.divisions) if p.line else Arc(p.arc.center, p.arc.to, p.arc.divisions, p.arc.ccw)
-            for p in self.profile
-        )
-        return Profile(self.start, pieces)
+    def build_profile(self) -> Profile:
+        assert self.start is not None and self.profile is not None, "a layered mesh has start and profile (_kind)"
+        return Profile(self.start, tuple(p.build() for p in self.profile))
 
 
 # what building a model takes per unknown, measured (4.5 kB a dof for Q8, 2.9 kB for Q4,
@@ -122,10 +125,12 @@ def grid_size(spec: MeshSpec) -> tuple[int, int, str] | None:
     """(nodes, dofs, what sets them: 'key: grid') of a rectangle or layered mesh, counted from
     its divisions without building it; None for a gmsh mesh (its file holds what it holds)."""
     if spec.kind == "rectangle":
+        assert spec.divisions is not None, "a rectangle mesh has divisions (_kind)"
         na, nb = spec.divisions
         what = f"mesh.divisions: {na} x {nb}"
     elif spec.kind == "layered":
-        na = sum(p.line.divisions if p.line else p.arc.divisions for p in spec.profile)
+        assert spec.profile is not None and spec.layers is not None, "a layered mesh has profile and layers (_kind)"
+        na = sum(p.build().divisions for p in spec.profile)
         nb = spec.layers
         what = f"mesh.layers: {na} profile divisions x {nb} layers of"
     else:
@@ -151,12 +156,17 @@ def build_mesh(spec: MeshSpec, base: Path) -> Mesh:
     """The mesh of a [mesh] table; a relative gmsh file is taken from the folder `base`."""
     check_size(spec)
     if spec.kind == "rectangle":
+        assert spec.r is not None and spec.z is not None and spec.divisions is not None, (
+            "a rectangle mesh has r, z and divisions (_kind)"
+        )
         return rectangle(spec.r, spec.z, spec.divisions, spec.element, grading=spec.grading or (1.0, 1.0))
     if spec.kind == "layered":
+        assert spec.layers is not None, "a layered mesh has layers (_kind)"
         try:
             return layered(spec.build_profile(), spec.thickness, spec.layers, spec.element)
         except ProfileError as exc:
             raise CaseError(f"mesh.profile: {exc}") from None
+    assert spec.file is not None, "a gmsh mesh has a file (_kind)"
     path = Path(spec.file)
     path = path if path.is_absolute() else base / path
     try:

@@ -91,9 +91,9 @@ class Monitor:
     name: str
     dofs: np.ndarray | None = None
     reaction: bool = False
-    pair: object = None
+    pair: ContactPair | None = None
     quantity: str = ""
-    cavity: object = None
+    cavity: Cavity | None = None
     index: int = 0  # of the pair or cavity in the model (the state's order); the node of a temperature
 
     def value(self, step) -> float:
@@ -127,11 +127,13 @@ def build_monitors(
             if m.cavity not in cavities:
                 raise CaseError(f"monitor[{i}].cavity: no [[cavity]] is named '{m.cavity}'")
             cavity = cavities[m.cavity]
+            assert m.quantity is not None, "a cavity monitor has a quantity (_one)"
             monitors.append(Monitor(m.name, cavity=cavity, quantity=m.quantity, index=model.cavities.index(cavity)))
             continue
         if m.contact is not None:
             if m.contact >= len(pairs):
                 raise CaseError(f"monitor[{i}].contact: there are {len(pairs)} [[contact]] tables (from 0)")
+            assert m.quantity is not None, "a contact monitor has a quantity (_one)"
             monitors.append(
                 Monitor(
                     m.name, pair=pairs[m.contact], quantity=m.quantity, index=model.contacts.index(pairs[m.contact])
@@ -141,13 +143,16 @@ def build_monitors(
         if m.quantity == "temperature":
             if model.temperature is None:
                 raise CaseError(f'monitor[{i}].quantity: "temperature" needs the case\'s [temperature]')
+            assert m.at is not None, "a temperature monitor has 'at' (_one)"
             monitors.append(Monitor(m.name, quantity="temperature", index=one_node(mesh, m.at, f"monitor[{i}].at")))
             continue
         if m.dof == "rot" and model.dpn == 2:
             raise CaseError(f"monitor[{i}].dof: element '{element}' has no rotation dof")
+        assert m.dof is not None, "a node or reaction monitor has a dof (_one)"
         if m.at is not None:
             nodes = np.array([one_node(mesh, m.at, f"monitor[{i}].at")])
         else:
+            assert m.reaction is not None, "a monitor without 'at' here has 'reaction' (_one)"
             nodes = select_nodes(mesh, m.reaction.model_dump(), f"monitor[{i}].reaction")
         monitors.append(Monitor(m.name, model.dof(nodes, m.dof), m.reaction is not None))
     if len({m.name for m in monitors}) != len(monitors):
