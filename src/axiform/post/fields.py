@@ -82,7 +82,9 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
         if when is not None:
             out["first_contact"] = np.nan_to_num(when, nan=-1.0)
         for k, pair in pieces(history):
-            out[f"first_contact_{k}"] = np.nan_to_num(contact_times(mesh, [pair]), nan=-1.0)
+            piece = contact_times(mesh, [pair])
+            assert piece is not None, "pieces() gives the pairs that record contact times"
+            out[f"first_contact_{k}"] = np.nan_to_num(piece, nan=-1.0)
     return out
 
 

@@ -6,12 +6,12 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 DPI = 110  # the results folder's pictures
 
 
-def new_figure(figsize: tuple[float, float], layout: str | None = "constrained"):
+def new_figure(figsize: tuple[float, float], layout: Literal["constrained", "tight"] | None = "constrained"):
     """An empty figure of `figsize` inches; its axes come from fig.subplots / add_subplot.
     layout: "constrained" (default), "tight" or None."""
     from matplotlib.figure import Figure

@@ -75,7 +75,7 @@ def _process_panels(h, info: FolderInfo) -> list[Panel]:
         if "cavity" not in a or a["cavity"] in info.cavities
     ]
     own = (info.load or {}).get("monitor")
-    for name in ([own] if own in h else []) + _monitors(h, info):
+    for name in ([own] if own is not None and own in h else []) + _monitors(h, info):
         panels.append(Panel(_time(h), h[name], xlabel, _label(name, info)))
     return panels
 
@@ -120,6 +120,7 @@ def _load_panels(h, info: FolderInfo) -> list[Panel]:
 def _alone_panels(h, info: FolderInfo) -> list[Panel]:
     """Without other monitors: a cavity's pressure against its volume (volume control), else
     the loaded quantity against the load factor or the time."""
+    assert info.load is not None, "drawn for a case with an applied load (load_curve_panels)"
     load = info.load_of(h)
     lam = _time(h)
     for a in info.applied:
@@ -189,6 +190,7 @@ def load_curve_figure(history: Path, info: FolderInfo):
         )
         text += f"\n({legend})"
     if dropped:
+        assert info.load is not None, "monitors are dropped against a loaded displacement (_stroke_panels)"
         text += f"\n({', '.join(dropped)} follows {info.load['name']}: not drawn)"
     title(fig, text)
     return fig

@@ -11,7 +11,7 @@ and keeps their names importable from one place.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from functools import partial
 from pathlib import Path
 
@@ -65,7 +65,7 @@ def plot_jobs(folder: str | Path, field: str = "von_mises", animation: bool = Fa
     folder = Path(folder)
     info = FolderInfo.read(folder)
     history = read_history(folder / "history.csv") if (folder / "history.csv").exists() else {}
-    jobs = []
+    jobs: list[Callable[[], Path | None]] = []
     if history:
         jobs.append(partial(plot_load_curves, folder / "history.csv", folder / "load_curve.png", info))
     if (folder / "thickness.csv").exists():
@@ -78,7 +78,7 @@ def plot_jobs(folder: str | Path, field: str = "von_mises", animation: bool = Fa
     return jobs
 
 
-def missing_plots(folder: str | Path, made: list[Path] = ()) -> dict[str, str]:
+def missing_plots(folder: str | Path, made: Sequence[Path] = ()) -> dict[str, str]:
     """Why each of load_curve.png, thickness.png and deformed.png is not among `made`."""
     folder = Path(folder)
     names = {Path(p).name for p in made}

@@ -221,7 +221,7 @@ def plot_deformed(
     return save(deformed_figure(vtu, info or FolderInfo(), field, surfaces, history), out)
 
 
-def animate(folder: Path, out: Path, info: FolderInfo | None = None, fps: float = 4.0) -> Path | None:
+def animate(folder: Path, out: Path, info: FolderInfo | None = None, fps: int = 4) -> Path | None:
     """forming.gif: one frame per written step (fields.pvd), the deformed wall coloured by
     its thickness (von Mises stress where no thickness is defined) on fixed axes and colour
     limits, with the moulds where they were at that step."""
