@@ -10,6 +10,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..fem.mesh import Mesh
+from .guard import guard_forces
+from .law import Law, damping, traction
+from .report import pair_report
 from .rings import edge_heights, pole_rows, ring_areas, slave_edges
 from .state import ContactSeen, ContactState, ContactTrial
 from .surfaces import RigidSurface
@@ -25,21 +28,6 @@ GUARD_ALLOWANCE = 0.25
 # contact stabilization of a body held only by contact: the damping per unit current area
 # and unit normal motion, as a fraction of the normal penalty (ContactPair, stabilization)
 STABILIZATION = 1e-4
-
-
-def _normal_law(g: np.ndarray, touching: np.ndarray, kn, d: float):
-    """The normal law (eqs. 40-41) rounded over -d < g < 0: the force fn (n,) (>= 0, along
-    the normal) at gaps g (n,) where `touching` (and g < 0), and dfn/dg (n,)."""
-    contact = touching & (g < 0.0)
-    band = contact & (g > -d)
-    fn = np.where(contact, np.where(band, kn * g * g / (2 * d), -kn * (g + 0.5 * d)), 0.0)
-    dfn = np.where(contact, np.where(band, kn * g / d, -kn), 0.0)
-    return fn, dfn
-
-
-def outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise outer products (n, 2, 2) of a and b (n, 2)."""
-    return a[:, :, None] * b[:, None, :]
 
 
 class ContactPair:
@@ -192,6 +180,11 @@ class ContactPair:
         # for the `evaluate` of the same u and state that follows it: (x, x_prev, projection)
         self._projected = None
 
+    @property
+    def law(self) -> Law:
+        """The parameters of the contact law (law.traction)."""
+        return Law(self.kn0, self.kt0, self.mu, self.sticky, self.smoothing)
+
     def initial_state(self) -> ContactState:
         """The history before the first step: no node touched, positions at the reference."""
         n = len(self.nodes)
@@ -237,10 +230,11 @@ class ContactPair:
         # f = w(a) t: w = a (a / a0)^thinning, the area times the thinning of the penalty
         ratio = np.where(self.on_axis, 1.0, a / np.where(self.on_axis, 1.0, self.area0)) ** self.thinning
         w, dw = a * ratio, np.where(self.on_axis, 1.0, (1.0 + self.thinning) * ratio)
-        t, dt, status, slip = self._traction(x, proj, state, predicting)
+        law = traction(self.law, x, proj, state, self._holds_resting(predicting))
+        t, dt, status, slip = law.t, law.dt, law.status, law.slip
         work = state.damping_work
         if self.stabilization:
-            ts, dts, energy = self._damping(x, state, proj)
+            ts, dts, energy = damping(self.stabilization * self.kn0, self.smoothing, x, state, proj)
             t += ts
             dt += dts
             work += float(w @ energy)
@@ -283,27 +277,6 @@ class ContactPair:
             self.nodes, x.copy(), s_stick, state.stuck, state.stuck_point, state.first_contact, seen, state.damping_work
         )
         return ContactTrial(zero, None, None, None, after)
-
-    def _damping(self, x: np.ndarray, state: ContactState, proj):
-        """The stabilization's traction per unit of w (n, 2), its derivative d/dx (n, 2, 2)
-        and the energy it dissipates over the step per unit of w (n,), at positions x
-        relative to the surface (the class: contact stabilization)."""
-        c = self.stabilization * self.kn0
-        d = self.smoothing
-        free = proj.active & ~state.stuck
-        xi = np.minimum(np.maximum(-proj.g / d, 0.0), 1.0)  # 0 at the surface, 1 at the depth of the rounding
-        s = np.where(free, 1.0 - xi * xi * (3.0 - 2.0 * xi), 0.0)
-        ds = np.where(free, 6.0 * xi * (1.0 - xi) / d, 0.0)  # ds/dg
-        step = x - state.x_prev  # the motion relative to the surface since the last converged step
-        nv, tv = proj.n, proj.t
-        delta = step[:, 0] * nv[:, 0] + step[:, 1] * nv[:, 1]
-        along = step[:, 0] * tv[:, 0] + step[:, 1] * tv[:, 1]
-        fs = -c * s * delta
-        # d(fs n)/dx = n (dfs/dx)^T + fs dn/dx, dn/dx = kappa t t^T, d delta/dx = n + kappa (step . t) t
-        K = -(c * ds * delta)[:, None, None] * outer(nv, nv)
-        K -= (c * s)[:, None, None] * outer(nv, nv + (proj.kappa * along)[:, None] * tv)
-        K += (fs * proj.kappa)[:, None, None] * outer(tv, tv)
-        return fs[:, None] * nv, K, 0.5 * c * s * delta * delta
 
     def _poles(self, x, t, dt, f, C):
         """Add to the forces f (n, 2) and to the coupling C (m, k, 2, k, 2), in place, the
@@ -354,30 +327,9 @@ class ContactPair:
             [(x, state.x_prev, self.depth), (mid, mid_prev, self.depth + self.guard_allowance.max())], self.search
         )
         self._projected = (x, state.x_prev, nodes)
-        m = len(e)
-        g = proj.g + self.guard_allowance
-        if not (proj.active & (g < 0.0)).any():  # no mid-point behind its allowance: no force
-            return None, None, None, np.zeros((m, 2))
-        fn, dfn = _normal_law(g, proj.active, self.guard_kn, self.smoothing)
-        w = self.guard_weight
-        force = (w * fn)[:, None] * proj.n  # on the mid-point (m, 2)
-        Kx = (w * dfn)[:, None, None] * outer(proj.n, proj.n)
-        Kx += (w * fn * proj.kappa)[:, None, None] * outer(proj.t, proj.t)
-        Kv = Kx @ velocity
-        if dpn == 2:  # P = [I I] / 2: the products are copies of force, Kx and Kx v
-            half, quarter = 0.5 * force, 0.25 * Kx
-            return (
-                np.concatenate((half, half), axis=1),
-                np.broadcast_to(quarter[:, None, :, None, :], (m, 2, 2, 2, 2)).reshape(m, 4, 4),
-                np.concatenate((0.5 * Kv,) * 2, axis=1),
-                force,
-            )
-        P = np.zeros((m, 2, 2, dpn))  # d x_m / d (node, dof)
-        P[:, 0, :, 0] = P[:, 1, :, 1] = 0.5
-        P[:, :, 0, 2], P[:, :, 1, 2] = self.guard_arm, -self.guard_arm
-        P = P.reshape(m, 2, 2 * dpn)
-        PT = P.transpose(0, 2, 1)  # (m, 2 dpn, 2): stacked matrix products, not einsums on tiny operands
-        return (PT @ force[..., None])[..., 0], PT @ (Kx @ P), (PT @ Kv[..., None])[..., 0], force
+        return guard_forces(
+            proj, self.guard_allowance, self.guard_kn, self.guard_weight, self.smoothing, velocity, self.guard_arm, dpn
+        )
 
     def rate(self, trial: ContactTrial, velocity: np.ndarray) -> np.ndarray:
         """d f / d lambda at fixed u of the evaluation `trial` divided by -1, per slave node
@@ -390,65 +342,6 @@ class ContactPair:
             q = np.arange(self.pole_edge.size)
             np.add.at(out, self.edges[self.pole_edge][q, self.pole_corner], (trial.pole_rate @ velocity).sum(axis=1))
         return out
-
-    def _traction(self, x: np.ndarray, proj, state: ContactState, predicting: bool):
-        """The contact law per unit of w (pressure per unit gap kn0, kt0): traction t (n, 2),
-        dt/dx (n, 2, 2), status and the slip state (friction: contact, s0, z, limit; else
-        None), at positions x relative to the surface and their projection `proj`."""
-        n = len(x)
-        f = np.zeros((n, 2))
-        K = np.zeros((n, 2, 2))  # d f / d x
-        status = np.zeros(n, np.int8)
-        kn, kt = self.kn0, self.kt0
-        d = self.smoothing
-        g = proj.g
-        stuck = state.stuck
-        contact = proj.active & (g < 0.0) & ~stuck
-        # normal law (eqs. 40-41): f = fn n, fn = -kn g, rounded over -d < g < 0 so that a node
-        # touching the surface (g = 0) feels no force and the force has a continuous slope
-        fn, dfn = _normal_law(g, contact, kn, d)
-        nv, tv = proj.n, proj.t
-        nn, tt = outer(nv, nv), outer(tv, tv)
-        if self._holds_resting(predicting):
-            # nodes resting on the surface (0 <= g < d) get the penalty in the tangent only
-            resting = proj.active & (g >= 0.0) & (g < d) & ~stuck
-            K -= (resting * kn)[:, None, None] * nn
-        f += fn[:, None] * nv
-        K += dfn[:, None, None] * nn
-        K += (fn * proj.kappa)[:, None, None] * tt  # fn dn/dx
-        status[contact] = 1
-        slip_state = None
-        if self.mu > 0 and not self.sticky:
-            # Coulomb friction (eqs. 42-45) with the stick/slip corner rounded:
-            # ft = -mu fn tanh(z), z = kt (s - s0) / (mu fn).  For small slips it is the
-            # tangential penalty kt (s - s0) (stick, eq. 44), for large ones mu fn (slip, eq. 45).
-            # The sharp law makes Newton cycle between stick and slip from one iteration to
-            # the next; this one is smooth.  A node touching for the first time sticks where it
-            # was at the last converged step.
-            fresh = contact & np.isnan(state.s_stick)
-            s0 = np.where(fresh, proj.s_prev, state.s_stick)
-            slip = np.where(contact, proj.s - s0, 0.0)
-            limit = self.mu * fn  # eq. 42
-            rub = contact & (limit > 0)
-            safe = np.where(rub, limit, 1.0)
-            z = np.where(rub, kt * slip / safe, 0.0)
-            th = np.tanh(z)
-            sech2 = 1.0 - th * th
-            ft = np.where(rub, -limit * th, 0.0)
-            f += ft[:, None] * tv
-            K -= (rub * kt * sech2 * proj.m)[:, None, None] * tt  # dft/ds
-            K -= (rub * self.mu * (th - z * sech2) * dfn)[:, None, None] * outer(tv, nv)  # dft/dfn
-            K -= (ft * proj.kappa)[:, None, None] * outer(nv, tv)  # ft dt/dx
-            sliding = rub & (np.abs(z) > 1.0)
-            status[sliding] = 2
-            slip_state = (contact, s0, z, limit)
-        if self.sticky:
-            tie = stuck * kn  # the penalty of the tied nodes, 0 elsewhere (whose stuck point is 0)
-            f -= tie[:, None] * (x - state.stuck_point)
-            K[:, 0, 0] -= tie
-            K[:, 1, 1] -= tie
-            status[stuck] = 3
-        return f, K, status, slip_state
 
     def _next(self, state: ContactState, seen: ContactSeen, slip_state, lam: float, work: float) -> ContactState:
         """The history after a step that ends at the evaluation `seen` from `state`: positions
@@ -475,52 +368,6 @@ class ContactPair:
 
     def report(self, state: ContactState) -> dict:
         """Per node of the committed `state`'s evaluation: current (r, z) in the global frame, gap, contact
-        pressure (normal force over the current ring area), status; and the totals (the
-        contact area is that of the reference configuration).  Nothing in contact before the
-        first step (or after a restart, until the next step)."""
-        if state.seen is None:
-            return self._untouched(state)
-        proj, f, status, a, traction, guard = (
-            state.seen.proj,
-            state.seen.f,
-            state.seen.status,
-            state.seen.a,
-            state.seen.traction,
-            state.seen.guard_force,
-        )
-        in_contact = status > 0
-        gap = np.where(proj.active, proj.g, np.nan)
-        return {
-            "node": self.nodes,
-            "pressure": np.where(in_contact, np.einsum("ij,ij->i", traction, proj.n), 0.0),
-            "gap": gap,
-            "status": status,
-            "force": f,
-            "area": self.area0,
-            "current_area": a,
-            "first_contact": state.first_contact,
-            "force_r": float(f[:, 0].sum() + guard[:, 0].sum()),
-            "force_z": float(f[:, 1].sum() + guard[:, 1].sum()),
-            "contact_area": float(self.area0[in_contact].sum()),
-            "penetration": float(
-                max(0.0, -np.nanmin(np.where(in_contact, gap, np.nan))) if (in_contact & proj.active).any() else 0.0
-            ),
-        }
-
-    def _untouched(self, state: ContactState) -> dict:
-        """The report of a pair whose state holds no evaluation: no force, no contact."""
-        n = len(self.nodes)
-        return {
-            "node": self.nodes,
-            "pressure": np.zeros(n),
-            "gap": np.full(n, np.nan),
-            "status": np.zeros(n, np.int8),
-            "force": np.zeros((n, 2)),
-            "area": self.area0,
-            "current_area": self.area0,
-            "first_contact": state.first_contact,
-            "force_r": 0.0,
-            "force_z": 0.0,
-            "contact_area": 0.0,
-            "penetration": 0.0,
-        }
+        pressure (normal force over the current ring area), status; and the totals
+        (report.pair_report)."""
+        return pair_report(self.nodes, self.area0, state)
