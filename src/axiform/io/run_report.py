@@ -15,16 +15,17 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..post.labels import QUANTITY_UNIT
-from ..post.thickness import nodal_thickness
+from ..post.thickness import nodal_thickness, thinnest_free
 
 PENETRATION_LIMIT = 0.05  # of the local wall thickness
 STABILIZATION_LIMIT = 0.01  # of the strain energy at the end
 
 
 def thickness_summary(table: dict[str, np.ndarray]) -> dict[str, float]:
-    """{min, max, s_min, r_min, z_min} of a thickness table (post.thickness.thickness_table)."""
+    """{min, max, s_min, r_min, z_min} of a thickness table (post.thickness.thickness_table):
+    the thinnest free wall (a held station keeps its reference thickness) and its station."""
     t = table["thickness"]
-    k = int(np.argmin(t))
+    k = thinnest_free(table)
     return {
         "min": float(t[k]),
         "max": float(t.max()),
