@@ -47,9 +47,9 @@ def guard_forces(
             np.concatenate((0.5 * Kv,) * 2, axis=1),
             force,
         )
-    P = np.zeros((m, 2, 2, dpn))  # d x_m / d (node, dof)
-    P[:, 0, :, 0] = P[:, 1, :, 1] = 0.5
-    P[:, :, 0, 2], P[:, :, 1, 2] = arm, -arm
-    P = P.reshape(m, 2, 2 * dpn)
+    dx = np.zeros((m, 2, 2, dpn))  # d x_m / d (node, dof)
+    dx[:, 0, :, 0] = dx[:, 1, :, 1] = 0.5
+    dx[:, :, 0, 2], dx[:, :, 1, 2] = arm, -arm
+    P = dx.reshape(m, 2, 2 * dpn)
     PT = P.transpose(0, 2, 1)  # (m, 2 dpn, 2): stacked matrix products, not einsums on tiny operands
     return (PT @ force[..., None])[..., 0], PT @ (Kx @ P), (PT @ Kv[..., None])[..., 0], force

@@ -1,7 +1,15 @@
 """The contact law of a pair per unit of its weighted area (ContactPair): the normal penalty
 law (eqs. 40-41) rounded over a band of gaps, Coulomb friction with a tangential penalty and
 a rounded stick/slip corner (eqs. 42-45), sticky ties, and the damping traction of the contact
-stabilization.  Arrays over the slave nodes (n,), vectorized; nothing kept between calls."""
+stabilization.  Arrays over the slave nodes (n,), vectorized; nothing kept between calls.
+
+Augmented Lagrange: the normal law and the sticky ties carry the traction of the last
+converged step (the multipliers of the history, ContactState.multiplier and .tie) and add the
+penalty of the gap to it: fn = law(g - lambda / kn), ~ lambda - kn g, and t_tie = lambda_tie
+- kn (x - x_stuck).  At the end of every converged step the multipliers take the step's
+traction (`updated_multipliers`, Uzawa's update), so that the penalty carries only the change
+of traction over one step: the penetration left is that change over kn, not the whole
+pressure over kn, and it shrinks again at the next step where the pressure holds."""
 
 from __future__ import annotations
 
@@ -43,26 +51,28 @@ class Law:
 @dataclass
 class Traction:
     """The law's traction t (n, 2), its derivative dt/dx (n, 2, 2), the status of each node
-    (0 open, 1 stick, 2 slip, 3 sticky) and, with friction, the slip state (contact, s0, z,
-    limit; else None)."""
+    (0 open, 1 stick, 2 slip, 3 sticky), with friction the slip state (contact, s0, z,
+    limit; else None), and the normal traction fn (n,) of the nodes not tied."""
 
     t: np.ndarray
     dt: np.ndarray
     status: np.ndarray
     slip: tuple | None
+    fn: np.ndarray
 
 
 def traction(law: Law, x: np.ndarray, proj, state: ContactState, resting: bool) -> Traction:
     """The contact law per unit of the weighted area at positions x (n, 2) relative to the
     surface, their projection `proj` (surfaces.Projection) and the committed history
-    `state`.  resting: nodes resting on the surface (0 <= g < d) get the penalty kn n n^T in
-    the tangent, not in the force (ContactPair, the predicting tangent)."""
+    `state` (its multipliers shift the gap: g - lambda / kn).  resting: nodes resting on the
+    surface (0 <= g - lambda / kn < d) get the penalty kn n n^T in the tangent, not in the
+    force (ContactPair, the predicting tangent)."""
     n = len(x)
     f = np.zeros((n, 2))
     K = np.zeros((n, 2, 2))  # d f / d x
     status = np.zeros(n, np.int8)
     kn, d = law.kn, law.d
-    g = proj.g
+    g = proj.g - state.multiplier / kn  # the gap the penalty sees: lambda / kn in front of the surface
     stuck = state.stuck
     contact = proj.active & (g < 0.0) & ~stuck
     # normal law (eqs. 40-41): f = fn n, fn = -kn g, rounded over -d < g < 0 so that a node
@@ -83,10 +93,27 @@ def traction(law: Law, x: np.ndarray, proj, state: ContactState, resting: bool) 
     if law.sticky:
         tie = stuck * kn  # the penalty of the tied nodes, 0 elsewhere (whose stuck point is 0)
         f -= tie[:, None] * (x - state.stuck_point)
+        f += stuck[:, None] * state.tie
         K[:, 0, 0] -= tie
         K[:, 1, 1] -= tie
         status[stuck] = 3
-    return Traction(f, K, status, slip_state)
+    return Traction(f, K, status, slip_state, fn)
+
+
+def updated_multipliers(
+    kn: np.ndarray, state: ContactState, law: Traction, proj, x: np.ndarray, new: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Uzawa's update at the end of a converged step: the normal multiplier (n,) takes the
+    step's normal traction fn (zero where a node left the surface), the tie of a tied node
+    (n, 2) its tie's traction at x (n, 2).  A node tied at this step (`new`, its point the
+    contact point x - g n) starts with the part of its normal traction the tie at x does not
+    already give, (fn + kn g) n (the old multiplier, about), so that the force does not jump
+    as it freezes; never a pull."""
+    multiplier = np.where(state.stuck | new, 0.0, law.fn)
+    tie = np.where(state.stuck[:, None], state.tie - kn[:, None] * (x - state.stuck_point), 0.0)
+    carried = np.maximum(law.fn + kn * proj.g, 0.0)
+    tie = np.where(new[:, None], carried[:, None] * proj.n, tie)
+    return multiplier, tie
 
 
 def _friction(law: Law, proj, state: ContactState, contact, fn, dfn, f, K, status) -> tuple:
@@ -119,15 +146,15 @@ def _friction(law: Law, proj, state: ContactState, contact, fn, dfn, f, K, statu
 
 
 def damping(
-    c: np.ndarray, d: float, x: np.ndarray, state: ContactState, proj
+    c: np.ndarray, d: float, x: np.ndarray, state: ContactState, proj, g: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The contact stabilization's traction per unit of the weighted area (n, 2), its
     derivative d/dx (n, 2, 2) and the energy it dissipates over the step per unit of that
     area (n,), at positions x (n, 2) relative to the surface: -c s(g) ((x - x_prev) . n) n,
     c (n,) the damping per unit area and normal motion, s = 1 for g >= 0, 0 for g <= -d, a
-    cubic between (ContactPair, contact stabilization)."""
+    cubic between, g (n,) the gap the normal law sees (ContactPair, contact stabilization)."""
     free = proj.active & ~state.stuck
-    xi = np.minimum(np.maximum(-proj.g / d, 0.0), 1.0)  # 0 at the surface, 1 at the depth of the rounding
+    xi = np.minimum(np.maximum(-g / d, 0.0), 1.0)  # 0 at the surface, 1 at the depth of the rounding
     s = np.where(free, 1.0 - xi * xi * (3.0 - 2.0 * xi), 0.0)
     ds = np.where(free, 6.0 * xi * (1.0 - xi) / d, 0.0)  # ds/dg
     step = x - state.x_prev  # the motion relative to the surface since the last converged step

@@ -11,7 +11,8 @@ import numpy as np
 
 from ..fem.mesh import Mesh
 from .guard import guard_forces
-from .law import Law, damping, traction
+from .law import Law, Traction, damping, traction, updated_multipliers
+from .projection import Projection
 from .report import pair_report
 from .rings import edge_heights, pole_rows, ring_areas, slave_edges
 from .state import ContactSeen, ContactState, ContactTrial
@@ -45,8 +46,12 @@ class ContactPair:
     under the node, estimated at constant volume as h0 a0 / a (h0 the reference height, a0
     and a the reference and current ring areas): a wall stretched and thinned keeps its
     penetration p h / (PENALTY_FACTOR E) a fixed fraction of its current thickness for a
-    contact pressure p.  tangential_penalty defaults to the normal one (and follows the same
-    thinning when that is the default).  friction: Coulomb coefficient mu (0: frictionless).
+    contact pressure p.  The penalty is augmented (contact.law): the traction of the last
+    converged step is carried in the state (its multipliers) and the penalty acts on the gap
+    beyond it, so that the penetration left is the change of the contact pressure over one
+    step over the penalty, and shrinks again where the pressure holds.  tangential_penalty
+    defaults to the normal one (and follows the same thinning when that is the default).
+    friction: Coulomb coefficient mu (0: frictionless).
     sticky: a node that touches is tied to the point where it touched.  depth: how deep
     behind the surface a node is still taken as touching it (nodes deeper were not in
     contact at the last converged step and did not cross the surface since).  smoothing:
@@ -178,7 +183,7 @@ class ContactPair:
         self.name: str | None = None  # a label for plots and summary.json (case file: [[contact]] name)
         # the nodes' projection found by `guard` with the mid-points' (one pass over the pieces),
         # for the `evaluate` of the same u and state that follows it: (x, x_prev, projection)
-        self._projected = None
+        self._projected: tuple[np.ndarray, np.ndarray, Projection] | None = None
 
     @property
     def law(self) -> Law:
@@ -189,7 +194,14 @@ class ContactPair:
         """The history before the first step: no node touched, positions at the reference."""
         n = len(self.nodes)
         return ContactState(
-            self.nodes, self.X.copy(), np.full(n, np.nan), np.zeros(n, bool), np.zeros((n, 2)), np.full(n, np.nan)
+            self.nodes,
+            self.X.copy(),
+            np.full(n, np.nan),
+            np.zeros(n, bool),
+            np.zeros((n, 2)),
+            np.full(n, np.nan),
+            np.zeros(n),
+            np.zeros((n, 2)),
         )
 
     def dofs(self, dpn: int) -> np.ndarray:
@@ -231,10 +243,12 @@ class ContactPair:
         ratio = np.where(self.on_axis, 1.0, a / np.where(self.on_axis, 1.0, self.area0)) ** self.thinning
         w, dw = a * ratio, np.where(self.on_axis, 1.0, (1.0 + self.thinning) * ratio)
         law = traction(self.law, x, proj, state, self._holds_resting(predicting))
-        t, dt, status, slip = law.t, law.dt, law.status, law.slip
+        t, dt, status = law.t, law.dt, law.status
         work = state.damping_work
         if self.stabilization:
-            ts, dts, energy = damping(self.stabilization * self.kn0, self.smoothing, x, state, proj)
+            ts, dts, energy = damping(
+                self.stabilization * self.kn0, self.smoothing, x, state, proj, proj.g - state.multiplier / self.kn0
+            )
             t += ts
             dt += dts
             work += float(w @ energy)
@@ -246,16 +260,16 @@ class ContactPair:
         C = (dw[e][:, :, None] * t[e])[:, :, :, None, None] * dparts[:, :, None]
         pole_rate = self._poles(xa, t, dt, f, C) if self.pole_edge.size else None
         seen = ContactSeen(x, proj, f, status, a, ratio[:, None] * t, guard_force)
-        return ContactTrial(f, K, C.reshape(m, 2 * k, 2 * k), pole_rate, self._next(state, seen, slip, lam, work))
+        return ContactTrial(f, K, C.reshape(m, 2 * k, 2 * k), pole_rate, self._next(state, seen, law, lam, work))
 
     def _idle(self, proj, state: ContactState, predicting: bool) -> bool:
         """Whether the law gives no force and no stiffness at the projection `proj`: no node
-        behind the surface (nor resting on it, where the predicting tangent holds it), none
-        tied, no stabilization."""
+        behind the surface shifted by its multiplier (nor resting on it, where the predicting
+        tangent holds it), none tied, no stabilization."""
         if self.stabilization or state.stuck.any():
             return False
         below = self.smoothing if self._holds_resting(predicting) else 0.0
-        return not (proj.active & (proj.g < below)).any()
+        return not (proj.active & (proj.g - state.multiplier / self.kn0 < below)).any()
 
     def _holds_resting(self, predicting: bool) -> bool:
         """Whether the tangent holds the nodes resting on the surface (see the class): in a
@@ -274,7 +288,16 @@ class ContactPair:
         seen = ContactSeen(x, proj, zero, np.zeros(n, np.int8), a, zero, guard_force)
         s_stick = np.full(n, np.nan) if self.mu > 0 and not self.sticky else state.s_stick
         after = ContactState(
-            self.nodes, x.copy(), s_stick, state.stuck, state.stuck_point, state.first_contact, seen, state.damping_work
+            self.nodes,
+            x.copy(),
+            s_stick,
+            state.stuck,
+            state.stuck_point,
+            state.first_contact,
+            np.zeros(n),
+            state.tie,
+            seen,
+            state.damping_work,
         )
         return ContactTrial(zero, None, None, None, after)
 
@@ -343,28 +366,31 @@ class ContactPair:
             np.add.at(out, self.edges[self.pole_edge][q, self.pole_corner], (trial.pole_rate @ velocity).sum(axis=1))
         return out
 
-    def _next(self, state: ContactState, seen: ContactSeen, slip_state, lam: float, work: float) -> ContactState:
-        """The history after a step that ends at the evaluation `seen` from `state`: positions
-        for the crossing test, stick points, newly stuck nodes, the time of first contact."""
+    def _next(self, state: ContactState, seen: ContactSeen, law: Traction, lam: float, work: float) -> ContactState:
+        """The history after a step that ends at the evaluation `seen` (whose law gave `law`)
+        from `state`: positions for the crossing test, stick points, newly stuck nodes, the
+        time of first contact, the augmented Lagrange multipliers (law.updated_multipliers)."""
         x, proj, status = seen.x, seen.proj, seen.status
         s_stick, stuck, stuck_point = state.s_stick, state.stuck, state.stuck_point
-        if self.mu > 0 and not self.sticky:
+        if law.slip is not None:  # friction (not sticky)
             # slip beyond z = Z_SATURATED is plastic: the stick point follows the node, so that
             # a reversal of the slip finds the opposite force after a slip of about
             # Z_SATURATED mu fn / kt, not after the whole slide (at 12, where the force is
             # saturated to 1e-10, reversing nodes had next to no tangential stiffness and a
             # frictional tube took twice the iterations and a cut)
-            contact, s0, z, limit = slip_state
+            contact, s0, z, limit = law.slip
             zc = np.minimum(np.maximum(z, -Z_SATURATED), Z_SATURATED)
             s_new = np.where(z != zc, proj.s - zc * limit / np.maximum(self.kt0, 1e-300), s0)
             s_stick = np.where(contact, s_new, np.nan)
+        new = np.zeros(len(x), bool)
         if self.sticky:
             new = status == 1
             stuck_point = stuck_point.copy()
             stuck_point[new] = x[new] - proj.g[new, None] * proj.n[new]
             stuck = stuck | new
         first = np.where((status > 0) & np.isnan(state.first_contact), lam, state.first_contact)
-        return ContactState(self.nodes, x.copy(), s_stick, stuck, stuck_point, first, seen, work)
+        multiplier, tie = updated_multipliers(self.kn0, state, law, proj, x, new)
+        return ContactState(self.nodes, x.copy(), s_stick, stuck, stuck_point, first, multiplier, tie, seen, work)
 
     def report(self, state: ContactState) -> dict:
         """Per node of the committed `state`'s evaluation: current (r, z) in the global frame, gap, contact

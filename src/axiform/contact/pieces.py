@@ -9,6 +9,7 @@ import numpy as np
 # `Pieces._project` evaluates the arc formulas on every pair up to this many pairs (fewer
 # array operations), beyond on the arcs' pairs only (less arithmetic)
 ARC_SUBSET = 4096
+NO_ARC = np.zeros(0, bool)  # `_project`'s arc flags of a chain without arcs (never read)
 
 
 class Pieces:
@@ -68,7 +69,7 @@ class Pieces:
         # bounding boxes of the pieces for the global search
         self.lo, self.hi = np.minimum(self.a, self.b), np.maximum(self.a, self.b)
         for k in np.flatnonzero(self.is_arc):
-            pts = self._arc_points(k, 33)
+            pts = self._arc_points(int(k), 33)
             self.lo[k], self.hi[k] = pts.min(axis=0), pts.max(axis=0)
         # the pieces as arrays for `_project` (a straight piece: center 0, radius 1, phi0 0,
         # sweep 1, unused), and each vertex k (between pieces k - 1 and k) for cavity corners:
@@ -91,12 +92,12 @@ class Pieces:
         )
         self._cavity = np.zeros(m, bool)
         self._vertex_n = np.zeros((m, 2))
-        for k in range(1, m):
-            t1, t2 = self.tan_b[k - 1], self.tan_a[k]
-            self._cavity[k] = t1[0] * t2[1] - t1[1] * t2[0] > 0
+        for j in range(1, m):
+            t1, t2 = self.tan_b[j - 1], self.tan_a[j]
+            self._cavity[j] = t1[0] * t2[1] - t1[1] * t2[0] > 0
             nv = np.array([-t1[1], t1[0]]) + np.array([-t2[1], t2[0]])
             norm = np.linalg.norm(nv)
-            self._vertex_n[k] = nv / norm if norm > 0 else nv
+            self._vertex_n[j] = nv / norm if norm > 0 else nv
 
     def _arc_points(self, k: int, n: int) -> np.ndarray:
         phi = self.phi0[k] + self.dir[k] * np.linspace(0, self.sweep[k], n)
@@ -122,8 +123,8 @@ class Pieces:
         dx, dz = xr - ar, xz - az
         xi = (dx * tr + dz * tz) / L
         g = dx * -tz + dz * tr  # (x - a) . nor, nor = (-t_z, t_r)
-        arc = self.is_arc[k] if self._any_arc else None
-        arcs = arc is not None and bool(arc.any())  # the arc formulas only where a pair is on an arc
+        arc = self.is_arc[k] if self._any_arc else NO_ARC
+        arcs = self._any_arc and bool(arc.any())  # the arc formulas only where a pair is on an arc
         if arcs:
             if subset and len(k) > ARC_SUBSET:
                 return self._project_subset(k, x, full, arc, xi, g, P)

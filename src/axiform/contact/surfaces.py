@@ -53,6 +53,11 @@ class RigidSurface:
             held = self._held[name] = (t, self.curve, self.motion, value)
         return held[3]
 
+    def local(self, x: np.ndarray, x_prev: np.ndarray, depth: float, method: str = "buckets") -> Projection:
+        """The local search of the points x (n, 2), last converged at x_prev (n, 2), in the
+        surface's frame: each surface kind gives its own."""
+        raise NotImplementedError
+
     def local_sets(self, sets: list, method: str = "buckets") -> list[Projection]:
         """`local` of each set of points (x (n, 2), x_prev (n, 2), depth)."""
         return [self.local(x, x_prev, depth, method) for x, x_prev, depth in sets]
@@ -300,13 +305,13 @@ class Polyline(RigidSurface, Pieces):
         k: np.ndarray,
         g: np.ndarray,
         xi: np.ndarray,
-        depth: float,
+        depth: np.ndarray,
         tol: float,
     ) -> None:
         """Step 3 of `local`, in place on `out`: a node still without a contact point, behind
         piece k beyond its end and behind piece k+1 before its start, where the mould turns
         towards the body, touches the vertex, with the mean of the two normals.  Over the
-        candidate pairs (i node, k piece) and their projections (g, xi)."""
+        candidate pairs (i node, k piece), their projections (g, xi) and their nodes' depths."""
         free = ~out.active[i]
         behind = (g < 0) & (g > -depth) & free
         beyond = behind & (xi > 1 + tol)

@@ -148,15 +148,20 @@ def contact_times(mesh: Mesh, contacts: Sequence) -> np.ndarray | None:
 def first_contact(mesh: Mesh, contacts: Sequence) -> np.ndarray:
     """(stations,) the earliest time of first contact of the slave nodes that end the
     station's fibre (on either face); NaN where never or without contact."""
+    fibres = mesh.fibres
+    if fibres is None:
+        raise ValueError("the mesh has no wall (no fibres): no stations")
     when = contact_times(mesh, contacts)
     if when is None:
-        return np.full(len(mesh.fibres), np.nan)
-    return np.fmin(when[mesh.fibres[:, 0]], when[mesh.fibres[:, -1]])
+        return np.full(len(fibres), np.nan)
+    return np.fmin(when[fibres[:, 0]], when[fibres[:, -1]])
 
 
 def nodal_thickness(mesh: Mesh, table: dict[str, np.ndarray]) -> np.ndarray:
     """(n,) the thickness at every node: that of its station, linear between stations (the
     mid-side nodes of Q8 lie between two)."""
+    if mesh.node_s is None:
+        raise ValueError("the mesh has no wall (no fibres): no stations")
     return np.interp(mesh.node_s, table["s"], table["thickness"])
 
 
