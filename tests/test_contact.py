@@ -373,7 +373,7 @@ def test_an_idle_pair_gives_what_its_law_gives(element, law, predicting):
         u[:, 1] = -0.1
         history = pair.evaluate(u, 0.3, history).state
         assert (history.seen.status > 0).any() and (pair.mu == 0 or not np.isnan(history.s_stick).all())
-    u[:, 1] = 0.01  # away from the surface: every slave node in range, none behind
+    u[:, 1] = 0.1  # away from the surface and its multipliers' 0.08: every slave node in range, none behind
     idle = pair.evaluate(u, 0.5, history, predicting)
     assert idle.K is None and idle.coupling is None and not idle.f.any()
     assert idle.state.seen.proj.active.all() and (idle.state.seen.proj.g > 0).all()

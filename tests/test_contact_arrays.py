@@ -7,7 +7,8 @@ import contact_reference as ref
 import numpy as np
 import pytest
 
-from axiform.contact import surfaces
+from axiform.contact import pieces, surfaces
+from axiform.contact.projection import best_per_node
 from axiform.contact.surfaces import Polyline
 from axiform.fem.elements import edge_rule, edge_shape, gauss_1d, gauss_quad
 
@@ -161,7 +162,7 @@ def test_gauss_rules_are_built_once_and_read_only():
 def test_many_pairs_path_is_the_reference(seed, monkeypatch):
     """Beyond ARC_SUBSET pairs the arc formulas run on the arcs' pairs only and the best pair
     of each node is found without a sort: the same answer."""
-    monkeypatch.setattr(surfaces, "ARC_SUBSET", 0)
+    monkeypatch.setattr(pieces, "ARC_SUBSET", 0)
     rng = np.random.default_rng(200 + seed)
     surf = random_polyline(rng, int(rng.integers(1, 9)))
     x_prev = near_points(rng, surf, 500, 0.3)
@@ -180,7 +181,7 @@ def test_best_per_node_is_the_last_of_a_stable_sort():
     rank = rng.choice([0.0, -0.0, 0.5, -1.0, 3.0], len(i))
     order = np.lexsort((rank, score, i))
     expected = order[np.r_[i[order][1:] != i[order][:-1], True]]
-    assert np.array_equal(surfaces._best_per_node(i, score, rank), expected)
+    assert np.array_equal(best_per_node(i, score, rank), expected)
 
 
 @pytest.mark.parametrize("method", ["buckets", "binary", "brute"])

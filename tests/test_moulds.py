@@ -79,7 +79,9 @@ def test_penetration_stays_a_small_fraction_of_a_wall_thinned_five_times():
     to 2 (two thirds of E).  The default penalty
     10 E / h on the current element height leaves at most p h / (10 E), h the current height
     of one of the 4 layers: 0.8 % of the thickness; a penalty per reference area and
-    reference height would leave about 20 times as much."""
+    reference height would leave about 20 times as much; with the traction carried from step
+    to step (augmented Lagrange) under 1 %.  The wall is then 1.05 times as thick as an
+    incompressible one would be (kappa = 100 mu: it swells under its hoop tension)."""
     C1 = 0.5
     mesh = rectangle((0.2, 0.22), (0.0, 0.02), (4, 1), "q4")
     material = NeoHooke(C1, 100.0)
@@ -95,12 +97,13 @@ def test_penetration_stays_a_small_fraction_of_a_wall_thinned_five_times():
     u = res.last.u.reshape(-1, 2)
     inner = select_nodes(mesh, {"r": 0.2})
     t = 1.0 - (0.2 + u[inner, 0].mean())  # current wall: from the bore to the mould
-    assert t / 0.02 < 0.22  # thinned about five times
+    incompressible = 1.0 - np.sqrt(1.0 - (0.22**2 - 0.2**2))  # the bore of a wall of constant volume on the mould
+    assert 1.0 < t / incompressible < 1.1 and t / 0.02 < 0.23  # thinned about five times
     rep = pair.report(res.last.state.contacts[0])
     assert (rep["status"] > 0).all()
     pen = -rep["gap"]
     assert pen.max() > 0
-    assert pen.max() < 0.05 * t
+    assert pen.max() < 0.01 * t
     assert pen.max() < 1.05 * 2.0 * (t / 4) / (10 * E)  # p h / (10 E), h = t / 4
 
 

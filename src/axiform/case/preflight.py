@@ -7,7 +7,9 @@ fault.
 - slave nodes inside a mould at t = 0 (deeper than the contact smoothing);
 - a mould that faces away from its slaves (a polyline walked the wrong way, a circle with the
   wrong `inside`): the surface's normal at the slaves' projections points the way the body's
-  own outward normal does, not against it;
+  own outward normal does, not against it, the slaves behind it; or slaves on the face of
+  the body away from the mould (the same normals, the slaves in front of it: the body would
+  pass through the mould);
 - a load that inverts elements within one nominal step, in one linear solve of the reference
   tangent (no contact) for the largest increment its curve makes over one nominal step
   (INVERTING_FRACTION of it): a value typed in other units (a pressure in Pa in an mm / MPa
@@ -135,6 +137,7 @@ def mould_checks(built: Built) -> list[str]:
             continue
         alike = np.einsum("ij,ij->i", proj.n, body_normals(pair)) > 0.0
         wrong = alike & (proj.g < pair.smoothing)  # behind it, and facing the way it faces
+        away = alike & ~wrong  # in front of it, but on the body's face away from it
         where = _mould_name(built, i)
         if wrong[on].mean() > WRONG_FACE_FRACTION:
             if isinstance(pair.surface, Circle):
@@ -145,6 +148,14 @@ def mould_checks(built: Built) -> list[str]:
                 f"{where}.surface: faces away from its slaves: {int(wrong[on].sum())} of the {int(on.sum())} "
                 "slave nodes that project onto it lie behind it, its normal pointing the way the body's "
                 f"outward normal does (walked the wrong way, or contact on the wrong face?): try {fix}"
+            )
+            continue
+        if away[on].mean() > WRONG_FACE_FRACTION:
+            out.append(
+                f"{where}.slaves: on the face away from the mould: {int(away[on].sum())} of the {int(on.sum())} "
+                "slave nodes that project onto it lie in front of it with the body's outward normal pointing "
+                "the way the mould's does (the body between them and the mould): the body would pass through "
+                "the mould unseen; select the face towards it"
             )
             continue
         inside = proj.active & ~alike & (proj.g < -pair.smoothing)

@@ -250,7 +250,7 @@ def _chain(pieces: list[Piece], tol: float, reverse: bool, motion) -> Polyline:
     if same.any():
         raise DxfError(f"a piece closes on itself at {_fmt(where[node[2 * int(np.argmax(same))]])}")
     # walk the path from an open end (or round the loop from the first piece)
-    other = {}  # joint -> list of (piece, which end)
+    other: dict[int, list[tuple[int, int]]] = {}  # joint -> list of (piece, which end)
     for e in range(2 * n):
         other.setdefault(int(node[e]), []).append((e // 2, e % 2))
     open_ends = np.flatnonzero(count == 1)
@@ -270,7 +270,7 @@ def _chain(pieces: list[Piece], tol: float, reverse: bool, motion) -> Polyline:
         loose = where[open_ends]
         d = np.linalg.norm(loose[:, None] - loose[None], axis=2)
         d[np.arange(len(loose)), np.arange(len(loose))] = np.inf
-        i, j = np.unravel_index(int(np.argmin(d)), d.shape)
+        i, j = map(int, np.unravel_index(int(np.argmin(d)), d.shape))
         raise DxfError(
             f"the pieces do not chain into one path: a gap of {d[i, j]:.6g} between "
             f"{_fmt(loose[i])} and {_fmt(loose[j])} (ends join within {tol:.3g}; "
@@ -291,7 +291,7 @@ def _chain(pieces: list[Piece], tol: float, reverse: bool, motion) -> Polyline:
         chain = [p.flipped() for p in chain[::-1]]
         joints = joints[::-1]
     points = where[joints]
-    centers = []
+    centers: list[np.ndarray | None] = []
     for p, a, b in zip(chain, points[:-1], points[1:], strict=False):
         if p.center is None:
             centers.append(None)

@@ -10,6 +10,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..fem.mesh import Mesh
+from .guard import guard_forces
+from .law import Law, Traction, damping, traction, updated_multipliers
+from .projection import Projection
+from .report import pair_report
 from .rings import edge_heights, pole_rows, ring_areas, slave_edges
 from .state import ContactSeen, ContactState, ContactTrial
 from .surfaces import RigidSurface
@@ -27,21 +31,6 @@ GUARD_ALLOWANCE = 0.25
 STABILIZATION = 1e-4
 
 
-def _normal_law(g: np.ndarray, touching: np.ndarray, kn, d: float):
-    """The normal law (eqs. 40-41) rounded over -d < g < 0: the force fn (n,) (>= 0, along
-    the normal) at gaps g (n,) where `touching` (and g < 0), and dfn/dg (n,)."""
-    contact = touching & (g < 0.0)
-    band = contact & (g > -d)
-    fn = np.where(contact, np.where(band, kn * g * g / (2 * d), -kn * (g + 0.5 * d)), 0.0)
-    dfn = np.where(contact, np.where(band, kn * g / d, -kn), 0.0)
-    return fn, dfn
-
-
-def outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise outer products (n, 2, 2) of a and b (n, 2)."""
-    return a[:, :, None] * b[:, None, :]
-
-
 class ContactPair:
     """Slave nodes of the body (every node of the boundary edges whose nodes are all
     selected: corners and, for Q8, mid-side nodes) against a rigid surface.
@@ -57,8 +46,12 @@ class ContactPair:
     under the node, estimated at constant volume as h0 a0 / a (h0 the reference height, a0
     and a the reference and current ring areas): a wall stretched and thinned keeps its
     penetration p h / (PENALTY_FACTOR E) a fixed fraction of its current thickness for a
-    contact pressure p.  tangential_penalty defaults to the normal one (and follows the same
-    thinning when that is the default).  friction: Coulomb coefficient mu (0: frictionless).
+    contact pressure p.  The penalty is augmented (contact.law): the traction of the last
+    converged step is carried in the state (its multipliers) and the penalty acts on the gap
+    beyond it, so that the penetration left is the change of the contact pressure over one
+    step over the penalty, and shrinks again where the pressure holds.  tangential_penalty
+    defaults to the normal one (and follows the same thinning when that is the default).
+    friction: Coulomb coefficient mu (0: frictionless).
     sticky: a node that touches is tied to the point where it touched.  depth: how deep
     behind the surface a node is still taken as touching it (nodes deeper were not in
     contact at the last converged step and did not cross the surface since).  smoothing:
@@ -190,13 +183,25 @@ class ContactPair:
         self.name: str | None = None  # a label for plots and summary.json (case file: [[contact]] name)
         # the nodes' projection found by `guard` with the mid-points' (one pass over the pieces),
         # for the `evaluate` of the same u and state that follows it: (x, x_prev, projection)
-        self._projected = None
+        self._projected: tuple[np.ndarray, np.ndarray, Projection] | None = None
+
+    @property
+    def law(self) -> Law:
+        """The parameters of the contact law (law.traction)."""
+        return Law(self.kn0, self.kt0, self.mu, self.sticky, self.smoothing)
 
     def initial_state(self) -> ContactState:
         """The history before the first step: no node touched, positions at the reference."""
         n = len(self.nodes)
         return ContactState(
-            self.nodes, self.X.copy(), np.full(n, np.nan), np.zeros(n, bool), np.zeros((n, 2)), np.full(n, np.nan)
+            self.nodes,
+            self.X.copy(),
+            np.full(n, np.nan),
+            np.zeros(n, bool),
+            np.zeros((n, 2)),
+            np.full(n, np.nan),
+            np.zeros(n),
+            np.zeros((n, 2)),
         )
 
     def dofs(self, dpn: int) -> np.ndarray:
@@ -237,10 +242,13 @@ class ContactPair:
         # f = w(a) t: w = a (a / a0)^thinning, the area times the thinning of the penalty
         ratio = np.where(self.on_axis, 1.0, a / np.where(self.on_axis, 1.0, self.area0)) ** self.thinning
         w, dw = a * ratio, np.where(self.on_axis, 1.0, (1.0 + self.thinning) * ratio)
-        t, dt, status, slip = self._traction(x, proj, state, predicting)
+        law = traction(self.law, x, proj, state, self._holds_resting(predicting))
+        t, dt, status = law.t, law.dt, law.status
         work = state.damping_work
         if self.stabilization:
-            ts, dts, energy = self._damping(x, state, proj)
+            ts, dts, energy = damping(
+                self.stabilization * self.kn0, self.smoothing, x, state, proj, proj.g - state.multiplier / self.kn0
+            )
             t += ts
             dt += dts
             work += float(w @ energy)
@@ -252,16 +260,16 @@ class ContactPair:
         C = (dw[e][:, :, None] * t[e])[:, :, :, None, None] * dparts[:, :, None]
         pole_rate = self._poles(xa, t, dt, f, C) if self.pole_edge.size else None
         seen = ContactSeen(x, proj, f, status, a, ratio[:, None] * t, guard_force)
-        return ContactTrial(f, K, C.reshape(m, 2 * k, 2 * k), pole_rate, self._next(state, seen, slip, lam, work))
+        return ContactTrial(f, K, C.reshape(m, 2 * k, 2 * k), pole_rate, self._next(state, seen, law, lam, work))
 
     def _idle(self, proj, state: ContactState, predicting: bool) -> bool:
         """Whether the law gives no force and no stiffness at the projection `proj`: no node
-        behind the surface (nor resting on it, where the predicting tangent holds it), none
-        tied, no stabilization."""
+        behind the surface shifted by its multiplier (nor resting on it, where the predicting
+        tangent holds it), none tied, no stabilization."""
         if self.stabilization or state.stuck.any():
             return False
         below = self.smoothing if self._holds_resting(predicting) else 0.0
-        return not (proj.active & (proj.g < below)).any()
+        return not (proj.active & (proj.g - state.multiplier / self.kn0 < below)).any()
 
     def _holds_resting(self, predicting: bool) -> bool:
         """Whether the tangent holds the nodes resting on the surface (see the class): in a
@@ -280,30 +288,18 @@ class ContactPair:
         seen = ContactSeen(x, proj, zero, np.zeros(n, np.int8), a, zero, guard_force)
         s_stick = np.full(n, np.nan) if self.mu > 0 and not self.sticky else state.s_stick
         after = ContactState(
-            self.nodes, x.copy(), s_stick, state.stuck, state.stuck_point, state.first_contact, seen, state.damping_work
+            self.nodes,
+            x.copy(),
+            s_stick,
+            state.stuck,
+            state.stuck_point,
+            state.first_contact,
+            np.zeros(n),
+            state.tie,
+            seen,
+            state.damping_work,
         )
         return ContactTrial(zero, None, None, None, after)
-
-    def _damping(self, x: np.ndarray, state: ContactState, proj):
-        """The stabilization's traction per unit of w (n, 2), its derivative d/dx (n, 2, 2)
-        and the energy it dissipates over the step per unit of w (n,), at positions x
-        relative to the surface (the class: contact stabilization)."""
-        c = self.stabilization * self.kn0
-        d = self.smoothing
-        free = proj.active & ~state.stuck
-        xi = np.minimum(np.maximum(-proj.g / d, 0.0), 1.0)  # 0 at the surface, 1 at the depth of the rounding
-        s = np.where(free, 1.0 - xi * xi * (3.0 - 2.0 * xi), 0.0)
-        ds = np.where(free, 6.0 * xi * (1.0 - xi) / d, 0.0)  # ds/dg
-        step = x - state.x_prev  # the motion relative to the surface since the last converged step
-        nv, tv = proj.n, proj.t
-        delta = step[:, 0] * nv[:, 0] + step[:, 1] * nv[:, 1]
-        along = step[:, 0] * tv[:, 0] + step[:, 1] * tv[:, 1]
-        fs = -c * s * delta
-        # d(fs n)/dx = n (dfs/dx)^T + fs dn/dx, dn/dx = kappa t t^T, d delta/dx = n + kappa (step . t) t
-        K = -(c * ds * delta)[:, None, None] * outer(nv, nv)
-        K -= (c * s)[:, None, None] * outer(nv, nv + (proj.kappa * along)[:, None] * tv)
-        K += (fs * proj.kappa)[:, None, None] * outer(tv, tv)
-        return fs[:, None] * nv, K, 0.5 * c * s * delta * delta
 
     def _poles(self, x, t, dt, f, C):
         """Add to the forces f (n, 2) and to the coupling C (m, k, 2, k, 2), in place, the
@@ -354,30 +350,9 @@ class ContactPair:
             [(x, state.x_prev, self.depth), (mid, mid_prev, self.depth + self.guard_allowance.max())], self.search
         )
         self._projected = (x, state.x_prev, nodes)
-        m = len(e)
-        g = proj.g + self.guard_allowance
-        if not (proj.active & (g < 0.0)).any():  # no mid-point behind its allowance: no force
-            return None, None, None, np.zeros((m, 2))
-        fn, dfn = _normal_law(g, proj.active, self.guard_kn, self.smoothing)
-        w = self.guard_weight
-        force = (w * fn)[:, None] * proj.n  # on the mid-point (m, 2)
-        Kx = (w * dfn)[:, None, None] * outer(proj.n, proj.n)
-        Kx += (w * fn * proj.kappa)[:, None, None] * outer(proj.t, proj.t)
-        Kv = Kx @ velocity
-        if dpn == 2:  # P = [I I] / 2: the products are copies of force, Kx and Kx v
-            half, quarter = 0.5 * force, 0.25 * Kx
-            return (
-                np.concatenate((half, half), axis=1),
-                np.broadcast_to(quarter[:, None, :, None, :], (m, 2, 2, 2, 2)).reshape(m, 4, 4),
-                np.concatenate((0.5 * Kv,) * 2, axis=1),
-                force,
-            )
-        P = np.zeros((m, 2, 2, dpn))  # d x_m / d (node, dof)
-        P[:, 0, :, 0] = P[:, 1, :, 1] = 0.5
-        P[:, :, 0, 2], P[:, :, 1, 2] = self.guard_arm, -self.guard_arm
-        P = P.reshape(m, 2, 2 * dpn)
-        PT = P.transpose(0, 2, 1)  # (m, 2 dpn, 2): stacked matrix products, not einsums on tiny operands
-        return (PT @ force[..., None])[..., 0], PT @ (Kx @ P), (PT @ Kv[..., None])[..., 0], force
+        return guard_forces(
+            proj, self.guard_allowance, self.guard_kn, self.guard_weight, self.smoothing, velocity, self.guard_arm, dpn
+        )
 
     def rate(self, trial: ContactTrial, velocity: np.ndarray) -> np.ndarray:
         """d f / d lambda at fixed u of the evaluation `trial` divided by -1, per slave node
@@ -391,136 +366,34 @@ class ContactPair:
             np.add.at(out, self.edges[self.pole_edge][q, self.pole_corner], (trial.pole_rate @ velocity).sum(axis=1))
         return out
 
-    def _traction(self, x: np.ndarray, proj, state: ContactState, predicting: bool):
-        """The contact law per unit of w (pressure per unit gap kn0, kt0): traction t (n, 2),
-        dt/dx (n, 2, 2), status and the slip state (friction: contact, s0, z, limit; else
-        None), at positions x relative to the surface and their projection `proj`."""
-        n = len(x)
-        f = np.zeros((n, 2))
-        K = np.zeros((n, 2, 2))  # d f / d x
-        status = np.zeros(n, np.int8)
-        kn, kt = self.kn0, self.kt0
-        d = self.smoothing
-        g = proj.g
-        stuck = state.stuck
-        contact = proj.active & (g < 0.0) & ~stuck
-        # normal law (eqs. 40-41): f = fn n, fn = -kn g, rounded over -d < g < 0 so that a node
-        # touching the surface (g = 0) feels no force and the force has a continuous slope
-        fn, dfn = _normal_law(g, contact, kn, d)
-        nv, tv = proj.n, proj.t
-        nn, tt = outer(nv, nv), outer(tv, tv)
-        if self._holds_resting(predicting):
-            # nodes resting on the surface (0 <= g < d) get the penalty in the tangent only
-            resting = proj.active & (g >= 0.0) & (g < d) & ~stuck
-            K -= (resting * kn)[:, None, None] * nn
-        f += fn[:, None] * nv
-        K += dfn[:, None, None] * nn
-        K += (fn * proj.kappa)[:, None, None] * tt  # fn dn/dx
-        status[contact] = 1
-        slip_state = None
-        if self.mu > 0 and not self.sticky:
-            # Coulomb friction (eqs. 42-45) with the stick/slip corner rounded:
-            # ft = -mu fn tanh(z), z = kt (s - s0) / (mu fn).  For small slips it is the
-            # tangential penalty kt (s - s0) (stick, eq. 44), for large ones mu fn (slip, eq. 45).
-            # The sharp law makes Newton cycle between stick and slip from one iteration to
-            # the next; this one is smooth.  A node touching for the first time sticks where it
-            # was at the last converged step.
-            fresh = contact & np.isnan(state.s_stick)
-            s0 = np.where(fresh, proj.s_prev, state.s_stick)
-            slip = np.where(contact, proj.s - s0, 0.0)
-            limit = self.mu * fn  # eq. 42
-            rub = contact & (limit > 0)
-            safe = np.where(rub, limit, 1.0)
-            z = np.where(rub, kt * slip / safe, 0.0)
-            th = np.tanh(z)
-            sech2 = 1.0 - th * th
-            ft = np.where(rub, -limit * th, 0.0)
-            f += ft[:, None] * tv
-            K -= (rub * kt * sech2 * proj.m)[:, None, None] * tt  # dft/ds
-            K -= (rub * self.mu * (th - z * sech2) * dfn)[:, None, None] * outer(tv, nv)  # dft/dfn
-            K -= (ft * proj.kappa)[:, None, None] * outer(nv, tv)  # ft dt/dx
-            sliding = rub & (np.abs(z) > 1.0)
-            status[sliding] = 2
-            slip_state = (contact, s0, z, limit)
-        if self.sticky:
-            tie = stuck * kn  # the penalty of the tied nodes, 0 elsewhere (whose stuck point is 0)
-            f -= tie[:, None] * (x - state.stuck_point)
-            K[:, 0, 0] -= tie
-            K[:, 1, 1] -= tie
-            status[stuck] = 3
-        return f, K, status, slip_state
-
-    def _next(self, state: ContactState, seen: ContactSeen, slip_state, lam: float, work: float) -> ContactState:
-        """The history after a step that ends at the evaluation `seen` from `state`: positions
-        for the crossing test, stick points, newly stuck nodes, the time of first contact."""
+    def _next(self, state: ContactState, seen: ContactSeen, law: Traction, lam: float, work: float) -> ContactState:
+        """The history after a step that ends at the evaluation `seen` (whose law gave `law`)
+        from `state`: positions for the crossing test, stick points, newly stuck nodes, the
+        time of first contact, the augmented Lagrange multipliers (law.updated_multipliers)."""
         x, proj, status = seen.x, seen.proj, seen.status
         s_stick, stuck, stuck_point = state.s_stick, state.stuck, state.stuck_point
-        if self.mu > 0 and not self.sticky:
+        if law.slip is not None:  # friction (not sticky)
             # slip beyond z = Z_SATURATED is plastic: the stick point follows the node, so that
             # a reversal of the slip finds the opposite force after a slip of about
             # Z_SATURATED mu fn / kt, not after the whole slide (at 12, where the force is
             # saturated to 1e-10, reversing nodes had next to no tangential stiffness and a
             # frictional tube took twice the iterations and a cut)
-            contact, s0, z, limit = slip_state
+            contact, s0, z, limit = law.slip
             zc = np.minimum(np.maximum(z, -Z_SATURATED), Z_SATURATED)
             s_new = np.where(z != zc, proj.s - zc * limit / np.maximum(self.kt0, 1e-300), s0)
             s_stick = np.where(contact, s_new, np.nan)
+        new = np.zeros(len(x), bool)
         if self.sticky:
             new = status == 1
             stuck_point = stuck_point.copy()
             stuck_point[new] = x[new] - proj.g[new, None] * proj.n[new]
             stuck = stuck | new
         first = np.where((status > 0) & np.isnan(state.first_contact), lam, state.first_contact)
-        return ContactState(self.nodes, x.copy(), s_stick, stuck, stuck_point, first, seen, work)
+        multiplier, tie = updated_multipliers(self.kn0, state, law, proj, x, new)
+        return ContactState(self.nodes, x.copy(), s_stick, stuck, stuck_point, first, multiplier, tie, seen, work)
 
     def report(self, state: ContactState) -> dict:
         """Per node of the committed `state`'s evaluation: current (r, z) in the global frame, gap, contact
-        pressure (normal force over the current ring area), status; and the totals (the
-        contact area is that of the reference configuration).  Nothing in contact before the
-        first step (or after a restart, until the next step)."""
-        if state.seen is None:
-            return self._untouched(state)
-        proj, f, status, a, traction, guard = (
-            state.seen.proj,
-            state.seen.f,
-            state.seen.status,
-            state.seen.a,
-            state.seen.traction,
-            state.seen.guard_force,
-        )
-        in_contact = status > 0
-        gap = np.where(proj.active, proj.g, np.nan)
-        return {
-            "node": self.nodes,
-            "pressure": np.where(in_contact, np.einsum("ij,ij->i", traction, proj.n), 0.0),
-            "gap": gap,
-            "status": status,
-            "force": f,
-            "area": self.area0,
-            "current_area": a,
-            "first_contact": state.first_contact,
-            "force_r": float(f[:, 0].sum() + guard[:, 0].sum()),
-            "force_z": float(f[:, 1].sum() + guard[:, 1].sum()),
-            "contact_area": float(self.area0[in_contact].sum()),
-            "penetration": float(
-                max(0.0, -np.nanmin(np.where(in_contact, gap, np.nan))) if (in_contact & proj.active).any() else 0.0
-            ),
-        }
-
-    def _untouched(self, state: ContactState) -> dict:
-        """The report of a pair whose state holds no evaluation: no force, no contact."""
-        n = len(self.nodes)
-        return {
-            "node": self.nodes,
-            "pressure": np.zeros(n),
-            "gap": np.full(n, np.nan),
-            "status": np.zeros(n, np.int8),
-            "force": np.zeros((n, 2)),
-            "area": self.area0,
-            "current_area": self.area0,
-            "first_contact": state.first_contact,
-            "force_r": 0.0,
-            "force_z": 0.0,
-            "contact_area": 0.0,
-            "penetration": 0.0,
-        }
+        pressure (normal force over the current ring area), status; and the totals
+        (report.pair_report)."""
+        return pair_report(self.nodes, self.area0, state)

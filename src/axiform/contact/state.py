@@ -8,6 +8,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .projection import Projection
+
 
 @dataclass(frozen=True)
 class ContactSeen:
@@ -17,7 +19,7 @@ class ContactSeen:
     guards (m, 2) (zeros where none)."""
 
     x: np.ndarray
-    proj: object
+    proj: Projection
     f: np.ndarray
     status: np.ndarray
     a: np.ndarray
@@ -29,7 +31,10 @@ class ContactSeen:
 class ContactState:
     """The history of a pair, per slave node (n,), as of one converged step: positions for
     the crossing test x_prev (n, 2) (surface frame), friction stick points s_stick (NaN:
-    none), sticky nodes and their points, the time of first contact (NaN: never); and what
+    none), sticky nodes and their points, the time of first contact (NaN: never), the
+    augmented Lagrange multipliers (the normal traction `multiplier` (n,) and the sticky
+    ties' traction `tie` (n, 2) of the last converged step, per unit of the pair's weighted
+    area, see contact.law); and what
     the step's evaluation found (`seen`, None before the first step and after a restart),
     and the energy the contact stabilization has dissipated.
     Immutable: an evaluation returns a new (trial) state, the solver keeps the committed one."""
@@ -40,10 +45,13 @@ class ContactState:
     stuck: np.ndarray
     stuck_point: np.ndarray
     first_contact: np.ndarray
+    multiplier: np.ndarray
+    tie: np.ndarray
     seen: ContactSeen | None = None
     damping_work: float = 0.0  # the energy the contact stabilization dissipated so far
 
-    HISTORY = ("x_prev", "s_stick", "stuck", "stuck_point", "first_contact", "damping_work")
+    HISTORY = ("x_prev", "s_stick", "stuck", "stuck_point", "first_contact", "multiplier", "tie", "damping_work")
+    LATER = ("multiplier", "tie")  # history a checkpoint may lack (written before they were kept): zero
 
     def to_dict(self) -> dict[str, np.ndarray]:
         """The history arrays (a checkpoint)."""
@@ -53,12 +61,14 @@ class ContactState:
         """This state with the history arrays of `saved` (ContactState.to_dict), checked."""
         values = {}
         for k in self.HISTORY:
+            if k not in saved and k in self.LATER:
+                continue
             v = np.asarray(saved[k])
             ref = np.asarray(getattr(self, k))
             if v.shape != ref.shape:
                 raise ValueError(f"contact state '{k}' has shape {v.shape}, not {ref.shape}")
             values[k] = v.astype(ref.dtype, copy=True) if ref.ndim else float(v)
-        return replace(self, seen=None, **values)
+        return replace(self, seen=None, **values)  # type: ignore[arg-type]
 
 
 @dataclass(frozen=True)

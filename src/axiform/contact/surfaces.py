@@ -11,77 +11,18 @@ and the surface's curvature terms: dn/dx = kappa t t^T, dt/dx = -kappa n t^T, ds
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..fem.curves import PROPORTIONAL, Curve
-from . import search
+from . import pieces, search
+from .pieces import Pieces
+from .projection import Projection, best_per_node
 
 # `Polyline.local` tests every node against every piece's box at once up to this many pairs
 # (N M); beyond, the global search of `search` finds the candidates
 DENSE_PAIRS = 1 << 16
-# `Polyline._project` evaluates the arc formulas on every pair up to this many pairs (fewer
-# array operations), beyond on the arcs' pairs only (less arithmetic)
-ARC_SUBSET = 4096
-
-
-@dataclass
-class Projection:
-    """Local search result for every slave node (rows); `active` marks nodes with a contact
-    point (they may still have g >= 0: the law decides)."""
-
-    active: np.ndarray
-    g: np.ndarray
-    n: np.ndarray
-    t: np.ndarray
-    s: np.ndarray
-    kappa: np.ndarray
-    m: np.ndarray
-    point: np.ndarray
-    s_prev: np.ndarray  # surface coordinate of the last converged position on the same piece
-    kind: np.ndarray  # 0 none, 1 segment or circle, 2 cavity corner (vertex), 3 crossing
-
-    @classmethod
-    def empty(cls, n: int) -> Projection:
-        z = np.zeros(n)
-        return cls(
-            np.zeros(n, bool),
-            z.copy(),
-            np.zeros((n, 2)),
-            np.zeros((n, 2)),
-            z.copy(),
-            z.copy(),
-            np.ones(n),
-            np.zeros((n, 2)),
-            z.copy(),
-            np.zeros(n, np.int8),
-        )
-
-    def rows(self, sl: slice) -> Projection:
-        """The projections of the rows sl (views)."""
-        return Projection(*(getattr(self, name)[sl] for name in _PROJECTION_FIELDS))
-
-
-_PROJECTION_FIELDS = tuple(f.name for f in fields(Projection))  # (dataclasses.fields is slow to ask)
-
-
-def _best_per_node(i: np.ndarray, score: np.ndarray, rank: np.ndarray) -> np.ndarray:
-    """For pairs sorted by node i: the index of the last pair of each node among those with
-    the node's largest score and, among them, its largest rank."""
-    new = np.empty(len(i), bool)
-    new[0] = True
-    np.not_equal(i[1:], i[:-1], out=new[1:])
-    start = np.flatnonzero(new)
-    group = np.cumsum(new) - 1
-    top = score == np.maximum.reduceat(score, start)[group]
-    rank = np.where(top, rank, -np.inf)
-    pick = np.flatnonzero(top & (rank == np.maximum.reduceat(rank, start)[group]))
-    gp = group[pick]
-    last = np.empty(len(pick), bool)
-    np.not_equal(gp[1:], gp[:-1], out=last[:-1])
-    last[-1] = True
-    return pick[last]
 
 
 @dataclass
@@ -111,6 +52,11 @@ class RigidSurface:
             value.flags.writeable = False
             held = self._held[name] = (t, self.curve, self.motion, value)
         return held[3]
+
+    def local(self, x: np.ndarray, x_prev: np.ndarray, depth: float, method: str = "buckets") -> Projection:
+        """The local search of the points x (n, 2), last converged at x_prev (n, 2), in the
+        surface's frame: each surface kind gives its own."""
+        raise NotImplementedError
 
     def local_sets(self, sets: list, method: str = "buckets") -> list[Projection]:
         """`local` of each set of points (x (n, 2), x_prev (n, 2), depth)."""
@@ -165,7 +111,7 @@ class Circle(RigidSurface):
 
 
 @dataclass
-class Polyline(RigidSurface):
+class Polyline(RigidSurface, Pieces):
     """A chain of straight and circular pieces through `points` (k, 2); the body lies on the
     side of the normal n = (-s, c) of the direction of travel (eqs. 36-37): to the left when
     walking along the points.  `centers` (k - 1 entries, None for a straight piece) makes a
@@ -186,61 +132,9 @@ class Polyline(RigidSurface):
         ccw = self.ccw or [True] * m
         if len(centers) != m or len(ccw) != m:
             raise ValueError("one center (or None) and one ccw flag per piece")
-        self.a, self.b = P[:-1], P[1:]
-        self.is_arc = np.array([c is not None for c in centers])
-        self.c = np.array([c if c is not None else (np.nan, np.nan) for c in centers], float)
-        chord = np.linalg.norm(self.b - self.a, axis=1)
-        if (chord <= 0).any():
-            raise ValueError(f"polyline piece {int(np.argmin(chord))} has zero length")
-        self.R = np.where(self.is_arc, np.linalg.norm(self.a - np.nan_to_num(self.c), axis=1), np.nan)
-        self.phi0 = np.arctan2(self.a[:, 1] - self.c[:, 1], self.a[:, 0] - self.c[:, 0])
-        phi1 = np.arctan2(self.b[:, 1] - self.c[:, 1], self.b[:, 0] - self.c[:, 0])
-        self.dir = np.where(np.asarray(ccw, bool), 1.0, -1.0)  # +1 ccw, -1 cw
-        for k in np.flatnonzero(self.is_arc):
-            if abs(np.linalg.norm(self.b[k] - self.c[k]) - self.R[k]) > 1e-9 * max(self.R[k], 1.0):
-                raise ValueError(f"polyline piece {k}: the arc's ends are not on one circle")
-        self.sweep = np.where(self.is_arc, ((phi1 - self.phi0) * self.dir) % (2 * np.pi), 0.0)
-        self.L = np.where(self.is_arc, self.R * self.sweep, chord)
-        tan = (self.b - self.a) / chord[:, None]
-        self.tan_a, self.tan_b = tan.copy(), tan.copy()
-        for k in np.flatnonzero(self.is_arc):
-            for end, phi in (("tan_a", self.phi0[k]), ("tan_b", phi1[k])):
-                getattr(self, end)[k] = self.dir[k] * np.array([-np.sin(phi), np.cos(phi)])
-        self.s0 = np.concatenate([[0.0], np.cumsum(self.L)[:-1]])
-        # bounding boxes of the pieces for the global search
-        self.lo, self.hi = np.minimum(self.a, self.b), np.maximum(self.a, self.b)
-        for k in np.flatnonzero(self.is_arc):
-            pts = self._arc_points(k, 33)
-            self.lo[k], self.hi[k] = pts.min(axis=0), pts.max(axis=0)
-        # the pieces as arrays for `_project` (a straight piece: center 0, radius 1, phi0 0,
-        # sweep 1, unused), and each vertex k (between pieces k - 1 and k) for cavity corners:
-        # whether the mould turns towards the body there, and the mean normal
-        arc = self.is_arc
-        self._any_arc = bool(arc.any())
-        self._par = np.column_stack(
-            [
-                self.a,
-                self.tan_a,
-                self.L,
-                np.where(arc[:, None], self.c, 0.0),
-                np.where(arc, self.R, 1.0),
-                np.where(arc, self.phi0, 0.0),
-                np.where(arc & (self.sweep > 0), self.sweep, 1.0),
-                self.dir,
-                -self.tan_a[:, 1],
-                self.tan_a[:, 0],
-            ]
-        )
+        self._build_pieces(P, centers, ccw)
         self._pair_cache = search.PairCache()  # `_candidates`: the pairs of a step reused
         self._previous_held = None  # `_previous`: the last converged positions' projections, for the next call
-        self._cavity = np.zeros(m, bool)
-        self._vertex_n = np.zeros((m, 2))
-        for k in range(1, m):
-            t1, t2 = self.tan_b[k - 1], self.tan_a[k]
-            self._cavity[k] = t1[0] * t2[1] - t1[1] * t2[0] > 0
-            nv = np.array([-t1[1], t1[0]]) + np.array([-t2[1], t2[0]])
-            norm = np.linalg.norm(nv)
-            self._vertex_n[k] = nv / norm if norm > 0 else nv
 
     @classmethod
     def from_profile(cls, profile, motion=(0.0, 0.0)) -> Polyline:
@@ -261,87 +155,6 @@ class Polyline(RigidSurface):
             centers=centers,
             ccw=[bool(d < 0) for d in self.dir[::-1]],
         )
-
-    def _arc_points(self, k: int, n: int) -> np.ndarray:
-        phi = self.phi0[k] + self.dir[k] * np.linspace(0, self.sweep[k], n)
-        return self.c[k] + self.R[k] * np.column_stack([np.cos(phi), np.sin(phi)])
-
-    def polyline(self) -> np.ndarray:
-        """Points along the surface, arcs sampled finely (for pictures)."""
-        out = [self.a[:1]]
-        for k in range(len(self.a)):
-            out.append(self._arc_points(k, 25)[1:] if self.is_arc[k] else self.b[k : k + 1])
-        return np.vstack(out)
-
-    def _project(self, k: np.ndarray, x: np.ndarray, full: bool = True, subset: bool = True):
-        """For pairs (piece k (p,), point x (p, 2)): xi (fraction along the piece, < 0 before
-        its start, > 1 beyond its end), gap g, normal n, tangent t, curvature kappa, m, point,
-        every pair at once: the pieces' data gathered by k and
-        both the straight and the circular formula evaluated for every pair (the arc's only
-        where a pair lies on an arc), the right one picked by np.where.  full=False: xi and g
-        only (the last converged positions need no more)."""
-        P = self._par[k]  # (p, 13): one gather of every piece's constants
-        ar, az, tr, tz, L, cr, cz, R, phi0, sweep, sgn = P.T[:11]
-        xr, xz = x[:, 0], x[:, 1]
-        dx, dz = xr - ar, xz - az
-        xi = (dx * tr + dz * tz) / L
-        g = dx * -tz + dz * tr  # (x - a) . nor, nor = (-t_z, t_r)
-        arc = self.is_arc[k] if self._any_arc else None
-        arcs = arc is not None and bool(arc.any())  # the arc formulas only where a pair is on an arc
-        if arcs:
-            if subset and len(k) > ARC_SUBSET:
-                return self._project_subset(k, x, full, arc, xi, g, P)
-            dr, dh = xr - cr, xz - cz
-            rho = np.maximum(np.sqrt(dr * dr + dh * dh), 1e-300)
-            phi = np.arctan2(dh, dr)
-            alpha = ((phi - phi0) * sgn) % (2 * np.pi)
-            after = alpha - sweep
-            before = 2 * np.pi - alpha
-            frac = np.where(
-                alpha <= sweep, alpha / sweep, np.where(after < before, 1.0 + after / sweep, -before / sweep)
-            )
-            cos, sin = np.cos(phi), np.sin(phi)
-            nar, naz = -(sgn * cos), sgn * -sin  # the arc's normal: its tangent sgn (-sin, cos) turned
-            ga = (dr - R * dr / rho) * nar + (dh - R * dh / rho) * naz
-            xi = np.where(arc, frac, xi)
-            g = np.where(arc, ga, g)
-        if not full:
-            return xi, g
-        xic = np.minimum(np.maximum(xi, 0.0), 1.0)
-        t, n = P[:, 2:4], P[:, 11:13]  # the line's tangent and normal
-        point = P[:, 0:2] + (xic * L)[:, None] * t
-        if arcs:
-            isarc = arc[:, None]
-            sc = np.empty((len(k), 2))
-            np.negative(sin, out=sc[:, 0])
-            sc[:, 1] = cos
-            ta = sgn[:, None] * sc  # sgn (-sin, cos)
-            t = np.where(isarc, ta, t)
-            n = np.where(isarc, ta[:, ::-1] * [-1.0, 1.0], n)
-            kappa = np.where(arc, -sgn / rho, 0.0)  # ccw: the body inside the arc
-            m = np.where(arc, R / rho, 1.0)
-            ph = phi0 + sgn * xic * sweep
-            sc[:, 0] = np.cos(ph)
-            sc[:, 1] = np.sin(ph)
-            point = np.where(isarc, P[:, 5:7] + R[:, None] * sc, point)
-        else:
-            kappa, m = np.zeros(len(k)), np.ones(len(k))
-        return xi, g, n, t, kappa, m, point
-
-    def _project_subset(self, k, x, full, arc, xi, g, P):
-        """`_project` for many pairs: the arc formulas on the arcs' pairs only (the same
-        numbers: every formula works element by element)."""
-        ia = np.flatnonzero(arc)
-        sub = self._project(k[ia], x[ia], full, subset=False)
-        xi[ia], g[ia] = sub[0], sub[1]
-        if not full:
-            return xi, g
-        xic = np.minimum(np.maximum(xi, 0.0), 1.0)
-        t, n = P[:, 2:4].copy(), P[:, 11:13].copy()
-        point = P[:, 0:2] + (xic * P[:, 4])[:, None] * t
-        kappa, m = np.zeros(len(k)), np.ones(len(k))
-        n[ia], t[ia], kappa[ia], m[ia], point[ia] = sub[2:]
-        return xi, g, n, t, kappa, m, point
 
     def _previous(self, x_prev: np.ndarray, i: np.ndarray, k: np.ndarray):
         """xi and g of the last converged positions x_prev (n, 2) on the pairs (node i, piece
@@ -463,7 +276,7 @@ class Polyline(RigidSurface):
         single[0] = True
         if single.all():  # one pair per node (the common case): nothing to choose
             best = np.arange(len(i))
-        elif len(i) <= ARC_SUBSET:
+        elif len(i) <= pieces.ARC_SUBSET:
             order = np.lexsort((gap_rank, score, i))
             io = i[order]
             last = np.empty(len(io), bool)
@@ -471,7 +284,7 @@ class Polyline(RigidSurface):
             last[-1] = True
             best = order[last]
         else:  # the same without the sort (the pairs come sorted by node): maxima per node
-            best = _best_per_node(i, score, gap_rank)
+            best = best_per_node(i, score, gap_rank)
         best = best[np.isfinite(score[best])]
         bi, bk = i[best], k[best]
         out.active[bi] = True
@@ -492,13 +305,13 @@ class Polyline(RigidSurface):
         k: np.ndarray,
         g: np.ndarray,
         xi: np.ndarray,
-        depth: float,
+        depth: np.ndarray,
         tol: float,
     ) -> None:
         """Step 3 of `local`, in place on `out`: a node still without a contact point, behind
         piece k beyond its end and behind piece k+1 before its start, where the mould turns
         towards the body, touches the vertex, with the mean of the two normals.  Over the
-        candidate pairs (i node, k piece) and their projections (g, xi)."""
+        candidate pairs (i node, k piece), their projections (g, xi) and their nodes' depths."""
         free = ~out.active[i]
         behind = (g < 0) & (g > -depth) & free
         beyond = behind & (xi > 1 + tol)

@@ -14,17 +14,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..contact.checks import PassedThrough, passed_through
+from ..contact.state import ContactState
 from ..post.labels import QUANTITY_UNIT
-from ..post.thickness import nodal_thickness
+from ..post.thickness import nodal_thickness, thinnest_free
 
-PENETRATION_LIMIT = 0.05  # of the local wall thickness
+PENETRATION_LIMIT = 0.01  # of the local wall thickness: the default contact law's target
 STABILIZATION_LIMIT = 0.01  # of the strain energy at the end
 
 
 def thickness_summary(table: dict[str, np.ndarray]) -> dict[str, float]:
-    """{min, max, s_min, r_min, z_min} of a thickness table (post.thickness.thickness_table)."""
+    """{min, max, s_min, r_min, z_min} of a thickness table (post.thickness.thickness_table):
+    the thinnest free wall (a held station keeps its reference thickness) and its station."""
     t = table["thickness"]
-    k = int(np.argmin(t))
+    k = thinnest_free(table)
     return {
         "min": float(t[k]),
         "max": float(t.max()),
@@ -111,22 +114,38 @@ class RunRecord:
         energy = float(self.model.strain_energy(step.u))
         return {"work": work, "strain_energy": energy, "ratio": work / energy if energy > 0 else float("inf")}
 
+    def _through(self, k: int, step) -> PassedThrough | None:
+        """The nodes of the body behind contact pair k at the end of the step (contact.checks)."""
+        model = self.model
+        x = model.mesh.points + step.u.reshape(-1, model.dpn)[:, :2]
+        return passed_through(model.contacts[k], x, step.lam)
+
     def warnings(self, step, stabilization: dict | None) -> list[str]:
-        """The end-of-run warnings, one line each: a pair that never touched, a penetration
-        above PENETRATION_LIMIT of the wall, stabilization work above STABILIZATION_LIMIT of
-        the strain energy."""
+        """The end-of-run warnings, one line each (a pair named once: contact[k], and its name
+        where it has one): a pair that never touched, a penetration above PENETRATION_LIMIT
+        of the wall, slave nodes that passed through the mould (contact.checks), stabilization
+        work above STABILIZATION_LIMIT of the strain energy."""
         lines = []
         for k, (rec, held) in enumerate(zip(self.pairs, step.state.contacts, strict=False)):
+            name = f"contact[{k}]" + (f' ("{rec.name}")' if rec.name != f"contact[{k}]" else "")
             touched = rec.touched or bool(np.isfinite(np.asarray(held.first_contact, float)).any())
             if not touched:
-                lines.append(f'contact[{k}] ("{rec.name}") never touched the body')
+                lines.append(f"{name} never touched the body")
             if rec.max_penetration_ratio > PENETRATION_LIMIT:
                 a = rec.at
                 lines.append(
-                    f'contact[{k}] ("{rec.name}") penetrates {100 * rec.max_penetration_ratio:.1f} % of the '
+                    f"{name} penetrates {100 * rec.max_penetration_ratio:.1f} % of the "
                     f"local wall thickness ({a['penetration']:.4g} of {a['wall']:.4g} at r = {a['r']:.4g}, "
                     f"z = {a['z']:.4g}, step {a['step']}; above {100 * PENETRATION_LIMIT:g} %): "
                     "raise its penalty or refine the steps"
+                )
+            through = self._through(k, step) if isinstance(held, ContactState) else None
+            if through is not None:
+                r, z = through.at
+                lines.append(
+                    f"{name}: the body passed through the mould: {through.count} of its nodes lie behind it at "
+                    f"the end, up to {through.deepest:.4g} deep (at r, z = {r:.6g}, {z:.6g}), beyond its search "
+                    "depth (slaves on the body's face away from the mould?)"
                 )
         if stabilization and stabilization["ratio"] > STABILIZATION_LIMIT:
             lines.append(

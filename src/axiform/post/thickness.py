@@ -23,6 +23,7 @@ import numpy as np
 from ..fem.mesh import Mesh
 
 COLUMNS = ("s", "r", "z", "thickness", "initial_thickness", "ratio", "first_contact", "s_current")
+UNWRITTEN = ("held",)  # arrays of a thickness table that thickness.csv leaves out
 
 
 def thickness_table(
@@ -34,13 +35,17 @@ def thickness_table(
     u: nodal displacements (n, 2); contacts: the model's contact pairs.  With more than one
     pair recording contact times, also first_contact_K per pair K; with the nodes'
     temperature (n,), the column temperature (mid-wall: the mean of the fibre's two faces, as
-    r and z).  None for meshes without fibres."""
+    r and z).  `held` (stations,) marks the stations whose wall is held (`held_stations`):
+    their thickness is the reference one (not written to thickness.csv).  None for meshes
+    without fibres."""
     if mesh.fibres is None:
         return None
     f = mesh.fibres
     corners = _corners(mesh.points, f)
     t0, _ = _normal_thickness(mesh.points, f, corners)
     t, mid = _normal_thickness(mesh.points + u, f, corners)
+    held = held_stations(f, u)
+    t = np.where(held, t0, t)
     s_current = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(mid, axis=0), axis=1))])
     table = {
         "s": mesh.fibre_s,
@@ -51,12 +56,32 @@ def thickness_table(
         "ratio": t / t0,
         "first_contact": first_contact(mesh, contacts),
         "s_current": s_current,
+        "held": held,
     }
     if temperature is not None:
         table["temperature"] = 0.5 * (temperature[f[:, 0]] + temperature[f[:, -1]])
     for k, pair in pieces(contacts):
         table[f"first_contact_{k}"] = first_contact(mesh, [pair])
     return table
+
+
+def held_stations(fibres: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """(stations,) True where every node of the station's fibre (fibres (stations, k)) has the
+    same displacement u (n, 2), exactly: a wall held by its supports (fixed, or moved by one
+    prescribed translation), whose chord is the reference one.  A free wall's nodes never
+    move exactly alike once it deforms (and where nothing moved yet, the measured thickness
+    is the reference one anyway)."""
+    uf = u[fibres]  # (stations, k, 2)
+    return (uf == uf[:, :1]).all(axis=(1, 2))
+
+
+def thinnest_free(table: dict[str, np.ndarray]) -> int:
+    """The index of the thinnest station of a thickness table among those whose wall is not
+    held (all of them where every station is held)."""
+    t = table["thickness"]
+    held = table.get("held")
+    free = np.ones(len(t), bool) if held is None or held.all() else ~held
+    return int(np.flatnonzero(free)[np.argmin(t[free])])
 
 
 def pieces(contacts: Sequence) -> list[tuple[int, object]]:
@@ -123,15 +148,20 @@ def contact_times(mesh: Mesh, contacts: Sequence) -> np.ndarray | None:
 def first_contact(mesh: Mesh, contacts: Sequence) -> np.ndarray:
     """(stations,) the earliest time of first contact of the slave nodes that end the
     station's fibre (on either face); NaN where never or without contact."""
+    fibres = mesh.fibres
+    if fibres is None:
+        raise ValueError("the mesh has no wall (no fibres): no stations")
     when = contact_times(mesh, contacts)
     if when is None:
-        return np.full(len(mesh.fibres), np.nan)
-    return np.fmin(when[mesh.fibres[:, 0]], when[mesh.fibres[:, -1]])
+        return np.full(len(fibres), np.nan)
+    return np.fmin(when[fibres[:, 0]], when[fibres[:, -1]])
 
 
 def nodal_thickness(mesh: Mesh, table: dict[str, np.ndarray]) -> np.ndarray:
     """(n,) the thickness at every node: that of its station, linear between stations (the
     mid-side nodes of Q8 lie between two)."""
+    if mesh.node_s is None:
+        raise ValueError("the mesh has no wall (no fibres): no stations")
     return np.interp(mesh.node_s, table["s"], table["thickness"])
 
 
@@ -152,7 +182,7 @@ def write_thickness_csv(path: str | Path, table: dict[str, np.ndarray]) -> None:
     then temperature (where the table has it) and any per-piece first_contact_K; the step and load factor are in
     summary.json; the
     contact times are left empty where never."""
-    names = list(COLUMNS) + [n for n in table if n not in COLUMNS]
+    names = list(COLUMNS) + [n for n in table if n not in COLUMNS and n not in UNWRITTEN]
     rows = np.column_stack([table[n] for n in names])
     text = np.char.mod("%.10g", rows)
     text[np.isnan(rows)] = ""

@@ -27,7 +27,8 @@ def _read_thickness(path: Path) -> tuple[dict[str, np.ndarray], int]:
         except (OSError, ValueError, KeyError):
             step = 0
     data = np.genfromtxt(path, delimiter=",", names=True, ndmin=1)
-    table = {k: np.atleast_1d(data[k]) for k in data.dtype.names} if data.size else {}
+    names = data.dtype.names or ()
+    table = {k: np.atleast_1d(data[k]) for k in names} if data.size else {}
     return table, step
 
 

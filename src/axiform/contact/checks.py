@@ -1,0 +1,38 @@
+"""Checks of a contact pair at the end of a run: nodes of the body that passed through the
+surface (behind it deeper than the pair's search depth, where the pair no longer sees them:
+a body whose slaves are on its face away from the mould sinks through the mould, held at most
+by that face)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+# how far behind the surface a node is still projected by the check, in spans of the body
+# (the pair's own search stops at its depth)
+REACH = 10.0
+
+
+@dataclass(frozen=True)
+class PassedThrough:
+    """Nodes of the body behind the surface beyond the search depth: how many, the deepest
+    one's depth and its position (r, z)."""
+
+    count: int
+    deepest: float
+    at: tuple[float, float]
+
+
+def passed_through(pair, x: np.ndarray, t: float) -> PassedThrough | None:
+    """The nodes of the body at positions x (n_nodes, 2) at time t that lie behind the pair's
+    surface by more than its search depth, on a piece they project onto and in front of
+    none (surfaces' `local`: the piece with the largest gap); None where there is none."""
+    rel = x - pair.surface.offset(t)
+    span = float(np.ptp(pair.mesh.points, axis=0).max())
+    proj = pair.surface.local(rel, rel, depth=REACH * span + pair.depth, method=pair.search)
+    behind = proj.active & (proj.kind == 1) & (proj.g < -pair.depth)
+    if not behind.any():
+        return None
+    k = int(np.argmin(np.where(behind, proj.g, np.inf)))
+    return PassedThrough(int(behind.sum()), float(-proj.g[k]), (float(x[k, 0]), float(x[k, 1])))

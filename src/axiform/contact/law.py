@@ -1,0 +1,169 @@
+"""The contact law of a pair per unit of its weighted area (ContactPair): the normal penalty
+law (eqs. 40-41) rounded over a band of gaps, Coulomb friction with a tangential penalty and
+a rounded stick/slip corner (eqs. 42-45), sticky ties, and the damping traction of the contact
+stabilization.  Arrays over the slave nodes (n,), vectorized; nothing kept between calls.
+
+Augmented Lagrange: the normal law and the sticky ties carry the traction of the last
+converged step (the multipliers of the history, ContactState.multiplier and .tie) and add the
+penalty of the gap to it: fn = law(g - lambda / kn), ~ lambda - kn g, and t_tie = lambda_tie
+- kn (x - x_stuck).  At the end of every converged step the multipliers take the step's
+traction (`updated_multipliers`, Uzawa's update), so that the penalty carries only the change
+of traction over one step: the penetration left is that change over kn, not the whole
+pressure over kn, and it shrinks again at the next step where the pressure holds."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .state import ContactState
+
+
+def outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise outer products (n, 2, 2) of a and b (n, 2)."""
+    return a[:, :, None] * b[:, None, :]
+
+
+def normal_law(g: np.ndarray, touching: np.ndarray, kn, d: float) -> tuple[np.ndarray, np.ndarray]:
+    """The normal law (eqs. 40-41) rounded over -d < g < 0: the force fn (n,) (>= 0, along
+    the normal) at gaps g (n,) where `touching` (and g < 0), and dfn/dg (n,)."""
+    contact = touching & (g < 0.0)
+    band = contact & (g > -d)
+    fn = np.where(contact, np.where(band, kn * g * g / (2 * d), -kn * (g + 0.5 * d)), 0.0)
+    dfn = np.where(contact, np.where(band, kn * g / d, -kn), 0.0)
+    return fn, dfn
+
+
+@dataclass(frozen=True)
+class Law:
+    """The parameters of a pair's law: normal and tangential penalties per unit weighted
+    area kn, kt (n,), the Coulomb coefficient mu, sticky ties, the rounding band d of the
+    normal law."""
+
+    kn: np.ndarray
+    kt: np.ndarray
+    mu: float
+    sticky: bool
+    d: float
+
+
+@dataclass
+class Traction:
+    """The law's traction t (n, 2), its derivative dt/dx (n, 2, 2), the status of each node
+    (0 open, 1 stick, 2 slip, 3 sticky), with friction the slip state (contact, s0, z,
+    limit; else None), and the normal traction fn (n,) of the nodes not tied."""
+
+    t: np.ndarray
+    dt: np.ndarray
+    status: np.ndarray
+    slip: tuple | None
+    fn: np.ndarray
+
+
+def traction(law: Law, x: np.ndarray, proj, state: ContactState, resting: bool) -> Traction:
+    """The contact law per unit of the weighted area at positions x (n, 2) relative to the
+    surface, their projection `proj` (surfaces.Projection) and the committed history
+    `state` (its multipliers shift the gap: g - lambda / kn).  resting: nodes resting on the
+    surface (0 <= g - lambda / kn < d) get the penalty kn n n^T in the tangent, not in the
+    force (ContactPair, the predicting tangent)."""
+    n = len(x)
+    f = np.zeros((n, 2))
+    K = np.zeros((n, 2, 2))  # d f / d x
+    status = np.zeros(n, np.int8)
+    kn, d = law.kn, law.d
+    g = proj.g - state.multiplier / kn  # the gap the penalty sees: lambda / kn in front of the surface
+    stuck = state.stuck
+    contact = proj.active & (g < 0.0) & ~stuck
+    # normal law (eqs. 40-41): f = fn n, fn = -kn g, rounded over -d < g < 0 so that a node
+    # touching the surface (g = 0) feels no force and the force has a continuous slope
+    fn, dfn = normal_law(g, contact, kn, d)
+    nv, tv = proj.n, proj.t
+    nn, tt = outer(nv, nv), outer(tv, tv)
+    if resting:
+        on = proj.active & (g >= 0.0) & (g < d) & ~stuck
+        K -= (on * kn)[:, None, None] * nn
+    f += fn[:, None] * nv
+    K += dfn[:, None, None] * nn
+    K += (fn * proj.kappa)[:, None, None] * tt  # fn dn/dx
+    status[contact] = 1
+    slip_state = None
+    if law.mu > 0 and not law.sticky:
+        slip_state = _friction(law, proj, state, contact, fn, dfn, f, K, status)
+    if law.sticky:
+        tie = stuck * kn  # the penalty of the tied nodes, 0 elsewhere (whose stuck point is 0)
+        f -= tie[:, None] * (x - state.stuck_point)
+        f += stuck[:, None] * state.tie
+        K[:, 0, 0] -= tie
+        K[:, 1, 1] -= tie
+        status[stuck] = 3
+    return Traction(f, K, status, slip_state, fn)
+
+
+def updated_multipliers(
+    kn: np.ndarray, state: ContactState, law: Traction, proj, x: np.ndarray, new: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Uzawa's update at the end of a converged step: the normal multiplier (n,) takes the
+    step's normal traction fn (zero where a node left the surface), the tie of a tied node
+    (n, 2) its tie's traction at x (n, 2).  A node tied at this step (`new`, its point the
+    contact point x - g n) starts with the part of its normal traction the tie at x does not
+    already give, (fn + kn g) n (the old multiplier, about), so that the force does not jump
+    as it freezes; never a pull."""
+    multiplier = np.where(state.stuck | new, 0.0, law.fn)
+    tie = np.where(state.stuck[:, None], state.tie - kn[:, None] * (x - state.stuck_point), 0.0)
+    carried = np.maximum(law.fn + kn * proj.g, 0.0)
+    tie = np.where(new[:, None], carried[:, None] * proj.n, tie)
+    return multiplier, tie
+
+
+def _friction(law: Law, proj, state: ContactState, contact, fn, dfn, f, K, status) -> tuple:
+    """Coulomb friction (eqs. 42-45) with the stick/slip corner rounded, added in place to the
+    traction f (n, 2), its derivative K (n, 2, 2) and the status: ft = -mu fn tanh(z),
+    z = kt (s - s0) / (mu fn).  For small slips it is the tangential penalty kt (s - s0)
+    (stick, eq. 44), for large ones mu fn (slip, eq. 45).  The sharp law makes Newton cycle
+    between stick and slip from one iteration to the next; this one is smooth.  A node
+    touching for the first time sticks where it was at the last converged step.  Returns
+    the slip state (contact, s0, z, limit)."""
+    kt, tv, nv = law.kt, proj.t, proj.n
+    tt = outer(tv, tv)
+    fresh = contact & np.isnan(state.s_stick)
+    s0 = np.where(fresh, proj.s_prev, state.s_stick)
+    slip = np.where(contact, proj.s - s0, 0.0)
+    limit = law.mu * fn  # eq. 42
+    rub = contact & (limit > 0)
+    safe = np.where(rub, limit, 1.0)
+    z = np.where(rub, kt * slip / safe, 0.0)
+    th = np.tanh(z)
+    sech2 = 1.0 - th * th
+    ft = np.where(rub, -limit * th, 0.0)
+    f += ft[:, None] * tv
+    K -= (rub * kt * sech2 * proj.m)[:, None, None] * tt  # dft/ds
+    K -= (rub * law.mu * (th - z * sech2) * dfn)[:, None, None] * outer(tv, nv)  # dft/dfn
+    K -= (ft * proj.kappa)[:, None, None] * outer(nv, tv)  # ft dt/dx
+    sliding = rub & (np.abs(z) > 1.0)
+    status[sliding] = 2
+    return contact, s0, z, limit
+
+
+def damping(
+    c: np.ndarray, d: float, x: np.ndarray, state: ContactState, proj, g: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The contact stabilization's traction per unit of the weighted area (n, 2), its
+    derivative d/dx (n, 2, 2) and the energy it dissipates over the step per unit of that
+    area (n,), at positions x (n, 2) relative to the surface: -c s(g) ((x - x_prev) . n) n,
+    c (n,) the damping per unit area and normal motion, s = 1 for g >= 0, 0 for g <= -d, a
+    cubic between, g (n,) the gap the normal law sees (ContactPair, contact stabilization)."""
+    free = proj.active & ~state.stuck
+    xi = np.minimum(np.maximum(-g / d, 0.0), 1.0)  # 0 at the surface, 1 at the depth of the rounding
+    s = np.where(free, 1.0 - xi * xi * (3.0 - 2.0 * xi), 0.0)
+    ds = np.where(free, 6.0 * xi * (1.0 - xi) / d, 0.0)  # ds/dg
+    step = x - state.x_prev  # the motion relative to the surface since the last converged step
+    nv, tv = proj.n, proj.t
+    delta = step[:, 0] * nv[:, 0] + step[:, 1] * nv[:, 1]
+    along = step[:, 0] * tv[:, 0] + step[:, 1] * tv[:, 1]
+    fs = -c * s * delta
+    # d(fs n)/dx = n (dfs/dx)^T + fs dn/dx, dn/dx = kappa t t^T, d delta/dx = n + kappa (step . t) t
+    K = -(c * ds * delta)[:, None, None] * outer(nv, nv)
+    K -= (c * s)[:, None, None] * outer(nv, nv + (proj.kappa * along)[:, None] * tv)
+    K += (fs * proj.kappa)[:, None, None] * outer(tv, tv)
+    return fs[:, None] * nv, K, 0.5 * c * s * delta * delta
