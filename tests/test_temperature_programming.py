@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 import tomli_w
 
-from axiform.app.sensitivity import sensitivity
 from axiform.case.schema import build, parse
 from axiform.cli import main
+from axiform.design.sensitivity import sensitivity
 from axiform.post.thickness import thickness_table
 from axiform.solve.solver import solve
 

@@ -1,6 +1,6 @@
 """`axiform run CASE.toml [--out DIR]`, `axiform check CASE.toml [--plot [PNG]]`, `axiform plot
 DIR`, `axiform fit DATA.csv --model MODEL` (app/fit.py; prony and wlf: app/fit_viscoelastic.py),
-`axiform optimize CASE.toml --target T.csv --out DIR` (app/optimize.py), `axiform sweep
+`axiform optimize CASE.toml --target T.csv --out DIR` (app/optimize.py, design/), `axiform sweep
 SWEEP.toml --out DIR` (app/sweep.py).
 
 Exit codes: 0 finished, 1 stopped (converged steps kept), 2 invalid case (refused before any

@@ -86,6 +86,11 @@ class CaseDesign(ABC):
     def control(self) -> LoadControl:
         return self.built.control
 
+    def outside(self, values: np.ndarray) -> str | None:
+        """Why the design `values` (k,) lies outside the case's domain (not to be solved), or
+        None: every thickness within the bounds is a wall."""
+        return None
+
 
 @dataclass
 class ThicknessDesign(CaseDesign):

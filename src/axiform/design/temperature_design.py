@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..case.schema import Built, CaseError, build, parse, read
-from .design import CaseDesign, absolute_paths
+from .problem import CaseDesign, absolute_paths
 
 MARGIN = 30.0  # K: the default bounds, the table's range widened by this much
 RULE_GAIN = 15.0  # K per unit of ln(achieved / target) (the fixed-point rule)
@@ -85,6 +85,19 @@ class TemperatureDesign(CaseDesign):
             "table": [[float(x), float(T)] for x, T in zip(self.knots, values, strict=False)],
         }
         return tree
+
+    def outside(self, values: np.ndarray) -> str | None:
+        """Why the temperatures `values` (k,) lie outside the shift's domain (at or below the
+        WLF pole T_ref - C2, or not a positive absolute temperature), or None.  The table's
+        field lies between its smallest and largest knot value, so the knots tell."""
+        shift = self.built.model.shift
+        if shift is None:
+            return None
+        try:
+            shift.check(np.asarray(values, float))
+        except ValueError as exc:
+            return str(exc)
+        return None
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         k = self.knots.size
