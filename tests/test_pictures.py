@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from axiform.case.labels import case_labels
 from axiform.case.schema import load
 from axiform.post.figures import new_figure, title, wrapped
-from axiform.post.labels import case_labels
 from axiform.post.load_curve_plot import load_curve_figure, load_curve_reason
 from axiform.post.plots import FolderInfo, field_values, plot_folder
 from axiform.post.thickness_plot import thickness_figure, z_runs

@@ -19,10 +19,10 @@ from conftest import RELAXING_BAR
 import axiform.solve.solver as solver
 from axiform.app.console import COLUMNS
 from axiform.app.sweep import monitor_extremes
+from axiform.case.labels import case_labels
 from axiform.case.schema import HISTORY_COLUMNS, load, parse
 from axiform.cli import main
 from axiform.io.files import series_times
-from axiform.post.labels import case_labels
 from axiform.post.load_curve_plot import load_curve_figure
 from axiform.post.results_folder import FolderInfo, read_history
 

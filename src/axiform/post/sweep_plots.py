@@ -7,14 +7,28 @@ as a flat line."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import numpy as np
 
 from .figures import new_figure, save, wrapped
 
-if TYPE_CHECKING:
-    from ..app.sweep import Sweep
+
+class Sweep(Protocol):
+    """What the picture needs of a sweep (app.sweep.Sweep has it): the base case file, the
+    varied keys, one dict of overrides per case and the monitor to report (None: none)."""
+
+    @property
+    def case_file(self) -> Path: ...
+
+    @property
+    def keys(self) -> list[str]: ...
+
+    @property
+    def cases(self) -> list[dict[str, Any]]: ...
+
+    @property
+    def report(self) -> str | None: ...
 
 
 def value_text(value: Any) -> str:
