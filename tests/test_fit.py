@@ -1,4 +1,4 @@
-"""`axiform fit` (DESIGN section 10.3): the incompressible test stresses of every law against
+"""`axiform fit` (docs/guide.md: axiform fit): the incompressible test stresses of every law against
 their closed forms, the Drucker check against differences of the energy, fitting recovers the
 constants that generated synthetic data, the command on Treloar's data, bad files refused
 with exit 2 and the line named."""

@@ -1,4 +1,4 @@
-"""`axiform optimize` (DESIGN 10.10): a free-blown tube programmed for a uniform final wall by
+"""`axiform optimize` (docs/guide.md: axiform optimize): a free-blown tube programmed for a uniform final wall by
 the gradient method (least squares with the Jacobian from direct differentiation), the
 fixed-point rule as the baseline, the output files, and refused inputs."""
 

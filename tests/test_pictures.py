@@ -1,4 +1,4 @@
-"""What the pictures of a results folder say (DESIGN 10.12, 11.1, 13): the load curve's axes by
+"""What the pictures of a results folder say: the load curve's axes by
 what drives the run, no panel of a quantity against itself, the reason a picture is missing,
 thickness against the reference arc length, titles that fit, the sweep's legend.  Built on
 small hand-written results folders, so that they run in a second."""

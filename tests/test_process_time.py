@@ -1,4 +1,4 @@
-"""Process time in the outputs (DESIGN 11.1): history.csv's column `time`, the timesteps of
+"""Process time in the outputs (docs/reference.md: Time in the outputs): history.csv's column `time`, the timesteps of
 fields.pvd, the progress line of a case whose load factor is a physical time, the time in the
 pictures' titles, and load_curve.png of a process against t with a panel per applied quantity.
 On a viscoelastic bar of four elements and hand-written results folders."""

@@ -71,7 +71,7 @@ __all__ = [
     "sensitivity",
     "Sensitivity",
 ]
-__version__ = "0.1.0"
+__version__ = "0.1.0"  # the version (pyproject.toml reads it from here)
 
 
 def __getattr__(name: str):

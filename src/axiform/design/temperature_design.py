@@ -1,6 +1,7 @@
-"""Temperature programming (DESIGN § 11.6): the design is the table of the initial
-temperature, `[temperature] initial = { along = "s" | "r" | "z", table = [[x_k, T_k], ...] }`;
-the T_k are the design variables, bounded to the table's range +- 30 K (or `--bounds LOW,HIGH`).
+"""Temperature programming (`axiform optimize --vary temperature`, docs/guide.md): the design
+is the table of the initial temperature,
+`[temperature] initial = { along = "s" | "r" | "z", table = [[x_k, T_k], ...] }`; the T_k
+are the design variables, bounded to the table's range +- 30 K (or `--bounds LOW,HIGH`).
 The thickness table stays fixed.  The optimizer works on y = T itself (the wall responds to a
 temperature through the law's tables and the shift, smoothly and without a natural scale of
 its own, unlike a thickness, worked on as ln t).
