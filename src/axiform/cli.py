@@ -277,11 +277,8 @@ def main(argv: list[str] | None = None) -> int:
                     f"argument --model: invalid choice: {args.model!r} "
                     f"(choose from {', '.join((*KEYS, *VISCOELASTIC_FITS))})"
                 )
-        import numpy as np
-
         try:
-            with np.errstate(all="ignore"):  # overflow and NaN are caught by the guards, not printed
-                return dispatch(args)
+            return dispatch(args)
         except KeyboardInterrupt:
             print("axiform: interrupted", file=sys.stderr)
             return 130
