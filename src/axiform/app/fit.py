@@ -30,7 +30,7 @@ import csv
 import json
 import math
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -80,9 +80,12 @@ def read_text(path: Path) -> str:
         raise FitDataError(f"{path}: cannot read ({exc.strerror or exc})") from None
 
 
-def read_data(paths: list[str | Path]) -> Data:
+def read_data(paths: Sequence[str | Path]) -> Data:
     """Read CSV files with the header mode,stretch,stress; FitDataError names the line."""
-    modes, stretches, stresses, notes = [], [], [], []
+    modes: list[int] = []
+    stretches: list[float] = []
+    stresses: list[float] = []
+    notes: list[str] = []
     for path in map(Path, paths):
         text = read_text(path)
         header, rows = None, len(modes)
@@ -269,6 +272,8 @@ def fit(data: Data, model: str, terms: int = 3, kappa: float | None = None) -> F
     k = kappa if kappa is not None else 1000.0 * fam.law(p).shear_modulus
     table = fam.table(p)
     law = MaterialSpec.model_validate(table | {"model": model, "kappa": k}).build()
+    if not isinstance(law, Hyperelastic):  # a table of constants without memory or tables of T
+        raise TypeError(f"the fitted {model} table built a {type(law).__name__}, not a hyperelastic law")
     r = _residual(fam, data, p)
     rms = {m: float(np.sqrt(np.mean(r[data.mode == i] ** 2))) for i, m in enumerate(MODES) if (data.mode == i).any()}
     stable = {m: stable_range(drucker_stable(law, m, STABILITY_STRETCHES)) for m in MODES}
@@ -291,8 +296,8 @@ def material_table(result: FitResult) -> str:
 
 def combined_range(result: FitResult) -> tuple[float, float] | None:
     """The stretch range stable in all three modes."""
-    ranges = list(result.stable.values())
-    if any(r is None for r in ranges):
+    ranges = [r for r in result.stable.values() if r is not None]
+    if len(ranges) < len(result.stable):
         return None
     return max(r[0] for r in ranges), min(r[1] for r in ranges)
 

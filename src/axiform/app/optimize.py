@@ -92,21 +92,23 @@ def picture(design: Design, result: OptimizeResult, target: tuple[np.ndarray, np
     ):
         mesh = design.model(values).mesh
         f = mesh.fibres
+        if f is None:  # no wall measured: refused when the design was read
+            raise ValueError("the design's mesh has no through-wall fibres")
         a, b = mesh.points[f[:, 0]], mesh.points[f[:, -1]]
         runs.append(PictureRun(name, colour, np.asarray(values, float), np.vstack([a, b[::-1], a[:1]]), it.thickness))
     end = float(design.control.target)
     moulds = [pair.surface.polyline() + pair.surface.offset(end) for pair in design.built.model.contacts]
     units = design.built.case.units
-    temperature = isinstance(design, TemperatureDesign)
+    along, limits = (design.along, design.limits) if isinstance(design, TemperatureDesign) else (None, None)
     return OptimizePicture(
         runs=runs,
         moulds=moulds,
         knots=design.knots,
-        along=design.along if temperature else None,
-        limits=design.limits if temperature else None,
+        along=along,
+        limits=limits,
         length_unit=units.length or "",
         temperature_unit=units.temperature or "",
-        stations=design.built.model.mesh.fibre_s,
+        stations=design.stations,
         target=target,
         rows=result.rows,
         tolerance=result.tolerance,
@@ -234,7 +236,7 @@ def prepare(case_file: Path, target_path: str, vary: str, bounds: str | None) ->
         return 2
     try:
         target = read_target(target_path)
-        Objective(design.built.model.mesh.fibre_s, *target, 1.0)
+        Objective(design.stations, *target, 1.0)
     except TargetError as exc:
         say(f"axiform: invalid target:\n--target: {exc}")
         return 2

@@ -140,7 +140,7 @@ def active_knots(design: Design, objective: Objective) -> np.ndarray:
     their values."""
     k = design.knots
     left, right = np.concatenate([[-np.inf], k[:-1]]), np.concatenate([k[1:], [np.inf]])
-    s_in = _stations(design, {"s": design.built.model.mesh.fibre_s})[objective.inside]
+    s_in = _stations(design, {"s": design.stations})[objective.inside]
     return ((s_in[None, :] > left[:, None]) & (s_in[None, :] < right[:, None])).any(axis=1)
 
 
@@ -166,6 +166,8 @@ def fixed_point(forward: Forward, initial: Iterate, max_iter: int, tolerance: fl
     best = current = initial
     while current.deviation > tolerance and len(forward.rows) <= max_iter:
         t = current.thickness
+        if t is None:  # a finished iterate has its wall (Forward): never here
+            break
         ratio = np.interp(design.knots, _stations(design, t)[inside], objective.target[inside] / t["thickness"][inside])
         ratio[~active] = 1.0
         current, _ = forward(np.clip(design.rule(current.design, ratio), lo, hi), False)
@@ -183,7 +185,7 @@ class LeastSquares:
     iterate is a row, and the callback stops the search at the first one within the
     tolerance or after max_iter iterations."""
 
-    def __init__(self, forward: Forward, initial: Iterate, first: tuple, max_iter: int, tolerance: float):
+    def __init__(self, forward: Forward, initial: Iterate, first: tuple | None, max_iter: int, tolerance: float):
         self.forward = forward
         self.active = active_knots(forward.design, forward.objective)
         self.x0 = initial.design
@@ -209,7 +211,10 @@ class LeastSquares:
     def fun(self, y) -> np.ndarray:
         it, rj = self.evaluate(y)
         if rj is None:  # the solve stopped (a design too thin to blow): a step to reject
-            r_best = self.forward.objective.residuals(self.best.thickness["thickness"], self.best.design)
+            wall = self.best.thickness  # the best iterate finished (the initial one at least)
+            if wall is None:
+                raise ValueError("the best iterate of the optimization has no wall")
+            r_best = self.forward.objective.residuals(wall["thickness"], self.best.design)
             return 10.0 * np.abs(r_best) + 1.0
         return rj[0]
 
@@ -270,7 +275,7 @@ def optimize(
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, not {method!r}")
     t0 = time.perf_counter()
-    objective = Objective(design.built.model.mesh.fibre_s, *target, float(design.initial.mean()), smoothness)
+    objective = Objective(design.stations, *target, float(design.initial.mean()), smoothness)
     forward = Forward(design, objective, report)
     initial, first = forward(design.initial.astype(float), method == "gradient")
     forward.record(initial)

@@ -14,6 +14,7 @@ ln(achieved / target) at the knot, from the last design.
 from __future__ import annotations
 
 import copy
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -21,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from ..case.schema import Built, CaseError, build, parse, read
+from ..materials.temperature import WLF, Arrhenius
 from .problem import CaseDesign, absolute_paths
 
 MARGIN = 30.0  # K: the default bounds, the table's range widened by this much
@@ -47,12 +49,12 @@ class TemperatureDesign(CaseDesign):
 
     @classmethod
     def from_case(
-        cls, path: str | Path, overrides: list[str] = (), bounds: tuple[float, float] | None = None
+        cls, path: str | Path, overrides: Sequence[str] = (), bounds: tuple[float, float] | None = None
     ) -> TemperatureDesign:
         """Read a case for temperature programming: a [temperature] whose initial field is a
         table, load control, a wall with thickness stations.  CaseError names the key."""
         path = Path(path)
-        tree = read(path, overrides)
+        tree = read(path, list(overrides))
         case = parse(tree)
         heat = case.temperature
         if heat is None or isinstance(heat.initial, float):
@@ -92,7 +94,7 @@ class TemperatureDesign(CaseDesign):
         WLF pole T_ref - C2, or not a positive absolute temperature), or None.  The table's
         field lies between its smallest and largest knot value, so the knots tell."""
         shift = self.built.model.shift
-        if shift is None:
+        if not isinstance(shift, (WLF, Arrhenius)):  # no shift: every temperature will do
             return None
         try:
             shift.check(np.asarray(values, float))
