@@ -133,7 +133,10 @@ def test_sigterm_in_the_final_run_exits_143_with_everything_kept(tmp_path):
     assert proc.returncode == 143, err
     assert "Traceback" not in err
     summary = json.loads((out / "optimize.json").read_text())
-    assert summary["status"] == "interrupted" and "the final run was interrupted (exit 143)" in summary["message"]
+    assert (
+        summary["status"] == "interrupted"
+        and "the final run was interrupted by SIGTERM (exit 143)" in summary["message"]
+    )
     assert summary["final"] == "final" and len(csv_rows(out / "optimize.csv")) == 2
     assert json.loads((out / "final" / "summary.json").read_text())["status"] == "interrupted"
     assert (out / "optimized.toml").exists()

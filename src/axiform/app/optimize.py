@@ -183,7 +183,8 @@ def run_final(out_dir: Path, design: Design, result: OptimizeResult, quiet: bool
         code = run_case(str(case_out), str(final), quiet=True)
     if code in INTERRUPTED:
         result.status = "interrupted"
-        result.message += f"; the final run was interrupted (exit {code}), its converged steps are kept"
+        name = signal.Signals(code - 128).name
+        result.message += f"; the final run was interrupted by {name} (exit {code}), its converged steps are kept"
     elif code != 0:
         result.status = "stopped"
         result.message += f"; the final run exited with {code}"
