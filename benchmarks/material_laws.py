@@ -33,8 +33,9 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _perf_common import RESULTS, load_average, machine, table, write_result  # noqa: E402
 
-from axiform.app.fit import MODES, combined_range, fit, read_data  # noqa: E402
+from axiform.app.fit import combined_range, fit, read_data  # noqa: E402
 from axiform.materials import ArrudaBoyce, Gent, MooneyRivlin, NeoHooke, Ogden, Yeoh  # noqa: E402
+from axiform.materials.homogeneous import MODES  # noqa: E402
 
 TRELOAR = RESULTS.parents[1] / "examples" / "data" / "treloar.csv"
 LAWS = {

@@ -4,14 +4,14 @@ Thick-walled cylinder r in [A, B] in plane strain (axial stretch 1) under intern
 
 - `lame_plane_strain`: small-strain (Lame) radial displacement.
 - `incompressible_cylinder_pressure`: exact large-strain pressure of an incompressible
-  Mooney-Rivlin tube (DESIGN.md section 8).
+  Mooney-Rivlin tube.
 - `RadialBVP`: the compressible law *exactly as implemented* (axiform.materials), reduced to
   the 1D radial boundary-value problem and solved with scipy's solve_bvp.  Only the
   constitutive routine is shared with the code under test; kinematics, equilibrium, boundary
   conditions and the discretization are independent.
 
-Viscoelasticity (a Prony series on the isochoric 2nd Piola-Kirchhoff stress, DESIGN.md
-section 11.2), with Mooney-Rivlin written anew in principal stretches
+Viscoelasticity (a Prony series on the isochoric 2nd Piola-Kirchhoff stress, docs/internals.md:
+Time, temperature and heat), with Mooney-Rivlin written anew in principal stretches
 (`mooney_rivlin_iso_pk2`) and the history integrated by scipy, no code of axiform used:
 
 - `uniaxial_prony`: a homogeneous compressible bar stretched along z, lateral faces free.

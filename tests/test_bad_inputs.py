@@ -1,4 +1,4 @@
-"""Bad inputs refused cleanly (DESIGN § 13): exit 2 with a message naming the key, or the file
+"""Bad inputs refused cleanly: exit 2 with a message naming the key, or the file
 and line, before any work; no traceback, no hang.  One test per family the fuzzing found or
 the issue named.  A family whose fix lies in files of other owners (cli.py, app/*, post/*)
 comes as a strict xfail test whose reason says the fix, its marker lifted with the fix."""

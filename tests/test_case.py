@@ -1,4 +1,4 @@
-"""The case-file contract (DESIGN section 7): invalid input refused before any work with the key
+"""The case-file contract (docs/reference.md: The case file): invalid input refused before any work with the key
 path and exit 2; history.csv and summary.json written as steps converge; exit 1 for a run
 that stopped short, with its converged steps kept; exit 0 when finished."""
 

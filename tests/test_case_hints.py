@@ -1,4 +1,4 @@
-"""What a person meets before a run (DESIGN § 13): "did you mean" for a misspelt key or word,
+"""What a person meets before a run: "did you mean" for a misspelt key or word,
 pre-run warnings of a built case (case.preflight), and the picture of `check --plot`."""
 
 import re

@@ -1,4 +1,4 @@
-"""`axiform fit --model prony|wlf` (DESIGN section 11.4): the series' moduli against the
+"""`axiform fit --model prony|wlf` (docs/guide.md): the series' moduli against the
 project's Prony convention and the complex modulus, a known 3-term series recovered from its
 relaxation modulus and from its DMA moduli, known WLF constants recovered (and moved to
 another reference by the exact change of reference), the command's files and their snippets

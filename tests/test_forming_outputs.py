@@ -15,10 +15,11 @@ import pytest
 from PIL import Image
 
 from axiform import rectangle
+from axiform.case.labels import case_labels
 from axiform.case.schema import CaseError, build, load, parse
 from axiform.cli import main
 from axiform.post.fields import point_fields
-from axiform.post.labels import case_labels, short
+from axiform.post.labels import short
 from axiform.post.plots import (
     FolderInfo,
     deformed_figure,
@@ -378,6 +379,9 @@ def test_cavity_pressure_monitor_is_the_load_axis(tmp_path):
         point_load=[],
         fix=[],
         contact=[],
+        cavity=[],
+        material=SimpleNamespace(viscoelastic=None),
+        thermal=None,
         units=SimpleNamespace(model_dump=lambda: {"length": "mm", "pressure": "MPa"}),
     )
     labels = case_labels(case)

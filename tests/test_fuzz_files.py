@@ -1,4 +1,4 @@
-"""Input fuzzing of the files the commands read besides the case file (DESIGN § 13): sweep files
+"""Input fuzzing of the files the commands read besides the case file: sweep files
 (`axiform sweep`), optimize targets (`axiform optimize --target`), fit data (`axiform fit`),
 DXF mould outlines (a [[contact]] surface, through `axiform check`) and damaged checkpoints
 (`axiform run --resume`).  Hypothesis writes them, valid and broken, and runs the command line

@@ -1,5 +1,5 @@
-"""Transient conduction (fem.heat, DESIGN § 11.5) against exact answers: a slab with a film
-on one face (series solution, several Biot numbers), an annulus with a film outside (Bessel
+"""Transient conduction (fem.heat, docs/internals.md: Time, temperature and heat) against exact
+answers: a slab with a film on one face (series solution, several Biot numbers), an annulus with a film outside (Bessel
 series), the energy balance of a step."""
 
 import numpy as np

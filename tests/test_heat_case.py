@@ -1,4 +1,4 @@
-"""Heat in the wall through the case file (DESIGN § 11.5): [thermal], [[convection]],
+"""Heat in the wall through the case file (docs/reference.md: [thermal] and [[convection]]): [thermal], [[convection]],
 [[contact]] temperature and conductance, monitors of a node's temperature, checkpoints,
 and the errors that name the key."""
 

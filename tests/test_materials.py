@@ -1,5 +1,5 @@
 """The Mooney-Rivlin law: P against the gradient of W, A against a difference of P, P against
-the 3x3 formula of DESIGN section 4 (with J = det F), and the reference state."""
+the 3x3 formula of the law's W (docs/internals.md: Hyperelastic laws; with J = det F), and the reference state."""
 
 import numpy as np
 import pytest
@@ -17,7 +17,7 @@ def random_F(rng, n, spread=0.3):
 
 
 def full_P(m, x):
-    """P from the 3x3 formula of DESIGN section 4, components in the order of x."""
+    """P from the 3x3 formula (dW/dF of the 3x3 F), components in the order of x."""
     F = np.array([[x[0], 0, x[1]], [0, x[4], 0], [x[2], 0, x[3]]])
     J = np.linalg.det(F)
     C = F.T @ F

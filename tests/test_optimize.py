@@ -1,4 +1,4 @@
-"""`axiform optimize` (DESIGN 10.10): a free-blown tube programmed for a uniform final wall by
+"""`axiform optimize` (docs/guide.md: axiform optimize): a free-blown tube programmed for a uniform final wall by
 the gradient method (least squares with the Jacobian from direct differentiation), the
 fixed-point rule as the baseline, the output files, and refused inputs."""
 
@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 import tomli_w
 
-from axiform.app.design import Objective, TargetError, read_target
 from axiform.case.schema import load
 from axiform.cli import main
+from axiform.design.problem import Objective, TargetError, read_target
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -119,7 +119,7 @@ def test_fixed_point_baseline_needs_more_forward_solves(runs):
 def test_every_element_reaches_the_uniform_target_in_3_forward_solves(tmp_path, element, formulation):
     """The free tube of the fixture (Q4 mixed) with the other elements and formulations, with
     the default settings: within 1 % in 3 forward solves (measured 0.36 % to 0.45 %)."""
-    from axiform.app.optimize import ThicknessDesign, optimize
+    from axiform.design.optimize import ThicknessDesign, optimize
 
     tree = copy.deepcopy(TUBE)
     tree["mesh"].update(element=element, formulation=formulation)
@@ -134,7 +134,7 @@ def test_a_creeping_viscoelastic_tube_reaches_its_target(tmp_path):
     """The free tube with a Prony series relaxing over 0.1 and 1 s, blown in 1 s by a gauge
     pressure ramped to 0.01 (it creeps: its outer radius at t = 1 is 17.5, the elastic tube's
     12.2), programmed by `axiform optimize` for a uniform 0.6: the Jacobian carries the
-    history of the series (app.sensitivity); within 1 % in 4 forward solves (measured: from
+    history of the series (design.sensitivity); within 1 % in 4 forward solves (measured: from
     25 % to 0.04 %; 13 solves when the shadows' history was not carried), and the final run
     is within it too."""
     tree = copy.deepcopy(TUBE)
@@ -232,7 +232,7 @@ def test_bottle_example_is_a_design_case():
     """examples/parison_bottle.toml is valid for `axiform optimize` (its run is measured in the
     README): a layered mesh, 21 design variables, load control, a target over the whole wall
     but the pinch-off's element."""
-    from axiform.app.optimize import ThicknessDesign
+    from axiform.design.problem import ThicknessDesign
 
     design = ThicknessDesign.from_case(EXAMPLES / "parison_bottle.toml")
     assert design.initial.tolist() == [2.0] * 21
@@ -247,7 +247,7 @@ def test_bottle_whole_wall_within_5_percent_in_fewer_forward_solves_than_the_rul
     """The bottle example on a coarser mesh (16 Q8 elements, 10 steps, a knot every 8 mm and at
     s = 68): the whole wall but the pinch-off's element, neck included, within 5 % of a uniform
     target; the gradient method needs 3 forward solves, the fixed-point rule 6."""
-    from axiform.app.optimize import ThicknessDesign, optimize
+    from axiform.design.optimize import ThicknessDesign, optimize
 
     tree = tomllib.loads((EXAMPLES / "parison_bottle.toml").read_text())
     for piece, n in zip(tree["mesh"]["profile"], (2, 2, 12), strict=False):

@@ -1,4 +1,4 @@
-"""What the pictures of a results folder say (DESIGN 10.12, 11.1, 13): the load curve's axes by
+"""What the pictures of a results folder say: the load curve's axes by
 what drives the run, no panel of a quantity against itself, the reason a picture is missing,
 thickness against the reference arc length, titles that fit, the sweep's legend.  Built on
 small hand-written results folders, so that they run in a second."""
@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from axiform.case.labels import case_labels
 from axiform.case.schema import load
 from axiform.post.figures import new_figure, title, wrapped
-from axiform.post.labels import case_labels
 from axiform.post.load_curve_plot import load_curve_figure, load_curve_reason
 from axiform.post.plots import FolderInfo, field_values, plot_folder
 from axiform.post.thickness_plot import thickness_figure, z_runs

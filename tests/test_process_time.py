@@ -1,4 +1,4 @@
-"""Process time in the outputs (DESIGN 11.1): history.csv's column `time`, the timesteps of
+"""Process time in the outputs (docs/reference.md: Time in the outputs): history.csv's column `time`, the timesteps of
 fields.pvd, the progress line of a case whose load factor is a physical time, the time in the
 pictures' titles, and load_curve.png of a process against t with a panel per applied quantity.
 On a viscoelastic bar of four elements and hand-written results folders."""
@@ -19,10 +19,10 @@ from conftest import RELAXING_BAR
 import axiform.solve.solver as solver
 from axiform.app.console import COLUMNS
 from axiform.app.sweep import monitor_extremes
+from axiform.case.labels import case_labels
 from axiform.case.schema import HISTORY_COLUMNS, load, parse
 from axiform.cli import main
 from axiform.io.files import series_times
-from axiform.post.labels import case_labels
 from axiform.post.load_curve_plot import load_curve_figure
 from axiform.post.results_folder import FolderInfo, read_history
 

@@ -1,4 +1,4 @@
-"""Never lose a run, never accept nonsense (DESIGN 10.9, 10.12): signals and crashes end with
+"""Never lose a run, never accept nonsense: signals and crashes end with
 a status and every converged step kept, result files parse after a kill -9 at any moment, the
 results-folder rule, -q, and every bad input of the reliability issue refused with its key
 path (exit 2) or stopped with the place named (exit 1), never a traceback."""

@@ -1,4 +1,4 @@
-"""What summary.json says about the whole run (DESIGN § 13): warnings (pre-run, `warn`, the
+"""What summary.json says about the whole run: warnings (pre-run, `warn`, the
 end-of-run checks, each printed once), the thinnest wall, per contact pair the largest force
 and penetration against the wall over the run, the stabilization's work; contact.csv leaves
 a gap with no surface empty; the VTU's stress components and hydrostatic_pressure."""

@@ -1,4 +1,4 @@
-"""Sensitivities by direct differentiation along the load path (axiform.app.sensitivity) against
+"""Sensitivities by direct differentiation along the load path (axiform.design.sensitivity) against
 central differences of whole forward solves: a free tube blown by a cavity under volume
 control, and tubes blown against a conical mould with sticky contact (mixed) and with
 Coulomb friction (mixed and displacement); nodes touch at different steps, so the history
@@ -9,8 +9,8 @@ import copy
 import numpy as np
 import pytest
 
-from axiform.app.sensitivity import DesignError, sensitivity
 from axiform.case.schema import build, parse
+from axiform.design.sensitivity import DesignError, sensitivity
 from axiform.post.thickness import thickness_table
 from axiform.solve.solver import ArcLengthControl, NewtonOptions, solve
 

@@ -1,4 +1,4 @@
-"""Sensitivities along the load path (axiform.app.sensitivity) with a viscoelastic law: a tube
+"""Sensitivities along the load path (axiform.design.sensitivity) with a viscoelastic law: a tube
 inflated in process time (t from 0 to 1) by a cavity under volume or pressure control, its
 Prony series relaxing over 0.1 and 1 (times comparable to the process), so that the
 residual of every step depends on the history h_i committed before it.  The derivatives of
@@ -14,8 +14,8 @@ import copy
 import numpy as np
 import pytest
 
-from axiform.app.sensitivity import sensitivity, thickness_derivative
 from axiform.case.schema import build, parse
+from axiform.design.sensitivity import sensitivity, thickness_derivative
 from axiform.post.thickness import thickness_table
 from axiform.solve.linsolve import factorize
 from axiform.solve.solver import solve

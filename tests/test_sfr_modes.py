@@ -1,5 +1,5 @@
-"""Zero-energy modes of the stiffness at the reference state (DESIGN.md 3, "Things to know
-about SFR"), counted from the eigenvalues of the dense global matrix of small meshes.
+"""Zero-energy modes of the stiffness at the reference state (docs/internals.md:
+Elements), counted from the eigenvalues of the dense global matrix of small meshes.
 
 How zero is counted: K is symmetric positive semi-definite at the reference state (no stress,
 no load), so its eigenvalues are computed by eigh with an absolute error of about

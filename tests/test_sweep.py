@@ -1,4 +1,4 @@
-"""`axiform sweep` (DESIGN 10.8): cases on a Dask LocalCluster, each in its own results
+"""`axiform sweep` (docs/reference.md: Sweep file): cases on a Dask LocalCluster, each in its own results
 folder and a row of sweep.csv; a failing case recorded, not fatal; resume skips the
 finished ones; an invalid sweep file refused with exit 2 before any work."""
 

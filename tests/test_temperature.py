@@ -1,4 +1,4 @@
-"""Temperature in the law (DESIGN § 11.3): the shift of the relaxation times (WLF, Arrhenius),
+"""Temperature in the law (docs/reference.md: [temperature]): the shift of the relaxation times (WLF, Arrhenius),
 constants as tables of T, the [temperature] table of a case, and its outputs."""
 
 import json

@@ -1,4 +1,4 @@
-"""Temperature programming (DESIGN § 11.6, `axiform optimize --vary temperature`): the
+"""Temperature programming (`axiform optimize --vary temperature`, docs/guide.md): the
 sensitivity of the final wall to each knot of the initial temperature table against central
 differences of whole solves, and a reachable target (the wall left by a known profile)
 reached within 1 % in fewer forward solves than the fixed-point rule."""
@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 import tomli_w
 
-from axiform.app.sensitivity import sensitivity
 from axiform.case.schema import build, parse
 from axiform.cli import main
+from axiform.design.sensitivity import sensitivity
 from axiform.post.thickness import thickness_table
 from axiform.solve.solver import solve
 

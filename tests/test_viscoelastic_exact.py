@@ -1,4 +1,4 @@
-"""Exact answers for the Prony series (DESIGN.md section 11.2) on problems whose reference
+"""Exact answers for the Prony series (docs/internals.md: Time, temperature and heat) on problems whose reference
 solutions are written here independently of the finite element code (tests/oracles.py):
 the order of the time integration on a homogeneous bar, and a thin sphere inflated at a
 constant stretch rate, then under a held pressure (creep)."""

@@ -2,6 +2,15 @@
 
 The names below are imported on first use (PEP 562), so that `import axiform.cli` does not
 load NumPy, SciPy and the element code before a command needs them.
+
+The packages, in layers (a package imports only from its own layer and those before it, and
+no module imports another that imports it back; tests/test_architecture.py checks both):
+materials < fem < contact < model < solve < post < io < case < design < app < cli.
+materials: the laws; fem: meshes, elements, assembly, heat; contact: moulds and their pairs;
+model: the residual's terms and the model that sums them; solve: the load paths; post: what is
+read off a solution and drawn (fields, thickness, pictures); io: the results folder; case: the
+case file and what it builds; design: sensitivities and design loops; app: the commands; cli:
+the command line.
 """
 
 from importlib import import_module
@@ -23,8 +32,8 @@ _WHERE = {
     "Model": "model.model",
     "select_edges": "fem.selectors",
     "select_nodes": "fem.selectors",
-    "Sensitivity": "app.sensitivity",
-    "sensitivity": "app.sensitivity",
+    "Sensitivity": "design.sensitivity",
+    "sensitivity": "design.sensitivity",
     "ArcLengthControl": "solve.controls",
     "DisplacementControl": "solve.controls",
     "LoadControl": "solve.controls",
@@ -62,7 +71,7 @@ __all__ = [
     "sensitivity",
     "Sensitivity",
 ]
-__version__ = "0.1.0"
+__version__ = "0.1.0"  # the version (pyproject.toml reads it from here)
 
 
 def __getattr__(name: str):

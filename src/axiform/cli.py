@@ -1,6 +1,6 @@
 """`axiform run CASE.toml [--out DIR]`, `axiform check CASE.toml [--plot [PNG]]`, `axiform plot
 DIR`, `axiform fit DATA.csv --model MODEL` (app/fit.py; prony and wlf: app/fit_viscoelastic.py),
-`axiform optimize CASE.toml --target T.csv --out DIR` (app/optimize.py), `axiform sweep
+`axiform optimize CASE.toml --target T.csv --out DIR` (app/optimize.py, design/), `axiform sweep
 SWEEP.toml --out DIR` (app/sweep.py).
 
 Exit codes: 0 finished, 1 stopped (converged steps kept), 2 invalid case (refused before any
@@ -277,11 +277,8 @@ def main(argv: list[str] | None = None) -> int:
                     f"argument --model: invalid choice: {args.model!r} "
                     f"(choose from {', '.join((*KEYS, *VISCOELASTIC_FITS))})"
                 )
-        import numpy as np
-
         try:
-            with np.errstate(all="ignore"):  # overflow and NaN are caught by the guards, not printed
-                return dispatch(args)
+            return dispatch(args)
         except KeyboardInterrupt:
             print("axiform: interrupted", file=sys.stderr)
             return 130

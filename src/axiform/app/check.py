@@ -6,12 +6,13 @@ unless a path is given, and where it went on stdout."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 from .console import failed, invalid, say, tell, warn
 
 
-def check(case_path: str, overrides: list[str] = (), plot: str | None = None) -> int:
+def check(case_path: str, overrides: Sequence[str] = (), plot: str | None = None) -> int:
     """Validate a case and build its model, without solving; returns the exit code (0 valid,
     2 invalid, 3 an unexpected error).  plot: the PNG to draw the case in, or None."""
     from ..case.preflight import preflight
@@ -19,7 +20,7 @@ def check(case_path: str, overrides: list[str] = (), plot: str | None = None) ->
 
     case_file = Path(case_path)
     try:
-        built = build(parse(read(case_file, overrides)), case_file.parent)
+        built = build(parse(read(case_file, list(overrides))), case_file.parent)
     except CaseError as exc:
         return invalid(case_file, exc)
     except Exception as exc:  # noqa: BLE001 - a fault of axiform's, not of the case: exit 3

@@ -18,6 +18,7 @@ import time
 import traceback
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 # the widest progress line (a terminal's width when it is narrower)
 COLUMNS = 80
@@ -140,7 +141,7 @@ class ProgressLine:
         self.quiet = quiet
         self.tty = stream.isatty() and not quiet
         self.t0 = time.perf_counter()
-        self._bar = None
+        self._bar: Any = None  # a tqdm bar, made at the first update on a terminal
 
     @property
     def elapsed(self) -> float:

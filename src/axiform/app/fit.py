@@ -30,9 +30,8 @@ import csv
 import json
 import math
 import sys
-from collections.abc import Callable
-from dataclasses import dataclass, field
-from functools import cached_property
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -41,11 +40,19 @@ from scipy.optimize import least_squares, lsq_linear
 from ..case.material import KEYS, MAX_OGDEN_TERMS, MaterialSpec
 from ..case.schema import MAX_MAGNITUDE, MIN_MAGNITUDE
 from ..materials import ArrudaBoyce, Gent, Hyperelastic, MooneyRivlin, Ogden, Yeoh
+from ..materials.homogeneous import (
+    MODES,
+    STABILITY_STRETCHES,
+    Data,
+    FitResult,
+    drucker_stable,
+    kinematics,
+    nominal,
+    stable_range,
+)
 from ..post.fit_plots import plot_fit as plot
 from .run import prepare_folder
 
-MODES = ("uniaxial", "equibiaxial", "planar")
-STABILITY_STRETCHES = 10.0 ** np.linspace(-1.0, 1.0, 401)  # 0.1 to 10, 1 in the middle
 # the stretches and stresses a data file may hold: beyond them the fit's powers overflow
 STRETCH_RANGE = (1e-3, 1e3)
 ALPHA_BOUND = 25.0  # |alpha_i| of the Ogden fit, so that lambda^alpha stays finite
@@ -63,27 +70,6 @@ class FitDataError(ValueError):
     """A bad data file: the message names the file and the line."""
 
 
-@dataclass
-class Data:
-    """Test points: mode (n) as an index into MODES, stretch (n), nominal stress (n)."""
-
-    mode: np.ndarray
-    stretch: np.ndarray
-    stress: np.ndarray
-    notes: list[str] = field(default_factory=list)
-
-    def count(self, mode: str) -> int:
-        return int(np.sum(self.mode == MODES.index(mode)))
-
-    @cached_property
-    def x(self) -> np.ndarray:
-        """F components (n, 5) of every point's incompressible test."""
-        x = np.empty((len(self.stretch), 5))
-        for i, mode in enumerate(MODES):
-            x[self.mode == i] = kinematics(mode, self.stretch[self.mode == i])
-        return x
-
-
 def read_text(path: Path) -> str:
     """The text of a data file; FitDataError names the file where it cannot be read."""
     try:
@@ -94,9 +80,12 @@ def read_text(path: Path) -> str:
         raise FitDataError(f"{path}: cannot read ({exc.strerror or exc})") from None
 
 
-def read_data(paths: list[str | Path]) -> Data:
+def read_data(paths: Sequence[str | Path]) -> Data:
     """Read CSV files with the header mode,stretch,stress; FitDataError names the line."""
-    modes, stretches, stresses, notes = [], [], [], []
+    modes: list[int] = []
+    stretches: list[float] = []
+    stresses: list[float] = []
+    notes: list[str] = []
     for path in map(Path, paths):
         text = read_text(path)
         header, rows = None, len(modes)
@@ -150,59 +139,6 @@ def read_data(paths: list[str | Path]) -> Data:
         if len(modes) == rows:
             raise FitDataError(f"{path}: no data rows")
     return Data(np.array(modes), np.array(stretches), np.array(stresses), notes)
-
-
-def kinematics(mode: str, lam: np.ndarray) -> np.ndarray:
-    """x = F components (n, 5) of the incompressible test, loading direction r, thickness z."""
-    lam = np.asarray(lam, float)
-    one = np.ones_like(lam)
-    lateral, thickness = {
-        "uniaxial": (lam**-0.5, lam**-0.5),
-        "equibiaxial": (lam, lam**-2.0),
-        "planar": (one, 1.0 / lam),
-    }[mode]
-    zero = np.zeros_like(lam)
-    return np.stack([lam, zero, zero, thickness, lateral], axis=-1)
-
-
-def nominal_stress(law: Hyperelastic, mode: str, lam: np.ndarray) -> np.ndarray:
-    """Nominal stress (n) in the loading direction of the incompressible test."""
-    return _nominal(law, kinematics(mode, lam))
-
-
-def _nominal(law: Hyperelastic, x: np.ndarray) -> np.ndarray:
-    """Nominal stress (n) of the tests x (n, 5): loading direction r, free thickness z."""
-    with np.errstate(all="ignore"):
-        P = law.iso_stress(x)
-    return P[..., 0] - x[..., 3] / x[..., 0] * P[..., 3]
-
-
-def drucker_stable(law: Hyperelastic, mode: str, lam: np.ndarray) -> np.ndarray:
-    """True (n) where the Hessian of W_iso in the log principal strains is positive definite."""
-    x = kinematics(mode, lam)
-    with np.errstate(all="ignore"):
-        P, A = law.iso_stress_tangent(x)
-        k = [0, 4, 3]  # principal directions: loading r, lateral theta, thickness z
-        lp = x[..., k]
-        M = lp[..., :, None] * A[..., k, :][..., :, k] * lp[..., None, :]
-        M[..., [0, 1, 2], [0, 1, 2]] += lp * P[..., k]
-        N = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, -1.0]])  # d ln(lambda_k) / d eps_i
-        D = N.T @ M @ N
-        det = D[..., 0, 0] * D[..., 1, 1] - D[..., 0, 1] * D[..., 1, 0]
-        return (D[..., 0, 0] > 0) & (det > 0)
-
-
-def stable_range(stable: np.ndarray, lam: np.ndarray = STABILITY_STRETCHES) -> tuple[float, float] | None:
-    """The stretch interval around 1 on which every point of the grid is stable (None if
-    stretch 1 itself is not)."""
-    mid = int(np.argmin(np.abs(np.log(lam))))
-    if not stable[mid]:
-        return None
-    below = np.flatnonzero(~stable[:mid])
-    above = np.flatnonzero(~stable[mid:])
-    lo = below.max() + 1 if below.size else 0
-    hi = mid + above.min() - 1 if above.size else len(lam) - 1
-    return float(lam[lo]), float(lam[hi])
 
 
 @dataclass(frozen=True)
@@ -282,22 +218,9 @@ def family(model: str, terms: int = 3) -> Family:
     raise ValueError(f"unknown model {model!r}")
 
 
-@dataclass
-class FitResult:
-    """The fitted law (kappa as asked), its constants, and how well and where it holds."""
-
-    model: str
-    terms: int | None
-    law: Hyperelastic
-    table: dict
-    rms: dict[str, float]
-    stable: dict[str, tuple[float, float] | None]
-    points: dict[str, int]
-
-
 def _residual(fam: Family, data: Data, p: np.ndarray) -> np.ndarray:
     """Relative errors (n); non-finite model stresses (Gent beyond its limit) count as huge."""
-    r = (_nominal(fam.law(p), data.x) - data.stress) / np.abs(data.stress)
+    r = (nominal(fam.law(p), data.x) - data.stress) / np.abs(data.stress)
     return np.nan_to_num(r, nan=1e6, posinf=1e6, neginf=-1e6)
 
 
@@ -325,7 +248,7 @@ def fit(data: Data, model: str, terms: int = 3, kappa: float | None = None) -> F
     for b in fam.nonlinear_starts(data):
         b = np.clip(b, nl_lo, nl_hi)
         # the stress is linear in the first n constants: columns = stress of unit constants
-        basis = np.stack([_nominal(fam.law(np.concatenate([e, b])), data.x) for e in np.eye(n)], axis=1)
+        basis = np.stack([nominal(fam.law(np.concatenate([e, b])), data.x) for e in np.eye(n)], axis=1)
         a = lsq_linear(basis * w[:, None], np.sign(data.stress), bounds=(lin_lo, np.full(n, np.inf))).x
         p0 = np.clip(np.concatenate([a, b]), lo, hi)
         sol = least_squares(
@@ -349,6 +272,8 @@ def fit(data: Data, model: str, terms: int = 3, kappa: float | None = None) -> F
     k = kappa if kappa is not None else 1000.0 * fam.law(p).shear_modulus
     table = fam.table(p)
     law = MaterialSpec.model_validate(table | {"model": model, "kappa": k}).build()
+    if not isinstance(law, Hyperelastic):  # a table of constants without memory or tables of T
+        raise TypeError(f"the fitted {model} table built a {type(law).__name__}, not a hyperelastic law")
     r = _residual(fam, data, p)
     rms = {m: float(np.sqrt(np.mean(r[data.mode == i] ** 2))) for i, m in enumerate(MODES) if (data.mode == i).any()}
     stable = {m: stable_range(drucker_stable(law, m, STABILITY_STRETCHES)) for m in MODES}
@@ -371,8 +296,8 @@ def material_table(result: FitResult) -> str:
 
 def combined_range(result: FitResult) -> tuple[float, float] | None:
     """The stretch range stable in all three modes."""
-    ranges = list(result.stable.values())
-    if any(r is None for r in ranges):
+    ranges = [r for r in result.stable.values() if r is not None]
+    if len(ranges) < len(result.stable):
         return None
     return max(r[0] for r in ranges), min(r[1] for r in ranges)
 
@@ -438,7 +363,7 @@ def run(paths: list[str], model: str, terms: int | None, out: str | None, kappa:
     }
     (folder / "fit.json").write_text(json.dumps(summary, indent=2) + "\n")
     for mode in result.points:
-        plot(result, data, mode, folder / f"fit_{mode}.png", MODES, nominal_stress)
+        plot(result, data, mode, folder / f"fit_{mode}.png")
     print(f"{_name(result)} fitted to {counts} points; initial shear modulus {result.law.shear_modulus:.6g}\n")
     print(table)
     print(f"{'mode':<12} {'points':>6}  RMS relative error")

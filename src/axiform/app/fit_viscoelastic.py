@@ -55,7 +55,10 @@ def read_table(path: str | Path, kinds: tuple[str, ...]) -> Table:
     """Read a CSV file whose header is one of HEADERS[kinds]; FitDataError names the line."""
     path = Path(path)
     text = read_text(path)
-    header, kind, rows, lines = None, None, [], []
+    header: list[str] | None = None
+    kind: str | None = None
+    rows: list[list[float]] = []
+    lines: list[int] = []
     wanted = " or ".join(",".join(HEADERS[k]) for k in kinds)
     for number, row in enumerate(csv.reader(text.splitlines()), start=1):
         cells = [c.strip() for c in row]
@@ -85,7 +88,7 @@ def read_table(path: str | Path, kinds: tuple[str, ...]) -> Table:
                 )
         rows.append(values)
         lines.append(number)
-    if header is None:
+    if header is None or kind is None:
         raise FitDataError(f"{path} line 1: no header {wanted}")
     if not rows:
         raise FitDataError(f"{path}: no data rows")

@@ -1,351 +1,159 @@
-"""Parison and preform programming: the initial wall thickness table of a
-layered case that gives a wanted final wall (`--vary thickness`), or the initial temperature
-table (`--vary temperature`, app.temperature_design: temperature programming).
+"""`axiform optimize`: the command around axiform.design.optimize.
 
-Design: the thicknesses t_k of the case's `mesh.thickness` table [[s_k, t_k], ...], bounded
-to 0.2 to 5 times their initial values (or the T_k of `[temperature] initial`, bounded to the
-table's range +- 30 K).  Objective (`Objective`): the mean squared relative
-misfit of the final thickness to the target over the reference arc length,
-int ln(t / T)^2 ds / L over the stations inside the target's range (ln(t / T) = (t - T) / T
-to first order; a wall scales with its parison, so that ln t is nearly linear in the
-logarithm of the design), plus a small smoothness term on the design, `smoothness` times the
-sum of its squared second differences relative to its initial mean.
-
-Methods:
-- "gradient": SciPy's bound-constrained trust-region reflective least squares
-  (`scipy.optimize.least_squares`, method "trf") over ln t_k, with the Jacobian of the final
-  thickness to the design from direct differentiation along the load path (axiform.app.sensitivity): a
-  Gauss-Newton method, which needs few forward solves because the whole Jacobian (stations x
-  design) comes with each solve;
-- "fixed-point": the plain rule, each t_k scaled by target / achieved at its station s_k.
-Both stop at the first design whose final wall is within `tolerance` (max relative
-deviation) of the target, or after max_iter iterations.  Knots whose interpolation reaches
-no station of the target keep their values.
+It keeps its work as it goes: optimize.csv gets a row per iteration as the iteration is
+found, optimized.toml the best finished design so far (a case file that runs as it is); at
+the end optimize.json, optimize.png and the run of the best design in final/.  SIGINT or
+SIGTERM, also during the final run, stops it with exit 130 or 143 and these files kept
+(optimize.json then says "interrupted").  Exit 0 finished, 1 stopped short, 2 invalid input.
 """
 
 from __future__ import annotations
 
 import contextlib
+import csv
 import io
 import json
+import signal
 import time
-from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from ..post.optimize_plots import plot_optimization
-from ..post.thickness import thickness_table
-from ..solve.solver import solve
-from .design import SMOOTHNESS, Objective, TargetError, ThicknessDesign, read_target
-from .sensitivity import sensitivity
-from .temperature_design import TemperatureDesign
+from ..design.optimize import TOLERANCE, Design, Iterate, OptimizeResult, Row, case_text, optimize
+from ..design.problem import SMOOTHNESS, Objective, TargetError, ThicknessDesign, read_target
+from ..design.temperature_design import TemperatureDesign
+from ..io.files import write_atomic
+from ..post.optimize_plots import OptimizePicture, PictureRun, plot_optimization
+from .console import say
+from .run import Interrupted, Stops
 
-Design = ThicknessDesign | TemperatureDesign
-VARY = {"thickness": ThicknessDesign, "temperature": TemperatureDesign}
-
-METHODS = ("gradient", "fixed-point")
-TOLERANCE = 0.01
-Row = tuple[int, float, float, int]  # a row of optimize.csv: iteration, objective, deviation, forward solves
+INTERRUPTED = (128 + signal.SIGINT, 128 + signal.SIGTERM)  # the exit codes 130, 143
+Target = tuple[np.ndarray, np.ndarray]  # the target wall: s (k,), thickness (k,)
+HEADER = ("iteration", "objective", "max_rel_deviation", "forward_solves")
 
 
-@dataclass
-class Iterate:
-    """One forward solve of the optimization: the design, its final thickness table, the
-    objective and the max relative deviation, and whether the solve finished."""
+class Progress:
+    """The iterations of one optimization as they come (the `report` of design.optimize):
+    each row rewrites optimize.csv and a better finished design optimized.toml, both whole
+    (an atomic replace) and inside `stops.held()`, so that a signal waits for the file."""
 
-    design: np.ndarray
-    thickness: dict[str, np.ndarray] | None
-    objective: float
-    deviation: float
-    finished: bool
-    message: str = ""
-
-
-@dataclass
-class OptimizeResult:
-    """rows: (iteration, objective, max_rel_deviation, forward_solves) per iteration (the
-    initial design is iteration 0); best: the best finished iterate; initial: the first;
-    tolerance: the max relative deviation aimed at; reached: it was met; status "finished"
-    (reached or converged) or "stopped"."""
-
-    method: str
-    tolerance: float
-    rows: list[Row]
-    initial: Iterate
-    best: Iterate
-    forward_solves: int
-    reached: bool
-    status: str
-    message: str
-    wall_time_s: float
-
-
-class Forward:
-    """The forward solves of one optimization, counted, and its iterations, recorded as rows
-    of optimize.csv (`report(row)` is called with each as it comes)."""
-
-    def __init__(self, design: Design, objective: Objective, report: Callable[[Row], None] | None = None):
-        self.design = design
-        self.objective = objective
-        self.report = report
-        self.solves = 0
+    def __init__(self, out: Path, design: Design, stops: Stops, quiet: bool):
+        self.out, self.design, self.stops, self.quiet = out, design, stops, quiet
         self.rows: list[Row] = []
+        self.initial: Iterate | None = None
+        self.best: Iterate | None = None
+        self.t0 = time.perf_counter()
 
-    def __call__(self, x: np.ndarray, gradient: bool) -> tuple[Iterate, tuple | None]:
-        """Solve the case with the design x: the iterate, and (residuals, their Jacobian to
-        the design, None without gradient) when the solve finished, else None."""
-        design = self.design
-        self.solves += 1
-        if gradient:
-            sens = sensitivity(design.model, x, design.control, design.built.options, keep_steps=False)
-            result, table, jac = sens.solve, sens.thickness, sens.dthickness_ds
-        else:
-            model = design.model(x)
-            result = solve(model, design.control, design.built.options)
-            last = result.last
-            table = None if last is None else thickness_table(model.mesh, last.u.reshape(-1, model.dpn)[:, :2])
-            jac = None
-        if result.status != "finished":
-            return Iterate(x.copy(), table, np.inf, np.inf, False, result.message), None
-        r = self.objective.residuals(table["thickness"], x)
-        it = Iterate(x.copy(), table, float(r @ r), self.objective.max_rel_deviation(table["thickness"]), True)
-        return it, (r, None if jac is None else self.objective.jacobian(table["thickness"], jac))
-
-    def record(self, it: Iterate) -> None:
-        """A row of optimize.csv for the iterate."""
-        row = (len(self.rows), it.objective, it.deviation, self.solves)
+    def __call__(self, row: Row, it: Iterate) -> None:
         self.rows.append(row)
-        if self.report:
-            self.report(row)
+        self.initial = self.initial or it
+        better = it.finished and (self.best is None or it.objective < self.best.objective)
+        if better:
+            self.best = it
+        with self.stops.held():
+            write_atomic(self.out / "optimize.csv", csv_text(self.rows))
+            if better:
+                write_atomic(self.out / "optimized.toml", case_text(self.design, it.design))
+        if not self.quiet:
+            say(
+                f"iteration {row[0]}  objective {row[1]:.4g}  max deviation {100 * row[2]:.3g} %  "
+                f"forward solves {row[3]}"
+            )
 
-
-def active_knots(design: Design, objective: Objective) -> np.ndarray:
-    """The knots whose interpolation reaches a station of the target (k,): the others keep
-    their values."""
-    k = design.knots
-    left, right = np.concatenate([[-np.inf], k[:-1]]), np.concatenate([k[1:], [np.inf]])
-    s_in = _stations(design, {"s": design.built.model.mesh.fibre_s})[objective.inside]
-    return ((s_in[None, :] > left[:, None]) & (s_in[None, :] < right[:, None])).any(axis=1)
-
-
-def _stations(design, table: dict[str, np.ndarray]) -> np.ndarray:
-    """The positions of the wall's stations in the design table's coordinate (s, or the
-    reference r or z of a temperature table along them)."""
-    along = getattr(design, "along", "s")
-    if along == "s":
-        return table["s"]
-    mesh = design.built.model.mesh
-    f = mesh.fibres
-    return 0.5 * (mesh.points[f[:, 0], "rz".index(along)] + mesh.points[f[:, -1], "rz".index(along)])
-
-
-def fixed_point(forward: Forward, initial: Iterate, max_iter: int, tolerance: float) -> tuple[Iterate, str]:
-    """The plain rule of the design (`design.rule`: each t_k scaled by target / achieved at
-    its knot; a temperature raised where the wall is too thick), from the last design, better
-    or not; the best iterate and why it stopped ("" unless a solve did)."""
-    design, objective = forward.design, forward.objective
-    active = active_knots(design, objective)
-    lo, hi = design.bounds()
-    inside = objective.inside
-    best = current = initial
-    while current.deviation > tolerance and len(forward.rows) <= max_iter:
-        t = current.thickness
-        ratio = np.interp(design.knots, _stations(design, t)[inside], objective.target[inside] / t["thickness"][inside])
-        ratio[~active] = 1.0
-        current, _ = forward(np.clip(design.rule(current.design, ratio), lo, hi), False)
-        if not current.finished:
-            return best, f"the forward solve of iteration {len(forward.rows)} stopped: {current.message}"
-        forward.record(current)
-        if current.objective < best.objective:
-            best = current
-    return best, ""
-
-
-class LeastSquares:
-    """The gradient method: SciPy's least_squares (trust-region reflective) over y = ln t_k
-    of the active knots, each forward solve done once (a cache by design); every accepted
-    iterate is a row, and the callback stops the search at the first one within the
-    tolerance or after max_iter iterations."""
-
-    def __init__(self, forward: Forward, initial: Iterate, first: tuple, max_iter: int, tolerance: float):
-        self.forward = forward
-        self.active = active_knots(forward.design, forward.objective)
-        self.x0 = initial.design
-        self.y0 = forward.design.to_y(self.x0[self.active])
-        self.cache: dict[bytes, tuple[Iterate, Any]] = {self.y0.tobytes(): (initial, first)}
-        self.best = self.last = initial
-        self.max_iter = max_iter
-        self.tolerance = tolerance
-        self.reached = False
-
-    def evaluate(self, y) -> tuple[Iterate, Any]:
-        y = np.asarray(y, float)
-        key = y.tobytes()
-        if key not in self.cache:
-            x = self.x0.copy()
-            x[self.active] = self.forward.design.from_y(y)
-            self.cache[key] = self.forward(x, True)
-            it = self.cache[key][0]
-            if it.finished and it.objective < self.best.objective:
-                self.best = it
-        return self.cache[key]
-
-    def fun(self, y) -> np.ndarray:
-        it, rj = self.evaluate(y)
-        if rj is None:  # the solve stopped (a design too thin to blow): a step to reject
-            r_best = self.forward.objective.residuals(self.best.thickness["thickness"], self.best.design)
-            return 10.0 * np.abs(r_best) + 1.0
-        return rj[0]
-
-    def jac(self, y) -> np.ndarray:
-        it, rj = self.evaluate(y)
-        return rj[1][:, self.active] * self.forward.design.dx_dy(it.design[self.active])  # dr/dy = dr/dx dx/dy
-
-    def callback(self, intermediate_result) -> None:
-        """After each iteration of the optimizer: record the iterate it accepted (if new);
-        StopIteration when it is within the tolerance or the iterations are spent."""
-        it = self.evaluate(intermediate_result.x)[0]
-        if it is not self.last:
-            self.forward.record(it)
-            self.last = it
-        if it.finished and it.deviation <= self.tolerance:
-            self.reached = True
-            raise StopIteration
-        if len(self.forward.rows) > self.max_iter:
-            raise StopIteration
-
-    def run(self) -> tuple[Iterate, bool, str]:
-        """The best iterate, whether the optimizer converged to a best fit (that misses the
-        tolerance), and why it stopped."""
-        from scipy.optimize import least_squares
-
-        lo, hi = self.forward.design.bounds()
-        bounds = (self.forward.design.to_y(lo[self.active]), self.forward.design.to_y(hi[self.active]))
-        out = least_squares(
-            self.fun,
-            self.y0,
-            jac=self.jac,
-            bounds=bounds,
-            method="trf",
-            max_nfev=4 * self.max_iter + 4,
-            callback=self.callback,
-        )
-        converged = out.status > 0
-        if converged:
-            message = f"the optimizer converged to a best fit: {out.message}"
-        elif out.status == -2 and not self.reached:
-            message = f"the tolerance was not reached in {self.max_iter} iterations"
-        else:
-            message = "" if self.reached else out.message
-        return self.best, converged, message
-
-
-def optimize(
-    design: Design,
-    target: tuple[np.ndarray, np.ndarray],
-    method: str = "gradient",
-    max_iter: int = 20,
-    tolerance: float = TOLERANCE,
-    smoothness: float = SMOOTHNESS,
-    report: Callable[[Row], None] | None = None,
-) -> OptimizeResult:
-    """Find the thickness table whose final wall meets the target (module docstring).
-    report(row) is called with each row of optimize.csv as it comes."""
-    if method not in METHODS:
-        raise ValueError(f"method must be one of {METHODS}, not {method!r}")
-    t0 = time.perf_counter()
-    objective = Objective(design.built.model.mesh.fibre_s, *target, float(design.initial.mean()), smoothness)
-    forward = Forward(design, objective, report)
-    initial, first = forward(design.initial.astype(float), method == "gradient")
-    forward.record(initial)
-    if not initial.finished:
+    def interrupted(self, method: str, tolerance: float, exc: Interrupted) -> OptimizeResult:
+        """The result so far, status "interrupted" (no iterate yet: the initial design unsolved)."""
+        nothing = Iterate(self.design.initial.astype(float), None, np.inf, np.inf, False, str(exc))
+        initial = self.initial or nothing
+        best = self.best or initial
+        solves = self.rows[-1][3] if self.rows else 0
+        message = f"{exc}; the iterations so far are kept"
+        wall = time.perf_counter() - self.t0
         return OptimizeResult(
-            method,
-            tolerance,
-            forward.rows,
-            initial,
-            initial,
-            forward.solves,
-            False,
-            "stopped",
-            f"the forward solve of the initial design stopped: {initial.message}",
-            time.perf_counter() - t0,
+            method, tolerance, list(self.rows), initial, best, solves, False, "interrupted", message, wall
         )
-    best, converged, message = initial, False, ""  # converged: a best fit that misses the tolerance
-    if method == "fixed-point":
-        best, message = fixed_point(forward, initial, max_iter, tolerance)
-    elif initial.deviation > tolerance:
-        best, converged, message = LeastSquares(forward, initial, first, max_iter, tolerance).run()
-    reached = best.deviation <= tolerance
-    if reached:
-        message = f"the final wall is within {tolerance:.3g} of the target"
-    elif not message:
-        message = f"the tolerance was not reached in {max_iter} iterations"
-    status = "finished" if reached or converged else "stopped"
-    return OptimizeResult(
-        method,
-        tolerance,
-        forward.rows,
-        initial,
-        best,
-        forward.solves,
-        reached,
-        status,
-        message,
-        time.perf_counter() - t0,
+
+
+def csv_text(rows: list[Row]) -> str:
+    """optimize.csv: a row per iteration (HEADER)."""
+    table = io.StringIO()
+    w = csv.writer(table, lineterminator="\n")
+    w.writerow(HEADER)
+    w.writerows([i, repr(o), repr(d), n] for i, o, d, n in rows)
+    return table.getvalue()
+
+
+def picture(design: Design, result: OptimizeResult, target: tuple[np.ndarray, np.ndarray]) -> OptimizePicture:
+    """What optimize.png draws, from the design and the result: each design's parison (from
+    its model) and final wall, the moulds at the end of the forming, the tables and rows."""
+    runs = []
+    for values, it, colour, name in (
+        (design.initial, result.initial, "0.55", "initial"),
+        (result.best.design, result.best, "C0", "optimized"),
+    ):
+        mesh = design.model(values).mesh
+        f = mesh.fibres
+        if f is None:  # no wall measured: refused when the design was read
+            raise ValueError("the design's mesh has no through-wall fibres")
+        a, b = mesh.points[f[:, 0]], mesh.points[f[:, -1]]
+        runs.append(PictureRun(name, colour, np.asarray(values, float), np.vstack([a, b[::-1], a[:1]]), it.thickness))
+    end = float(design.control.target)
+    moulds = [pair.surface.polyline() + pair.surface.offset(end) for pair in design.built.model.contacts]
+    units = design.built.case.units
+    along, limits = (design.along, design.limits) if isinstance(design, TemperatureDesign) else (None, None)
+    return OptimizePicture(
+        runs=runs,
+        moulds=moulds,
+        knots=design.knots,
+        along=along,
+        limits=limits,
+        length_unit=units.length or "",
+        temperature_unit=units.temperature or "",
+        stations=design.stations,
+        target=target,
+        rows=result.rows,
+        tolerance=result.tolerance,
+        method=result.method,
+        forward_solves=result.forward_solves,
+        deviations=(result.initial.deviation, result.best.deviation),
     )
-
-
-def case_text(design: Design, values: np.ndarray) -> str:
-    """optimized.toml: the case with the thickness table's t = values, as TOML (tomli-w)."""
-    import tomli_w
-
-    return tomli_w.dumps(design.case_tree(values))
 
 
 def write_outputs(
     out: Path, design: Design, result: OptimizeResult, target: tuple[np.ndarray, np.ndarray], final: Path | None
 ) -> None:
-    """optimized.toml, optimize.csv, optimize.json and optimize.png in `out`."""
-    import csv
-
-    from ..io.files import write_atomic
-
-    write_atomic(out / "optimized.toml", case_text(design, result.best.design))
-    table = io.StringIO()
-    w = csv.writer(table, lineterminator="\n")
-    w.writerow(["iteration", "objective", "max_rel_deviation", "forward_solves"])
-    w.writerows([i, repr(o), repr(d), n] for i, o, d, n in result.rows)
-    write_atomic(out / "optimize.csv", table.getvalue())
+    """optimized.toml (the best finished design), optimize.csv, optimize.json and optimize.png
+    (where the initial design finished) in `out`."""
+    if result.best.finished:
+        write_atomic(out / "optimized.toml", case_text(design, result.best.design))
+    write_atomic(out / "optimize.csv", csv_text(result.rows))
+    quantity = "temperature" if isinstance(design, TemperatureDesign) else "thickness"
     summary = {
         "method": result.method,
         "tolerance": result.tolerance,
         "status": result.status,
         "message": result.message,
         "reached": result.reached,
-        "iterations": len(result.rows) - 1,
+        "iterations": max(len(result.rows) - 1, 0),
         "forward_solves": result.forward_solves,
         "wall_time_s": round(result.wall_time_s, 3),
-        "objective": result.best.objective,
-        "max_rel_deviation": result.best.deviation,
-        "initial_objective": result.initial.objective,
-        "initial_max_rel_deviation": result.initial.deviation,
+        "objective": _number(result.best.objective),
+        "max_rel_deviation": _number(result.best.deviation),
+        "initial_objective": _number(result.initial.objective),
+        "initial_max_rel_deviation": _number(result.initial.deviation),
         "vary": design.name,
         "knots": design.knots.tolist(),
-        f"initial_{_quantity(design)}": design.initial.tolist(),
-        f"optimized_{_quantity(design)}": result.best.design.tolist(),
+        f"initial_{quantity}": design.initial.tolist(),
+        f"optimized_{quantity}": result.best.design.tolist(),
         "final": None if final is None else final.name,
     }
     write_atomic(out / "optimize.json", json.dumps(summary, indent=2) + "\n")
-    plot_optimization(out / "optimize.png", design, result, target)
+    if result.initial.finished:
+        plot_optimization(out / "optimize.png", picture(design, result, target))
 
 
-def _quantity(design: Design) -> str:
-    """ "thickness" or "temperature": what the design's values are."""
-    return "temperature" if isinstance(design, TemperatureDesign) else "thickness"
+def _number(value: float) -> float | None:
+    """A misfit for optimize.json: None (null) for a design that was not solved."""
+    return float(value) if np.isfinite(value) else None
 
 
 def _invalid_option(max_iter: int, tolerance: float, smoothness: float) -> str | None:
@@ -360,23 +168,80 @@ def _invalid_option(max_iter: int, tolerance: float, smoothness: float) -> str |
     return None
 
 
-def run_final(out_dir: Path, design: Design, result: OptimizeResult, quiet: bool) -> Path | None:
-    """optimized.toml and its run in out_dir/final/ (as `axiform run`); the folder, None
-    when no design finished.  A final run that does not finish makes the result "stopped"."""
-    from ..io.files import write_atomic
+def run_final(out_dir: Path, design: Design, result: OptimizeResult, quiet: bool) -> tuple[Path | None, int]:
+    """optimized.toml and its run in out_dir/final/ (as `axiform run`); the folder (None when
+    no design finished) and the run's exit code.  A final run that does not finish makes the
+    result "stopped"; one stopped by SIGINT or SIGTERM (exit 130 or 143) "interrupted"."""
     from .run import run as run_case
 
     if not result.best.finished:
-        return None
+        return None, 0
     case_out = out_dir / "optimized.toml"
     write_atomic(case_out, case_text(design, result.best.design))
     final = out_dir / "final"
     with contextlib.redirect_stderr(io.StringIO()) if quiet else contextlib.nullcontext():
         code = run_case(str(case_out), str(final), quiet=True)
-    if code != 0:
+    if code in INTERRUPTED:
+        result.status = "interrupted"
+        name = signal.Signals(code - 128).name
+        result.message += f"; the final run was interrupted by {name} (exit {code}), its converged steps are kept"
+    elif code != 0:
         result.status = "stopped"
         result.message += f"; the final run exited with {code}"
-    return final
+    return final, code
+
+
+def read_bounds(bounds: str | None, vary: str) -> tuple[tuple[float, float] | None, str | None]:
+    """--bounds as (LOW, HIGH), or the message that refuses it."""
+    if bounds is None:
+        return None, None
+    try:
+        limits = tuple(float(v) for v in bounds.split(","))
+        if len(limits) != 2 or not all(np.isfinite(limits)):
+            raise ValueError
+    except ValueError:
+        return None, f"axiform: invalid option:\n--bounds: {bounds!r} is not LOW,HIGH (two numbers)"
+    if vary != "temperature":
+        return None, (
+            "axiform: invalid option:\n--bounds: belongs to --vary temperature (a thickness is bounded to "
+            "0.2 to 5 times its initial value)"
+        )
+    return (limits[0], limits[1]), None
+
+
+def prepare(case_file: Path, target_path: str, vary: str, bounds: str | None) -> tuple[Design, Target] | int:
+    """The design and the target of the command line, or the exit code 2 (the message said)."""
+    from ..case.schema import CaseError
+    from .console import invalid
+
+    limits, problem = read_bounds(bounds, vary)
+    if problem:
+        say(problem)
+        return 2
+    try:
+        design: Design = (
+            TemperatureDesign.from_case(case_file, bounds=limits)
+            if vary == "temperature"
+            else ThicknessDesign.from_case(case_file)
+        )
+    except CaseError as exc:
+        return invalid(case_file, exc)
+    lo, hi = design.bounds()
+    outside = (design.initial < lo) | (design.initial > hi)
+    if outside.any():
+        k = int(np.argmax(outside))
+        say(
+            f"axiform: invalid option:\n--bounds: {lo[k]:g} to {hi[k]:g} exclude the initial design "
+            f"({design.name} at {design.knots[k]:g} is {design.initial[k]:g})"
+        )
+        return 2
+    try:
+        target = read_target(target_path)
+        Objective(design.stations, *target, 1.0)
+    except TargetError as exc:
+        say(f"axiform: invalid target:\n--target: {exc}")
+        return 2
+    return design, target
 
 
 def run(
@@ -391,43 +256,15 @@ def run(
     vary: str = "thickness",
     bounds: str | None = None,
 ) -> int:
-    """`axiform optimize`: returns the exit code (0 finished, 1 stopped short, 2 invalid input).
+    """`axiform optimize`: returns the exit code (module docstring).
     vary: "thickness" (the mesh.thickness table) or "temperature" ([temperature] initial);
     bounds: "LOW,HIGH" of every temperature (--vary temperature only)."""
-    from ..case.schema import CaseError
-    from .console import invalid, say
     from .run import prepare_folder
 
-    case_file = Path(case_path)
-    limits = None
-    if bounds is not None:
-        try:
-            limits = tuple(float(v) for v in bounds.split(","))
-            if len(limits) != 2 or not all(np.isfinite(limits)):
-                raise ValueError
-        except ValueError:
-            say(f"axiform: invalid option:\n--bounds: {bounds!r} is not LOW,HIGH (two numbers)")
-            return 2
-        if vary != "temperature":
-            say(
-                "axiform: invalid option:\n--bounds: belongs to --vary temperature (a thickness is bounded to "
-                "0.2 to 5 times its initial value)"
-            )
-            return 2
-    try:
-        design = (
-            TemperatureDesign.from_case(case_file, bounds=limits)
-            if vary == "temperature"
-            else ThicknessDesign.from_case(case_file)
-        )
-    except CaseError as exc:
-        return invalid(case_file, exc)
-    try:
-        target = read_target(target_path)
-        Objective(design.built.model.mesh.fibre_s, *target, 1.0)
-    except TargetError as exc:
-        say(f"axiform: invalid target:\n--target: {exc}")
-        return 2
+    prepared = prepare(Path(case_path), target_path, vary, bounds)
+    if isinstance(prepared, int):
+        return prepared
+    design, target = prepared
     problem = _invalid_option(max_iter, tolerance, smoothness)
     if problem:
         say(problem)
@@ -442,21 +279,27 @@ def run(
             f"axiform optimize: {design.knots.size} design variables ({design.name}), method {method}, "
             f"tolerance {tolerance:g} -> {out_dir}"
         )
-
-    def report(row: Row) -> None:
-        if not quiet:
-            say(
-                f"iteration {row[0]}  objective {row[1]:.4g}  max deviation {100 * row[2]:.3g} %  "
-                f"forward solves {row[3]}"
-            )
-
-    with np.errstate(all="ignore"):
-        result = optimize(design, target, method, max_iter, tolerance, smoothness, report)
-    final = run_final(out_dir, design, result, quiet)
-    write_outputs(out_dir, design, result, target, final)
+    final, code = None, 0
+    with Stops() as stops:
+        progress = Progress(out_dir, design, stops, quiet)
+        try:
+            result = optimize(design, target, method, max_iter, tolerance, smoothness, progress)
+        except Interrupted as exc:
+            result = progress.interrupted(method, tolerance, exc)
+        else:
+            try:
+                final, code = run_final(out_dir, design, result, quiet)
+            except Interrupted as exc:  # between the optimization and the final run
+                result.status, result.message = "interrupted", f"{result.message}; {exc} before the final run"
+        stops.raised = True  # a signal from here on is recorded: the files are written first
+        write_outputs(out_dir, design, result, target, final)
     say(
-        f"axiform optimize: {result.status} after {len(result.rows) - 1} iterations, {result.forward_solves} "
-        f"forward solves, {result.wall_time_s:.1f} s: max deviation {100 * result.best.deviation:.3g} % "
-        f"({result.message}) -> {out_dir}"
+        f"axiform optimize: {result.status} after {max(len(result.rows) - 1, 0)} iterations, "
+        f"{result.forward_solves} forward solves, {result.wall_time_s:.1f} s: max deviation "
+        f"{100 * result.best.deviation:.3g} % ({result.message}) -> {out_dir}"
     )
+    if code in INTERRUPTED:
+        return code
+    if stops.signum is not None:
+        return 128 + stops.signum
     return 0 if result.status == "finished" else 1

@@ -17,9 +17,9 @@ def fields_of(folder: Path) -> set[str] | None:
     if vtu is None or not vtu.exists():
         return None
     return {
-        a.get("Name")
+        name
         for a in ET.parse(vtu).getroot().iter("DataArray")
-        if a.get("Name") and a.get("Name") not in ("types", "offsets", "connectivity", "Points")
+        if (name := a.get("Name")) and name not in ("types", "offsets", "connectivity", "Points")
     }
 
 

@@ -214,9 +214,9 @@ class Job:
     def writer(self, out_dir: Path):
         """The results writer of this run in out_dir (a resumed run keeps the folder's rows and files
         up to its checkpoint)."""
+        from ..case.labels import case_labels
         from ..case.schema import fingerprint
         from ..io.results import ResultsWriter
-        from ..post.labels import case_labels
 
         o, case = self.case.output, self.case
         return ResultsWriter(
@@ -290,7 +290,7 @@ def time_name(case, model) -> tuple[str, str]:
     """What the progress calls the load factor, and its unit: `t` with the unit of [units] time
     (if given) where it is the process time (a physical time, labels.time_is_real; or load
     curves with knots or moving tools follow it), else `lambda` and no unit."""
-    from ..post.labels import time_is_real
+    from ..case.labels import time_is_real
 
     if time_is_real(case) or model.timed():
         return "t", case.units.time or ""

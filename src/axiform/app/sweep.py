@@ -198,14 +198,13 @@ def load_sweep(path: str | Path) -> Sweep:
 def run_case(case_file: str, overrides: list[str], out: str) -> dict[str, Any]:
     """Run one case as `axiform run CASE --set ... --out OUT -q` would (on a worker); its row
     of sweep.csv from the exit code and OUT/summary.json."""
-    import numpy as np
 
     from .run import run
 
     t0 = time.perf_counter()
     said = io.StringIO()
     try:
-        with redirect_stderr(said), np.errstate(all="ignore"):  # as `axiform run`: the guards report
+        with redirect_stderr(said):
             code = run(case_file, out, quiet=True, overrides=overrides)
     except BaseException as exc:  # noqa: BLE001 - the row says what happened, the sweep goes on
         return {

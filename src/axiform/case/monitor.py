@@ -13,8 +13,8 @@ from ..contact.pair import ContactPair
 from ..fem.cavity import Cavity
 from ..fem.mesh import Mesh
 from ..fem.selectors import select_nodes
+from ..io.columns import HISTORY_COLUMNS
 from ..model.model import Model
-from ..post.results_folder import HISTORY_COLUMNS
 from .base import CaseError, DofName, Selector, Strict, one_node
 
 # characters a monitor name may not hold (besides the unprintable ones): the CSV separators and quotes

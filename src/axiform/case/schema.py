@@ -23,7 +23,7 @@ from pydantic import ValidationError
 
 from ..fem.mesh import MeshError
 from ..fem.selectors import SelectorError
-from ..model.guards import boundary_crossing, free_to_slide, key_path, not_numbers
+from ..model.guards import boundary_crossing, free_to_slide
 from ..model.model import Model
 from ..post.thickness import default_wall
 from ..solve.solver import ArcLengthControl, DisplacementControl, LoadControl, NewtonOptions
@@ -50,6 +50,7 @@ from .solver import DofRef, SolverSpec, StopSpec, build_control
 from .suggest import did_you_mean
 from .temperature import TemperatureSpec
 from .thermal import ConvectionSpec, ThermalSpec, build_conduction
+from .tree import key_path, not_numbers
 
 __all__ = [
     "CaseError",

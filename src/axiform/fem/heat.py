@@ -1,4 +1,4 @@
-"""Transient heat conduction in the body of revolution (DESIGN § 11.5):
+"""Transient heat conduction in the body of revolution (docs/internals.md, Time, temperature and heat):
 
     rho c dT/dt = div(k grad T)   in the current configuration,
     -k dT/dn = h (T - T_inf)      on convected edges (a film),

@@ -27,9 +27,9 @@ from pathlib import Path
 import numpy as np
 
 from ..post.fields import point_fields, with_components
-from ..post.results_folder import HISTORY_COLUMNS
 from ..post.thickness import thickness_table, write_thickness_csv
 from . import gid
+from .columns import HISTORY_COLUMNS
 from .files import atomic, contact_table, mould_outlines, write_atomic, write_pvd, write_vtu
 from .run_report import RunRecord, column_units, thickness_summary
 

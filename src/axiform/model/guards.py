@@ -1,5 +1,5 @@
-"""Checks that refuse nonsense before any work: values that are not finite numbers anywhere in
-a case, outlines that cross themselves (moulds, mesh boundaries), bodies free to move rigidly.
+"""Checks that refuse nonsense before any work: outlines that cross themselves (moulds, mesh
+boundaries), bodies free to move rigidly.
 
 Each check returns what it found (None when all is well); the case file turns a finding into
 a CaseError naming the key.
@@ -7,37 +7,10 @@ a CaseError naming the key.
 
 from __future__ import annotations
 
-import math
-from datetime import date, datetime, time
-from typing import Any
-
 import numpy as np
 import scipy.sparse as sp
 
 from ..fem.graphs import connected_components
-
-
-def key_path(parts: list[str | int]) -> str:
-    """('contact', 0, 'surface', 'polyline', 2, 1) -> 'contact[0].surface.polyline[2][1]'."""
-    out = ""
-    for p in parts:
-        out += f"[{p}]" if isinstance(p, int) else ("." if out else "") + p
-    return out or "(case)"
-
-
-def not_numbers(data: Any, path: list[str | int] | None = None) -> list[str]:
-    """Every place in a parsed TOML tree (dicts, lists, scalars) holding NaN, an infinity or
-    a date/time, as 'key.path: reason' lines."""
-    path = path or []
-    if isinstance(data, dict):
-        return [line for k, v in data.items() for line in not_numbers(v, [*path, str(k)])]
-    if isinstance(data, list):
-        return [line for i, v in enumerate(data) for line in not_numbers(v, [*path, i])]
-    if isinstance(data, float) and not math.isfinite(data):
-        return [f"{key_path(path)}: must be a finite number, not {data}"]
-    if isinstance(data, (date, datetime, time)):
-        return [f"{key_path(path)}: a date or time is not accepted here"]
-    return []
 
 
 def _crossing_pairs(a: np.ndarray, b: np.ndarray, skip: np.ndarray, block: int = 2048) -> tuple[int, int] | None:

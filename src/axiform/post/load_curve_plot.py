@@ -26,7 +26,7 @@ import numpy as np
 
 from .figures import new_figure, save, title
 from .labels import load_values, with_unit
-from .results_folder import HISTORY_COLUMNS, FolderInfo, read_history
+from .results_folder import FolderInfo, read_history
 
 _STARTS_AT_ZERO = ("displacement", "rotation", "force", "area")
 
@@ -43,8 +43,10 @@ class Panel:
 
 
 def _monitors(h: dict[str, np.ndarray], info: FolderInfo) -> list[str]:
+    """The monitors of history.csv (summary.json names each with its quantity), in the file's
+    order, less the one that carries the load (it is the load curve's panel)."""
     own = (info.load or {}).get("monitor")
-    return [k for k in h if k not in HISTORY_COLUMNS and k != own]
+    return [k for k in h if k in info.monitor_quantities and k != own]
 
 
 def _label(name: str, info: FolderInfo) -> str:

@@ -16,9 +16,6 @@ import numpy as np
 
 from .labels import load_values, short, unit_of, with_unit
 
-# history.csv's first columns, before one column per monitor (time = load_factor: the process time t)
-HISTORY_COLUMNS = ("step", "load_factor", "time", "iterations")
-
 
 class FieldError(ValueError):
     """A field (or component) that the results folder does not have."""
@@ -27,7 +24,7 @@ class FieldError(ValueError):
 @dataclass
 class FolderInfo:
     """What summary.json says about the numbers: the case title, its units, the quantity the
-    load factor scales (labels.loaded_quantity) and each monitor's quantity."""
+    load factor scales (case.labels.loaded_quantity) and each monitor's quantity."""
 
     title: str = ""
     units: dict[str, str] = dc_field(default_factory=dict)
@@ -37,7 +34,7 @@ class FolderInfo:
     applied: list[dict[str, Any]] = dc_field(default_factory=list)  # every applied quantity (labels)
     process: bool = False  # a multi-stage process: load curves against the time t
     cavities: dict[str, dict[str, float]] = dc_field(default_factory=dict)  # summary.json's cavities
-    real_time: bool = False  # the load factor is a physical time (labels.time_is_real)
+    real_time: bool = False  # the load factor is a physical time (case.labels.time_is_real)
 
     @classmethod
     def read(cls, folder: Path) -> FolderInfo:
@@ -121,7 +118,8 @@ class FolderInfo:
 
 
 def read_history(path: Path) -> dict[str, np.ndarray]:
-    """history.csv as columns (HISTORY_COLUMNS, then the monitors); ValueError naming
+    """history.csv as columns (step, load_factor, time, iterations, then the monitors,
+    io.columns.HISTORY_COLUMNS); ValueError naming
     the file and line of a row with another number of values than the header has columns, or
     a value that is not a number."""
     with open(path, newline="") as fh:

@@ -7,14 +7,28 @@ as a flat line."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import numpy as np
 
 from .figures import new_figure, save, wrapped
 
-if TYPE_CHECKING:
-    from ..app.sweep import Sweep
+
+class Sweep(Protocol):
+    """What the picture needs of a sweep (app.sweep.Sweep has it): the base case file, the
+    varied keys, one dict of overrides per case and the monitor to report (None: none)."""
+
+    @property
+    def case_file(self) -> Path: ...
+
+    @property
+    def keys(self) -> list[str]: ...
+
+    @property
+    def cases(self) -> list[dict[str, Any]]: ...
+
+    @property
+    def report(self) -> str | None: ...
 
 
 def value_text(value: Any) -> str:
@@ -66,11 +80,11 @@ def legend_label(case: dict[str, Any], keys: list[str]) -> str:
     return ", ".join(f"{k} = {_text(case.get(k))}" for k in keys)
 
 
-def peak_and_end(row: dict, monitor: str) -> tuple[float, float] | None:
+def peak_and_end(row: dict | None, monitor: str | None) -> tuple[float, float] | None:
     """A finished case's (peak, end) of `monitor`: the peak is the value of largest magnitude
     over the run (its `extremes`; the end value where the row has none); None for a case that
     did not finish or has no such monitor."""
-    if not row or row.get("status") != "finished" or monitor not in row.get("monitors", {}):
+    if not row or monitor is None or row.get("status") != "finished" or monitor not in row.get("monitors", {}):
         return None
     end = float(row["monitors"][monitor])
     low, high = (row.get("extremes") or {}).get(monitor, (end, end))
@@ -87,7 +101,7 @@ def sweep_points(sweep: Sweep, rows: list[dict | None]) -> tuple[str, list[str],
     xs = list(dict.fromkeys(_text(case.get(first)) for case in cases))  # values as text: lists too
     values = {_text(case.get(first)): case.get(first) for case in cases}
     numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values.values())
-    groups: dict[str, list[tuple[float, float, float]]] = {}
+    groups: dict[str, list[tuple[Any, float, float]]] = {}  # x: the value, or its index when not a number
     for case, row in zip(cases, rows, strict=False):
         found = peak_and_end(row, sweep.report)
         if found is not None:

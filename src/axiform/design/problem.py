@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import copy
 from abc import ABC, abstractmethod
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -41,7 +42,8 @@ def read_target(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     rows = [(n, line) for n, line in enumerate(text.splitlines(), 1) if line.strip() and not line.startswith("#")]
     if not rows or [c.strip() for c in rows[0][1].split(",")] != ["s", "thickness"]:
         raise TargetError(f"{path}: the first row must be the header 's,thickness'")
-    s, t = [], []
+    s: list[float] = []
+    t: list[float] = []
     for n, line in rows[1:]:
         cells = line.split(",")
         try:
@@ -84,7 +86,24 @@ class CaseDesign(ABC):
 
     @property
     def control(self) -> LoadControl:
-        return self.built.control
+        """The case's load control (the designs refuse any other: from_case)."""
+        control = self.built.control
+        if not isinstance(control, LoadControl):
+            raise CaseError("solver.control: a design follows the load path under load control")
+        return control
+
+    @property
+    def stations(self) -> np.ndarray:
+        """The reference arc length of the wall's stations (n,), where its thickness is measured."""
+        s = self.built.model.mesh.fibre_s
+        if s is None:
+            raise CaseError("mesh: a design needs a wall whose thickness is measured (a layered or rectangle mesh)")
+        return s
+
+    def outside(self, values: np.ndarray) -> str | None:
+        """Why the design `values` (k,) lies outside the case's domain (not to be solved), or
+        None: every thickness within the bounds is a wall."""
+        return None
 
 
 @dataclass
@@ -103,11 +122,11 @@ class ThicknessDesign(CaseDesign):
     name = "mesh.thickness"  # the table that holds the design
 
     @classmethod
-    def from_case(cls, path: str | Path, overrides: list[str] = ()) -> ThicknessDesign:
+    def from_case(cls, path: str | Path, overrides: Sequence[str] = ()) -> ThicknessDesign:
         """Read a case for optimization: a layered mesh with a thickness table, load control.
         CaseError names the key at fault."""
         path = Path(path)
-        tree = read(path, overrides)
+        tree = read(path, list(overrides))
         case = parse(tree)
         if case.mesh.kind != "layered" or not isinstance(case.mesh.thickness, list):
             raise CaseError(

@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..fem.constraints import DofMap
 from ..model.model import Model
 from ..post.thickness import thickness_table
 from ..solve.linsolve import factorize
@@ -86,7 +87,7 @@ def _same_numbering(base: Model, other: Model, k: int) -> None:
     if (
         other.mesh.n_nodes != base.mesh.n_nodes
         or other.n_free != base.n_free
-        or not np.array_equal(other.dofmap.eq, base.dofmap.eq)
+        or not np.array_equal(_dofmap(other).eq, _dofmap(base).eq)
         or len(other.contacts) != len(base.contacts)
         or any(not np.array_equal(a.nodes, b.nodes) for a, b in zip(base.contacts, other.contacts, strict=False))
         or len(other.cavities) != len(base.cavities)
@@ -96,6 +97,13 @@ def _same_numbering(base: Model, other: Model, k: int) -> None:
             "contact nodes than the base model: select nodes by named sets (start, end, inner, "
             "outer, ...) or by coordinates that do not move with the design"
         )
+
+
+def _dofmap(model: Model) -> DofMap:
+    """The dof numbering of a finalized model."""
+    if model.dofmap is None:
+        raise ValueError("the model is not finalized: it has no dof numbering")
+    return model.dofmap
 
 
 def has_history(model: Model) -> bool:
@@ -180,7 +188,7 @@ def sensitivity(
     last = out.solve.last
     if last is not None:
         u2 = last.u.reshape(-1, model.dpn)[:, :2]
-        out.thickness = thickness_table(model.mesh, u2, last.state.contacts)
+        out.thickness = thickness_table(model.mesh, u2, () if last.state is None else last.state.contacts)
         if out.thickness is not None:
             out.dthickness_ds = thickness_derivative(model, u2, out.dx_final_ds())
     return out
@@ -194,11 +202,17 @@ def thickness_derivative(model: Model, u: np.ndarray, dx: np.ndarray) -> np.ndar
     element edge."""
     mesh = model.mesh
     m = dx.shape[-1]
-    out = np.empty((len(mesh.fibres), m))
+    out = np.empty((len(_wall(mesh, u)), m))
     for k in range(m):
         v = dx[..., k]
         eps = 1e-6 * mesh.size() / max(float(np.abs(v).max()), 1e-300)
-        plus = thickness_table(mesh, u + eps * v)["thickness"]
-        minus = thickness_table(mesh, u - eps * v)["thickness"]
-        out[:, k] = (plus - minus) / (2 * eps)
+        out[:, k] = (_wall(mesh, u + eps * v) - _wall(mesh, u - eps * v)) / (2 * eps)
     return out
+
+
+def _wall(mesh, u: np.ndarray) -> np.ndarray:
+    """The wall's thickness per station at the nodal displacements u (n_nodes, 2)."""
+    table = thickness_table(mesh, u)
+    if table is None:
+        raise ValueError("the mesh has no through-wall fibres: no thickness to differentiate")
+    return table["thickness"]

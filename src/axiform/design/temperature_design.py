@@ -1,6 +1,7 @@
-"""Temperature programming (DESIGN § 11.6): the design is the table of the initial
-temperature, `[temperature] initial = { along = "s" | "r" | "z", table = [[x_k, T_k], ...] }`;
-the T_k are the design variables, bounded to the table's range +- 30 K (or `--bounds LOW,HIGH`).
+"""Temperature programming (`axiform optimize --vary temperature`, docs/guide.md): the design
+is the table of the initial temperature,
+`[temperature] initial = { along = "s" | "r" | "z", table = [[x_k, T_k], ...] }`; the T_k
+are the design variables, bounded to the table's range +- 30 K (or `--bounds LOW,HIGH`).
 The thickness table stays fixed.  The optimizer works on y = T itself (the wall responds to a
 temperature through the law's tables and the shift, smoothly and without a natural scale of
 its own, unlike a thickness, worked on as ln t).
@@ -13,6 +14,7 @@ ln(achieved / target) at the knot, from the last design.
 from __future__ import annotations
 
 import copy
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -20,7 +22,8 @@ from typing import Any
 import numpy as np
 
 from ..case.schema import Built, CaseError, build, parse, read
-from .design import CaseDesign, absolute_paths
+from ..materials.temperature import WLF, Arrhenius
+from .problem import CaseDesign, absolute_paths
 
 MARGIN = 30.0  # K: the default bounds, the table's range widened by this much
 RULE_GAIN = 15.0  # K per unit of ln(achieved / target) (the fixed-point rule)
@@ -46,12 +49,12 @@ class TemperatureDesign(CaseDesign):
 
     @classmethod
     def from_case(
-        cls, path: str | Path, overrides: list[str] = (), bounds: tuple[float, float] | None = None
+        cls, path: str | Path, overrides: Sequence[str] = (), bounds: tuple[float, float] | None = None
     ) -> TemperatureDesign:
         """Read a case for temperature programming: a [temperature] whose initial field is a
         table, load control, a wall with thickness stations.  CaseError names the key."""
         path = Path(path)
-        tree = read(path, overrides)
+        tree = read(path, list(overrides))
         case = parse(tree)
         heat = case.temperature
         if heat is None or isinstance(heat.initial, float):
@@ -85,6 +88,19 @@ class TemperatureDesign(CaseDesign):
             "table": [[float(x), float(T)] for x, T in zip(self.knots, values, strict=False)],
         }
         return tree
+
+    def outside(self, values: np.ndarray) -> str | None:
+        """Why the temperatures `values` (k,) lie outside the shift's domain (at or below the
+        WLF pole T_ref - C2, or not a positive absolute temperature), or None.  The table's
+        field lies between its smallest and largest knot value, so the knots tell."""
+        shift = self.built.model.shift
+        if not isinstance(shift, (WLF, Arrhenius)):  # no shift: every temperature will do
+            return None
+        try:
+            shift.check(np.asarray(values, float))
+        except ValueError as exc:
+            return str(exc)
+        return None
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         k = self.knots.size

@@ -1,0 +1,324 @@
+"""Parison and preform programming: the initial wall thickness table of a
+layered case that gives a wanted final wall (`--vary thickness`), or the initial temperature
+table (`--vary temperature`, design.temperature_design: temperature programming).
+
+Design: the thicknesses t_k of the case's `mesh.thickness` table [[s_k, t_k], ...], bounded
+to 0.2 to 5 times their initial values (or the T_k of `[temperature] initial`, bounded to the
+table's range +- 30 K).  Objective (`Objective`): the mean squared relative
+misfit of the final thickness to the target over the reference arc length,
+int ln(t / T)^2 ds / L over the stations inside the target's range (ln(t / T) = (t - T) / T
+to first order; a wall scales with its parison, so that ln t is nearly linear in the
+logarithm of the design), plus a small smoothness term on the design, `smoothness` times the
+sum of its squared second differences relative to its initial mean.
+
+Methods:
+- "gradient": SciPy's bound-constrained trust-region reflective least squares
+  (`scipy.optimize.least_squares`, method "trf") over ln t_k, with the Jacobian of the final
+  thickness to the design from direct differentiation along the load path (axiform.design.sensitivity): a
+  Gauss-Newton method, which needs few forward solves because the whole Jacobian (stations x
+  design) comes with each solve;
+- "fixed-point": the plain rule, each t_k scaled by target / achieved at its station s_k.
+Both stop at the first design whose final wall is within `tolerance` (max relative
+deviation) of the target, or after max_iter iterations.  Knots whose interpolation reaches
+no station of the target keep their values.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..case.schema import CaseError
+from ..post.thickness import thickness_table
+from ..solve.solver import SolveResult, solve
+from .problem import SMOOTHNESS, Objective, ThicknessDesign
+from .sensitivity import sensitivity
+from .temperature_design import TemperatureDesign
+
+Design = ThicknessDesign | TemperatureDesign
+VARY = {"thickness": ThicknessDesign, "temperature": TemperatureDesign}
+
+METHODS = ("gradient", "fixed-point")
+TOLERANCE = 0.01
+Row = tuple[int, float, float, int]  # a row of optimize.csv: iteration, objective, deviation, forward solves
+
+
+@dataclass
+class Iterate:
+    """One forward solve of the optimization: the design, its final thickness table, the
+    objective and the max relative deviation, and whether the solve finished."""
+
+    design: np.ndarray
+    thickness: dict[str, np.ndarray] | None
+    objective: float
+    deviation: float
+    finished: bool
+    message: str = ""
+
+
+Report = Callable[[Row, Iterate], None]  # called with each row of optimize.csv and its iterate
+
+
+@dataclass
+class OptimizeResult:
+    """rows: (iteration, objective, max_rel_deviation, forward_solves) per iteration (the
+    initial design is iteration 0); best: the best finished iterate; initial: the first;
+    tolerance: the max relative deviation aimed at; reached: it was met; status "finished"
+    (reached or converged) or "stopped"."""
+
+    method: str
+    tolerance: float
+    rows: list[Row]
+    initial: Iterate
+    best: Iterate
+    forward_solves: int
+    reached: bool
+    status: str
+    message: str
+    wall_time_s: float
+
+
+class Forward:
+    """The forward solves of one optimization, counted, and its iterations, recorded as rows
+    of optimize.csv (`report(row, iterate)` is called with each as it comes)."""
+
+    def __init__(self, design: Design, objective: Objective, report: Report | None = None):
+        self.design = design
+        self.objective = objective
+        self.report = report
+        self.solves = 0
+        self.rows: list[Row] = []
+
+    def __call__(self, x: np.ndarray, gradient: bool) -> tuple[Iterate, tuple | None]:
+        """Solve the case with the design x: the iterate, and (residuals, their Jacobian to
+        the design, None without gradient) when the solve finished, else None.  A design
+        outside the case's domain (design.outside: a temperature at or below the shift's
+        pole) is not solved: a failed trial, as a solve that stopped (the gradient method
+        rejects the step, the fixed-point rule stops at the best design so far)."""
+        design = self.design
+        problem = design.outside(x)
+        if problem:
+            return Iterate(x.copy(), None, np.inf, np.inf, False, f"the design is not solved: {problem}"), None
+        self.solves += 1
+        try:
+            result, table, jac = self.solve(x, gradient)
+        except CaseError as exc:  # a case the design makes invalid: a failed trial, named
+            return Iterate(x.copy(), None, np.inf, np.inf, False, f"the design makes the case invalid: {exc}"), None
+        if result.status != "finished" or table is None:
+            return Iterate(x.copy(), table, np.inf, np.inf, False, result.message), None
+        r = self.objective.residuals(table["thickness"], x)
+        it = Iterate(x.copy(), table, float(r @ r), self.objective.max_rel_deviation(table["thickness"]), True)
+        return it, (r, None if jac is None else self.objective.jacobian(table["thickness"], jac))
+
+    def solve(self, x: np.ndarray, gradient: bool) -> tuple[SolveResult, dict[str, np.ndarray] | None, Any]:
+        """The forward solve of the design x: its result, the final thickness table (None
+        without a converged step) and d thickness / d x (n, k) with gradient, else None."""
+        design = self.design
+        if gradient:
+            sens = sensitivity(design.model, x, design.control, design.built.options, keep_steps=False)
+            return sens.solve, sens.thickness, sens.dthickness_ds
+        model = design.model(x)
+        result = solve(model, design.control, design.built.options)
+        last = result.last
+        table = None if last is None else thickness_table(model.mesh, last.u.reshape(-1, model.dpn)[:, :2])
+        return result, table, None
+
+    def record(self, it: Iterate) -> None:
+        """A row of optimize.csv for the iterate."""
+        row = (len(self.rows), it.objective, it.deviation, self.solves)
+        self.rows.append(row)
+        if self.report:
+            self.report(row, it)
+
+
+def active_knots(design: Design, objective: Objective) -> np.ndarray:
+    """The knots whose interpolation reaches a station of the target (k,): the others keep
+    their values."""
+    k = design.knots
+    left, right = np.concatenate([[-np.inf], k[:-1]]), np.concatenate([k[1:], [np.inf]])
+    s_in = _stations(design, {"s": design.stations})[objective.inside]
+    return ((s_in[None, :] > left[:, None]) & (s_in[None, :] < right[:, None])).any(axis=1)
+
+
+def _stations(design, table: dict[str, np.ndarray]) -> np.ndarray:
+    """The positions of the wall's stations in the design table's coordinate (s, or the
+    reference r or z of a temperature table along them)."""
+    along = getattr(design, "along", "s")
+    if along == "s":
+        return table["s"]
+    mesh = design.built.model.mesh
+    f = mesh.fibres
+    return 0.5 * (mesh.points[f[:, 0], "rz".index(along)] + mesh.points[f[:, -1], "rz".index(along)])
+
+
+def fixed_point(forward: Forward, initial: Iterate, max_iter: int, tolerance: float) -> tuple[Iterate, str]:
+    """The plain rule of the design (`design.rule`: each t_k scaled by target / achieved at
+    its knot; a temperature raised where the wall is too thick), from the last design, better
+    or not; the best iterate and why it stopped ("" unless a solve did)."""
+    design, objective = forward.design, forward.objective
+    active = active_knots(design, objective)
+    lo, hi = design.bounds()
+    inside = objective.inside
+    best = current = initial
+    while current.deviation > tolerance and len(forward.rows) <= max_iter:
+        t = current.thickness
+        if t is None:  # a finished iterate has its wall (Forward): never here
+            break
+        ratio = np.interp(design.knots, _stations(design, t)[inside], objective.target[inside] / t["thickness"][inside])
+        ratio[~active] = 1.0
+        current, _ = forward(np.clip(design.rule(current.design, ratio), lo, hi), False)
+        if not current.finished:
+            return best, f"the forward solve of iteration {len(forward.rows)} stopped: {current.message}"
+        forward.record(current)
+        if current.objective < best.objective:
+            best = current
+    return best, ""
+
+
+class LeastSquares:
+    """The gradient method: SciPy's least_squares (trust-region reflective) over y = ln t_k
+    of the active knots, each forward solve done once (a cache by design); every accepted
+    iterate is a row, and the callback stops the search at the first one within the
+    tolerance or after max_iter iterations."""
+
+    def __init__(self, forward: Forward, initial: Iterate, first: tuple | None, max_iter: int, tolerance: float):
+        self.forward = forward
+        self.active = active_knots(forward.design, forward.objective)
+        self.x0 = initial.design
+        self.y0 = forward.design.to_y(self.x0[self.active])
+        self.cache: dict[bytes, tuple[Iterate, Any]] = {self.y0.tobytes(): (initial, first)}
+        self.best = self.last = initial
+        self.max_iter = max_iter
+        self.tolerance = tolerance
+        self.reached = False
+
+    def evaluate(self, y) -> tuple[Iterate, Any]:
+        y = np.asarray(y, float)
+        key = y.tobytes()
+        if key not in self.cache:
+            x = self.x0.copy()
+            x[self.active] = self.forward.design.from_y(y)
+            self.cache[key] = self.forward(x, True)
+            it = self.cache[key][0]
+            if it.finished and it.objective < self.best.objective:
+                self.best = it
+        return self.cache[key]
+
+    def fun(self, y) -> np.ndarray:
+        it, rj = self.evaluate(y)
+        if rj is None:  # the solve stopped (a design too thin to blow): a step to reject
+            wall = self.best.thickness  # the best iterate finished (the initial one at least)
+            if wall is None:
+                raise ValueError("the best iterate of the optimization has no wall")
+            r_best = self.forward.objective.residuals(wall["thickness"], self.best.design)
+            return 10.0 * np.abs(r_best) + 1.0
+        return rj[0]
+
+    def jac(self, y) -> np.ndarray:
+        it, rj = self.evaluate(y)
+        return rj[1][:, self.active] * self.forward.design.dx_dy(it.design[self.active])  # dr/dy = dr/dx dx/dy
+
+    def callback(self, intermediate_result) -> None:
+        """After each iteration of the optimizer: record the iterate it accepted (if new);
+        StopIteration when it is within the tolerance or the iterations are spent."""
+        it = self.evaluate(intermediate_result.x)[0]
+        if it is not self.last:
+            self.forward.record(it)
+            self.last = it
+        if it.finished and it.deviation <= self.tolerance:
+            self.reached = True
+            raise StopIteration
+        if len(self.forward.rows) > self.max_iter:
+            raise StopIteration
+
+    def run(self) -> tuple[Iterate, bool, str]:
+        """The best iterate, whether the optimizer converged to a best fit (that misses the
+        tolerance), and why it stopped."""
+        from scipy.optimize import least_squares
+
+        lo, hi = self.forward.design.bounds()
+        bounds = (self.forward.design.to_y(lo[self.active]), self.forward.design.to_y(hi[self.active]))
+        out = least_squares(
+            self.fun,
+            self.y0,
+            jac=self.jac,
+            bounds=bounds,
+            method="trf",
+            max_nfev=4 * self.max_iter + 4,
+            callback=self.callback,
+        )
+        converged = out.status > 0
+        if converged:
+            message = f"the optimizer converged to a best fit: {out.message}"
+        elif out.status == -2 and not self.reached:
+            message = f"the tolerance was not reached in {self.max_iter} iterations"
+        else:
+            message = "" if self.reached else out.message
+        return self.best, converged, message
+
+
+def optimize(
+    design: Design,
+    target: tuple[np.ndarray, np.ndarray],
+    method: str = "gradient",
+    max_iter: int = 20,
+    tolerance: float = TOLERANCE,
+    smoothness: float = SMOOTHNESS,
+    report: Report | None = None,
+) -> OptimizeResult:
+    """Find the thickness table whose final wall meets the target (module docstring).
+    report(row, iterate) is called with each row of optimize.csv as it comes."""
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, not {method!r}")
+    t0 = time.perf_counter()
+    objective = Objective(design.stations, *target, float(design.initial.mean()), smoothness)
+    forward = Forward(design, objective, report)
+    initial, first = forward(design.initial.astype(float), method == "gradient")
+    forward.record(initial)
+    if not initial.finished:
+        return OptimizeResult(
+            method,
+            tolerance,
+            forward.rows,
+            initial,
+            initial,
+            forward.solves,
+            False,
+            "stopped",
+            f"the forward solve of the initial design stopped: {initial.message}",
+            time.perf_counter() - t0,
+        )
+    best, converged, message = initial, False, ""  # converged: a best fit that misses the tolerance
+    if method == "fixed-point":
+        best, message = fixed_point(forward, initial, max_iter, tolerance)
+    elif initial.deviation > tolerance:
+        best, converged, message = LeastSquares(forward, initial, first, max_iter, tolerance).run()
+    reached = best.deviation <= tolerance
+    if reached:
+        message = f"the final wall is within {tolerance:.3g} of the target"
+    elif not message:
+        message = f"the tolerance was not reached in {max_iter} iterations"
+    status = "finished" if reached or converged else "stopped"
+    return OptimizeResult(
+        method,
+        tolerance,
+        forward.rows,
+        initial,
+        best,
+        forward.solves,
+        reached,
+        status,
+        message,
+        time.perf_counter() - t0,
+    )
+
+
+def case_text(design: Design, values: np.ndarray) -> str:
+    """optimized.toml: the case with the thickness table's t = values, as TOML (tomli-w)."""
+    import tomli_w
+
+    return tomli_w.dumps(design.case_tree(values))
