@@ -115,6 +115,15 @@ def prepare_folder(folder: Path) -> str | None:
             if up.exists():
                 break
         folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        return f"cannot create or write {folder} ({exc.strerror or exc})"
+    return writable(folder)
+
+
+def writable(folder: Path) -> str | None:
+    """Why files cannot be written in an existing folder (read-only, full), or None: a probe
+    file is written and removed."""
+    try:
         probe = folder / ".axiform-write-test"
         probe.write_text("")
         probe.unlink()

@@ -4,6 +4,7 @@ each makes."""
 
 from __future__ import annotations
 
+import io
 import warnings
 from pathlib import Path
 from typing import Annotated, Literal
@@ -17,6 +18,7 @@ from ..contact.surfaces import Circle, Polyline
 from ..fem.mesh import Mesh
 from ..fem.profile import Arc, Line, Profile, ProfileError
 from ..fem.selectors import select_nodes
+from ..io.text import read_text
 from ..materials import Hyperelastic
 from ..model.guards import chain_crossing
 from ..model.model import Model
@@ -171,8 +173,8 @@ def _path_surface(spec: SurfaceSpec, motion: tuple[float, float], base: Path, wh
         try:
             with warnings.catch_warnings():  # an empty file: refused below, not warned about
                 warnings.simplefilter("ignore", UserWarning)
-                points = np.loadtxt(path, delimiter=",", ndmin=2, comments="#")
-        except (OSError, ValueError) as exc:
+                points = np.loadtxt(io.StringIO(read_text(path)), delimiter=",", ndmin=2, comments="#")
+        except (OSError, ValueError) as exc:  # UnicodeDecodeError is a ValueError
             raise CaseError(f"{where}.surface.file: cannot read {path} as r, z rows ({exc})") from None
         if points.size == 0:
             raise CaseError(f"{where}.surface.file: {path} holds no r, z rows")
