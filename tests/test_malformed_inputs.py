@@ -170,3 +170,28 @@ def test_plot_into_a_read_only_folder_is_exit_2(results):
 
 def test_plot_field_misspelt_says_the_nearest(results):
     refused(["plot", results, "--field", "von_mise"], 'did you mean "von_mises"?')
+
+
+# ---- the step cap -----------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("max_dt, target", [(1e-12, 1.0), (1e-7, 1.0), (1e-3, 1e4)])
+def test_a_max_dt_beyond_the_step_cap_is_refused_before_any_work(tmp_path, max_dt, target):
+    case = copy.deepcopy(BASE)
+    case["solver"].update(max_dt=max_dt, target=target)
+    out = tmp_path / "out"
+    refused(["run", write_case(tmp_path, case), "--out", out, "-q"], "solver.max_dt", "1,000,000", bound=10.0)
+    assert not out.exists()
+
+
+def test_a_max_dt_within_the_step_cap_passes_check(tmp_path):
+    case = copy.deepcopy(BASE)
+    case["solver"].update(max_dt=1e-6, target=1.0)
+    code, out, err = call(["check", str(write_case(tmp_path, case))])
+    assert code == 0, err
+
+
+def test_a_negative_load_target_is_refused(tmp_path):
+    case = copy.deepcopy(BASE)
+    case["solver"]["target"] = -1.0
+    refused(["check", write_case(tmp_path, case)], "solver.target: -1 is before the start")
