@@ -242,6 +242,7 @@ def _run(
     case_file: Path, out: str | None, quiet: bool, overrides: list[str], stops: Stops, resume: str | None, stream
 ) -> int:
     from ..case.schema import CaseError
+    from ..io.lock import FolderLock, FolderLocked
 
     try:
         job = Job.read(case_file, overrides, out, resume)
@@ -254,6 +255,22 @@ def _run(
     if problem:
         say(f"axiform: invalid output folder:\n--out: {problem}")
         return 2
+    lock = FolderLock(out_dir)
+    try:
+        lock.acquire()
+    except (FolderLocked, OSError) as exc:
+        say(f"axiform: invalid output folder:\n--{'resume' if resume else 'out'}: {exc}")
+        return 2
+    try:  # the lock is dropped however the run ends (an error, SIGINT, SIGTERM included)
+        return _write(job, out_dir, note, quiet, stops, stream)
+    finally:
+        lock.release()
+
+
+def _write(job: Job, out_dir: Path, note: str, quiet: bool, stops: Stops, stream) -> int:
+    """Run the job into its (locked) folder: a resumed run's checkpoint restored first."""
+    from ..case.schema import CaseError
+
     writer = None
     if job.state is not None:
         try:  # the checkpoint must fit this model and folder before anything is rewritten
@@ -261,7 +278,7 @@ def _run(
             with stops.held():
                 writer = job.writer(out_dir)
         except (ValueError, KeyError) as exc:
-            return invalid(case_file, CaseError(f"--resume: {exc}"))
+            return invalid(job.case_file, CaseError(f"--resume: {exc}"))
     return _solve(job, out_dir, note, writer, quiet, stops, stream)
 
 
