@@ -43,6 +43,7 @@ from .contact import (
     youngs_modulus,
 )
 from .loads import FixSpec, PointLoadSpec, PressureSpec, apply_loads, prescribe_fixes
+from .material import KEYS as LAW_KEYS
 from .material import MaterialSpec
 from .mesh import ArcPiece, LinePiece, MeshSpec, PieceSpec, build_mesh
 from .monitor import HISTORY_COLUMNS, Monitor, MonitorSpec, build_monitors
@@ -207,6 +208,16 @@ def not_table_numbers(data: Any, path: list[str | int] | None = None) -> list[st
     return bad
 
 
+def law_keys(data: dict[str, Any]) -> dict[tuple, list[str]]:
+    """The keys [material] takes for its model (when the model is a known one), for the
+    "did you mean" of an unknown key there: C3 in a Mooney-Rivlin table is not a Yeoh C30."""
+    table = data.get("material")
+    model = table.get("model") if isinstance(table, dict) else None
+    if not isinstance(model, str) or model not in LAW_KEYS:
+        return {}
+    return {("material",): ["model", *LAW_KEYS[model], "kappa", "E", "nu", "viscoelastic"]}
+
+
 def parse(data: dict[str, Any]) -> Case:
     """Validate a case given as a dict (as TOML reads it); CaseError lists every problem with
     its key path.  Every number must be finite, and types are strict: no "80" for 80.0, no
@@ -223,7 +234,7 @@ def parse(data: dict[str, Any]) -> Case:
             msg = err["msg"].removeprefix("Value error, ")
             if err["type"] == "extra_forbidden":
                 msg = "unknown key"
-            lines.append(f"{_loc(err['loc'])}: {msg}{did_you_mean(Case, err)}")
+            lines.append(f"{_loc(err['loc'])}: {msg}{did_you_mean(Case, err, law_keys(data))}")
         raise CaseError("\n".join(dict.fromkeys(lines))) from None
 
 

@@ -67,6 +67,12 @@ class PairRecord:
         }
 
 
+def pair_label(k: int, name: str | None) -> str:
+    """How a message names contact pair k: `contact[k]`, with its own name beside it
+    (`contact[k] ("plug")`) where it has one."""
+    return f'contact[{k}] ("{name}")' if name and name != f"contact[{k}]" else f"contact[{k}]"
+
+
 class RunRecord:
     """Follows the contact pairs over the converged steps (`contact_step`) and draws the
     end-of-run warnings (`warnings`)."""
@@ -119,11 +125,11 @@ class RunRecord:
         for k, (rec, held) in enumerate(zip(self.pairs, step.state.contacts, strict=False)):
             touched = rec.touched or bool(np.isfinite(np.asarray(held.first_contact, float)).any())
             if not touched:
-                lines.append(f'contact[{k}] ("{rec.name}") never touched the body')
+                lines.append(f"{pair_label(k, rec.name)} never touched the body")
             if rec.max_penetration_ratio > PENETRATION_LIMIT:
                 a = rec.at
                 lines.append(
-                    f'contact[{k}] ("{rec.name}") penetrates {100 * rec.max_penetration_ratio:.1f} % of the '
+                    f"{pair_label(k, rec.name)} penetrates {100 * rec.max_penetration_ratio:.1f} % of the "
                     f"local wall thickness ({a['penetration']:.4g} of {a['wall']:.4g} at r = {a['r']:.4g}, "
                     f"z = {a['z']:.4g}, step {a['step']}; above {100 * PENETRATION_LIMIT:g} %): "
                     "raise its penalty or refine the steps"
