@@ -230,7 +230,9 @@ def contact_pair(mesh: Mesh, model: Model, spec: ContactSpec, base: Path, where:
         raise CaseError(f"{where}.slaves: {exc}") from None
     if spec.depth is None and spec.conductance is not None:
         # the default search depth follows the element size; heat across gaps up to
-        # conductance_gap needs the nodes that far seen, on every mesh of the case (refined too)
-        pair.depth = max(pair.depth, spec.conductance_gap)
+        # conductance_gap needs the nodes that far seen, on every mesh of the case (refined too),
+        # up to half the body's smaller extent (deeper, nodes behind the mould would be caught)
+        reach = 0.5 * float(np.ptp(mesh.points, axis=0).min())
+        pair.depth = max(pair.depth, min(spec.conductance_gap, reach))
     pair.name = spec.name or (spec.surface.layer.lower() if spec.surface.layer else None)
     return pair
