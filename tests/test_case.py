@@ -67,7 +67,7 @@ def run(tmp_path, text, *extra):
 def test_plate_runs_and_writes_results(tmp_path, element):
     assert run(tmp_path, PLATE.format(element=element)) == 0
     out = tmp_path / "out"
-    rows = list(csv.DictReader(open(out / "history.csv")))
+    rows = list(csv.DictReader(open(out / "history.csv")))[1:]  # after the t = 0 row
     assert list(rows[0]) == ["step", "load_factor", "time", "iterations", "w_center", "rim_fz"]
     assert float(rows[-1]["w_center"]) == pytest.approx(3.0)
     lam = np.array([float(r["load_factor"]) for r in rows])
@@ -244,7 +244,7 @@ def test_run_that_stops_short_keeps_its_steps(tmp_path, capsys):
     assert run(tmp_path, CYLINDER_BEYOND_LIMIT) == 1
     out = tmp_path / "out"
     summary = json.loads((out / "summary.json").read_text())
-    rows = list(csv.DictReader(open(out / "history.csv")))
+    rows = list(csv.DictReader(open(out / "history.csv")))[1:]  # after the t = 0 row
     assert summary["status"] == "stopped" and "minimum" in summary["message"]
     assert summary["steps"] == len(rows) >= 2
     assert 0.3 < float(rows[-1]["load_factor"]) < 1.0
@@ -280,7 +280,7 @@ dof = "uz"
 steps = 2
 """
     assert run(tmp_path, text) == 0
-    rows = list(csv.DictReader(open(tmp_path / "out" / "history.csv")))
+    rows = list(csv.DictReader(open(tmp_path / "out" / "history.csv")))[1:]  # after the t = 0 row
     assert [float(r["load_factor"]) for r in rows] == [0.5, 1.0]
     assert float(rows[-1]["base_fz"]) == pytest.approx(0.4, rel=1e-9)
 
@@ -307,7 +307,7 @@ def test_toric_plate_case_with_sticky_contact(tmp_path):
         )
         == 0
     )
-    rows = list(csv.DictReader(open(out / "history.csv")))
+    rows = list(csv.DictReader(open(out / "history.csv")))[1:]  # after the t = 0 row
     area = np.array([float(r["contact_area"]) for r in rows])
     assert area[0] == 0 and area[-1] > 0 and (np.diff(area) >= 0).all()  # sticky: never lets go
     text = (out / "contact.csv").read_text().splitlines()

@@ -36,9 +36,9 @@ def test_files_written_in_batches_hold_every_step_at_the_end(tmp_path):
     seen_each, seen_batch = [], []
     _run(tmp_path / "each", 0.0, seen_each)
     _run(tmp_path / "batch", 1e9, seen_batch)
-    assert seen_each == [(k, k, k) for k in range(1, 7)]
+    assert seen_each == [(k + 1, k, k) for k in range(1, 7)]  # history.csv: the t = 0 row and the steps
     # step 1 at once, steps 2-4 before the checkpoint of step 4, nothing more until finish
-    assert seen_batch == [(1, 1, 1), (1, 1, 1), (1, 1, 1), (4, 4, 4), (4, 4, 4), (4, 4, 4)]
+    assert seen_batch == [(2, 1, 1), (2, 1, 1), (2, 1, 1), (5, 4, 4), (5, 4, 4), (5, 4, 4)]
     for name in ("history.csv", "thickness.csv", "fields.pvd"):
         assert (tmp_path / "batch" / name).read_text() == (tmp_path / "each" / name).read_text(), name
     summaries = [json.loads((tmp_path / d / "summary.json").read_text()) for d in ("each", "batch")]

@@ -50,8 +50,11 @@ time = "s"
 
 
 def history_rows(folder: Path) -> list[dict[str, str]]:
+    """The rows of the steps of history.csv (after its t = 0 row)."""
     with open(folder / "history.csv", newline="") as fh:
-        return list(csv.DictReader(fh))
+        table = list(csv.DictReader(fh))
+    assert (table[0]["step"], float(table[0]["time"])) == ("0", 0.0)
+    return table[1:]
 
 
 def pvd(folder: Path) -> list[tuple[float, str]]:

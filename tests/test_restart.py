@@ -138,7 +138,7 @@ def test_axiform_run_resume_gives_the_same_history(tmp_path, monkeypatch):
     out = tmp_path / "cut"
     assert cli.main(["run", str(path), "--out", str(out), "-q"]) == 128 + signal.SIGTERM
     monkeypatch.setattr(solver, "solve", real_solve)
-    assert len(stress_rows(out)) == 5
+    assert len(stress_rows(out)) == 6  # the t = 0 row and 5 steps
     assert cli.main(["run", str(path), "--resume", str(out), "-q"]) == 0
     full, resumed = stress_rows(tmp_path / "full"), stress_rows(out)
     assert len(full) == len(resumed)
@@ -155,4 +155,4 @@ def test_resume_refuses_another_model(tmp_path, capsys):
     # a later target is allowed: the run goes on from its last step
     assert cli.main(["run", str(path), "--resume", str(out), "--set", "solver.target=1.5", "-q"]) == 0
     rows = stress_rows(out)
-    assert rows[-1][1] == pytest.approx(1.5) and [r[0] for r in rows] == list(range(1, len(rows) + 1))
+    assert rows[-1][1] == pytest.approx(1.5) and [r[0] for r in rows] == list(range(len(rows)))

@@ -65,7 +65,8 @@ def _run_and_check(sub) -> None:
         "--resume",
         metavar="DIR",
         help="continue the run in results folder DIR from its last checkpoint (restart/); "
-        "[mesh] and [material] must be unchanged, a later target or more output may be set",
+        "the physics of the run ([mesh], [material], [temperature], [thermal], [[convection]], "
+        "[[contact]], the loads so far) must be unchanged; a later target or more output may be set",
     )
     p_check = sub.add_parser(
         "check",

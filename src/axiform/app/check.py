@@ -19,6 +19,15 @@ def check(case_path: str, overrides: Sequence[str] = (), plot: str | None = None
     from ..case.schema import CaseError, build, parse, read
 
     case_file = Path(case_path)
+    png = None
+    if plot is not None:
+        from ..post.check_plot import png_path
+
+        try:
+            png = png_path(plot, case_file)
+        except (ValueError, OSError) as exc:
+            say(f"axiform: --plot: {exc}")
+            return 2
     try:
         built = build(parse(read(case_file, list(overrides))), case_file.parent)
     except CaseError as exc:
@@ -31,12 +40,9 @@ def check(case_path: str, overrides: Sequence[str] = (), plot: str | None = None
         f"{m.n_free} free dofs"
     )
     warn(*preflight(built))
-    if plot is not None:
+    if png is not None:
         from ..post.check_plot import plot_check
 
-        png = Path(plot)
-        if png.is_dir():
-            png = png / "check.png"
         try:
             png.parent.mkdir(parents=True, exist_ok=True)
             written = plot_check(built, png)

@@ -72,8 +72,10 @@ class FitDataError(ValueError):
 
 def read_text(path: Path) -> str:
     """The text of a data file; FitDataError names the file where it cannot be read."""
+    from ..io.text import read_text as read_bounded
+
     try:
-        return path.read_text()
+        return read_bounded(path)
     except UnicodeDecodeError as exc:
         raise FitDataError(f"{path}: not UTF-8 text (byte {exc.start})") from None
     except OSError as exc:

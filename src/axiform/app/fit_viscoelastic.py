@@ -38,6 +38,9 @@ HEADERS = {
 }
 LONG_TERM_MIN = 1e-6  # E_inf / E0 below this: the data relax to nothing (no solid)
 WLF_POLE_MARGIN = 1e-3  # C2 + T - T_ref at the data or T_ref below this x their span: at the pole
+# how far from the data's temperatures --reference may lie: the span of the data, at least 100 degrees
+# (a reference far beyond them extrapolates the shift by orders of magnitude, or overflows)
+WLF_REFERENCE_REACH = 100.0
 
 
 @dataclass
@@ -320,6 +323,12 @@ def run_wlf(path: str, reference: float | None, out: str | None) -> int:
             given = False
         else:
             given = True
+            reach = max(float(np.ptp(T)), WLF_REFERENCE_REACH)
+            if not T.min() - reach <= reference <= T.max() + reach:
+                raise FitDataError(
+                    f"--reference {reference:g} is far from the data's temperatures ({T.min():g} to {T.max():g}): "
+                    f"give a reference within {reach:g} degrees of them (the shift there is extrapolated)"
+                )
         if len(T) < 2 + given:
             raise FitDataError(
                 f"{path}: {len(T)} rows, fewer than the {2 + given} parameters (C1, C2"

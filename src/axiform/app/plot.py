@@ -25,7 +25,9 @@ def fields_of(folder: Path) -> set[str] | None:
 
 def plot(folder: str, field: str, animate: bool = False) -> int:
     """(Re)write the PNG plots of a results folder; returns the exit code."""
+    from ..case.suggest import nearest
     from ..post.plots import FieldError, plot_folder, read_history
+    from .run import writable
 
     path = Path(folder)
     try:
@@ -43,12 +45,21 @@ def plot(folder: str, field: str, animate: bool = False) -> int:
         say(f"axiform: {folder}: unreadable results ({type(exc).__name__}: {exc})")
         return 2
     if fields is not None and field.split(":")[0] not in fields:
-        say(f"axiform: --field: no field '{field}' in {folder}; there are: {', '.join(sorted(fields))}")
+        guess = nearest(field.split(":")[0], sorted(fields))
+        hint = f'; did you mean "{guess}"?' if guess else ""
+        say(f"axiform: --field: no field '{field}' in {folder}; there are: {', '.join(sorted(fields))}{hint}")
+        return 2
+    problem = writable(path)
+    if problem:
+        say(f"axiform: {problem}")
         return 2
     try:
         pngs = plot_folder(path, field, animate)
     except FieldError as exc:
         say(f"axiform: --field: {exc}")
+        return 2
+    except OSError as exc:  # the folder turned read-only, or the disk is full
+        say(f"axiform: cannot write the plots in {folder} ({exc.strerror or exc})")
         return 2
     except Exception as exc:  # noqa: BLE001 - a fault of axiform's: exit 3
         return failed(exc, f"failed while plotting {folder}")

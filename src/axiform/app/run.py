@@ -1,6 +1,6 @@
 """`axiform run`: read, check, solve and write a case (or resume a run in its folder), with
 SIGINT / SIGTERM winding the run up (`Stops`), the default results folder (`results_folder`)
-and the checks of a resumed run (`resume_state`).  The PNG plots are drawn in this process
+and the checks of a resumed run (app/resume.py).  The PNG plots are drawn in this process
 by the results writer at the end of the run (`plots.plot_folder`).
 
 What it prints: the header, one progress line per converged step (at most 80 columns) and the
@@ -32,8 +32,6 @@ EXIT = {"finished": 0, "stopped": 1, "failed": 3}
 # history.csv, summary.json, thickness.csv and fields.pvd are rewritten at most every half
 # second (and whenever the run ends): four atomic rewrites a step (benchmarks/README.md § 3.1)
 FLUSH_EVERY_S = 0.5
-# the case tables a resumed run may not change: the model must be the same
-FROZEN_ON_RESUME = ("mesh", "material")
 
 
 class Interrupted(Exception):
@@ -115,56 +113,21 @@ def prepare_folder(folder: Path) -> str | None:
             if up.exists():
                 break
         folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        return f"cannot create or write {folder} ({exc.strerror or exc})"
+    return writable(folder)
+
+
+def writable(folder: Path) -> str | None:
+    """Why files cannot be written in an existing folder (read-only, full), or None: a probe
+    file is written and removed."""
+    try:
         probe = folder / ".axiform-write-test"
         probe.write_text("")
         probe.unlink()
     except OSError as exc:
         return f"cannot create or write {folder} ({exc.strerror or exc})"
     return None
-
-
-def resume_state(folder: Path, data: dict) -> dict:
-    """The checkpoint of a results folder to resume, after checking that the case's mesh and
-    material are the ones it was made with; CaseError (exit 2) otherwise."""
-    from ..case.schema import CaseError, fingerprint
-    from ..io.checkpoint import load as load_checkpoint
-
-    try:
-        there = folder.is_dir()
-    except OSError as exc:  # a name longer than the file system allows
-        raise CaseError(f"--resume: {folder}: {exc.strerror or exc}") from None
-    if not there:
-        raise CaseError(f"--resume: {folder} is not a results folder")
-    try:
-        state, meta = load_checkpoint(folder / "restart")
-    except ValueError as exc:
-        raise CaseError(f"--resume: {exc}") from None
-    for key in FROZEN_ON_RESUME:
-        if meta.get(key) != fingerprint(data.get(key, {})):
-            raise CaseError(f"{key}: differs from the run being resumed ([{key}] cannot change on --resume)")
-    return state
-
-
-def check_fit(state: dict, model, folder: Path) -> None:
-    """CaseError (exit 2) naming the checkpoint file and its first item that does not fit the
-    model at hand (another number of unknowns, of contact pairs, a number where a table
-    belongs), before the solve would fail on it."""
-    import numpy as np
-
-    from ..case.schema import CaseError
-    from ..io.checkpoint import FILE, check_like
-
-    template = {
-        "path": {"u_f": np.zeros(model.n_free)},
-        "model": model.initial_state().to_dict(),
-        "size": 0.0,
-        "step": 0,
-        "newton_iterations": 0,
-    }
-    try:
-        check_like(state, template)
-    except ValueError as exc:
-        raise CaseError(f"--resume: {folder / 'restart' / FILE}: {exc}") from None
 
 
 @dataclass
@@ -193,6 +156,8 @@ class Job:
     def read(cls, case_file: Path, overrides: list[str], out: str | None, resume: str | None) -> Job:
         """Read, validate and build the case (CaseError: exit 2)."""
         from ..case.schema import CaseError, build, parse, read
+        from ..case.solver import check_resumed_target
+        from .resume import check_fit, resume_state
 
         data = read(case_file, overrides)
         case = parse(data)
@@ -205,18 +170,32 @@ class Job:
         built = build(case, case_file.parent)
         if state is not None:
             check_fit(state, built.model, Path(resume))
+            check_resumed_target(case.solver, float(state["path"].get("lam", 0.0)))
         return cls(case_file, overrides, data, case, built, state, out)
 
     def folder(self) -> tuple[Path, str]:
         """The results folder (--out, or the default) and a note when it is not the first choice."""
         return (Path(self.out), "") if self.out else results_folder(self.case_file, self.digest)
 
+    def origin(self, out_dir: Path) -> dict[str, Any]:
+        """summary.json's `case`: the case file, its overrides and fingerprint; a resumed run adds
+        the `case` of the run it continues (`resumed_from`, a chain over every resume)."""
+        case: dict[str, Any] = {"file": str(self.case_file), "overrides": self.overrides, "sha256": self.digest}
+        if self.state is not None:
+            try:
+                earlier = json.loads((out_dir / "summary.json").read_text())["case"]
+            except (OSError, ValueError, KeyError, TypeError):
+                earlier = None
+            if isinstance(earlier, dict):
+                case["resumed_from"] = earlier
+        return case
+
     def writer(self, out_dir: Path):
         """The results writer of this run in out_dir (a resumed run keeps the folder's rows and files
         up to its checkpoint)."""
         from ..case.labels import case_labels
-        from ..case.schema import fingerprint
         from ..io.results import ResultsWriter
+        from .resume import frozen_meta
 
         o, case = self.case.output, self.case
         return ResultsWriter(
@@ -231,9 +210,9 @@ class Job:
             plots=o.plots,
             thickness_every=o.thickness_every,
             labels=case_labels(case),
-            case={"file": str(self.case_file), "overrides": self.overrides, "sha256": self.digest},
+            case=self.origin(out_dir),
             restart_every=case.restart.every,
-            restart_meta={key: fingerprint(self.data.get(key, {})) for key in FROZEN_ON_RESUME},
+            restart_meta=frozen_meta(self.data),
             resume=self.state,
             flush_every_s=FLUSH_EVERY_S,
             warnings=self.warnings,
@@ -263,6 +242,7 @@ def _run(
     case_file: Path, out: str | None, quiet: bool, overrides: list[str], stops: Stops, resume: str | None, stream
 ) -> int:
     from ..case.schema import CaseError
+    from ..io.lock import FolderLock, FolderLocked
 
     try:
         job = Job.read(case_file, overrides, out, resume)
@@ -275,6 +255,22 @@ def _run(
     if problem:
         say(f"axiform: invalid output folder:\n--out: {problem}")
         return 2
+    lock = FolderLock(out_dir)
+    try:
+        lock.acquire()
+    except (FolderLocked, OSError) as exc:
+        say(f"axiform: invalid output folder:\n--{'resume' if resume else 'out'}: {exc}")
+        return 2
+    try:  # the lock is dropped however the run ends (an error, SIGINT, SIGTERM included)
+        return _write(job, out_dir, note, quiet, stops, stream)
+    finally:
+        lock.release()
+
+
+def _write(job: Job, out_dir: Path, note: str, quiet: bool, stops: Stops, stream) -> int:
+    """Run the job into its (locked) folder: a resumed run's checkpoint restored first."""
+    from ..case.schema import CaseError
+
     writer = None
     if job.state is not None:
         try:  # the checkpoint must fit this model and folder before anything is rewritten
@@ -282,7 +278,7 @@ def _run(
             with stops.held():
                 writer = job.writer(out_dir)
         except (ValueError, KeyError) as exc:
-            return invalid(case_file, CaseError(f"--resume: {exc}"))
+            return invalid(job.case_file, CaseError(f"--resume: {exc}"))
     return _solve(job, out_dir, note, writer, quiet, stops, stream)
 
 

@@ -46,6 +46,7 @@ from typing import Annotated, Any
 from pydantic import BaseModel, ConfigDict, Field, StrictStr, ValidationError, field_validator, model_validator
 
 from ..case.schema import HISTORY_COLUMNS, CaseError, fingerprint, parse, read
+from ..io.text import MAX_CASE_BYTES, FileTooLarge, read_text
 from ..post.sweep_plots import plot_sweep
 from .console import ProgressLine
 
@@ -143,7 +144,9 @@ def load_sweep(path: str | Path) -> Sweep:
     read and validated (not built) here, before any work."""
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        data = tomllib.loads(read_text(path, MAX_CASE_BYTES))
+    except FileTooLarge as exc:
+        raise CaseError(str(exc)) from None
     except FileNotFoundError:
         raise CaseError(f"{path}: no such file") from None
     except (OSError, UnicodeDecodeError) as exc:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 
 from ..fem.curves import PROPORTIONAL, Curve
 from ..fem.mesh import Mesh
@@ -13,8 +13,18 @@ from ..fem.selectors import select_nodes
 
 DofName = Literal["ur", "uz", "rot"]
 PositiveFloat = Annotated[float, Field(gt=0)]
+
+
+def _increasing_times(knots: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """The knots of a curve, whose times must increase from row to row (ValueError otherwise)."""
+    t = [k[0] for k in knots]
+    if any(b <= a for a, b in zip(t, t[1:], strict=False)):
+        raise ValueError("the times (first column) must increase from row to row")
+    return knots
+
+
 # a load curve [[t0, f0], [t1, f1], ...]: t increasing, the applied value is value x f(t)
-CurveKnots = Annotated[list[tuple[float, float]], Field(min_length=1)]
+CurveKnots = Annotated[list[tuple[float, float]], Field(min_length=1), AfterValidator(_increasing_times)]
 
 
 class CaseError(ValueError):

@@ -4,6 +4,7 @@ each makes."""
 
 from __future__ import annotations
 
+import io
 import warnings
 from pathlib import Path
 from typing import Annotated, Literal
@@ -17,6 +18,7 @@ from ..contact.surfaces import Circle, Polyline
 from ..fem.mesh import Mesh
 from ..fem.profile import Arc, Line, Profile, ProfileError
 from ..fem.selectors import select_nodes
+from ..io.text import read_text
 from ..materials import Hyperelastic
 from ..materials.temperature import TemperatureDependent
 from ..materials.viscoelastic import Viscoelastic
@@ -179,8 +181,8 @@ def _path_surface(spec: SurfaceSpec, motion: tuple[float, float], base: Path, wh
         try:
             with warnings.catch_warnings():  # an empty file: refused below, not warned about
                 warnings.simplefilter("ignore", UserWarning)
-                points = np.loadtxt(path, delimiter=",", ndmin=2, comments="#")
-        except (OSError, ValueError) as exc:
+                points = np.loadtxt(io.StringIO(read_text(path)), delimiter=",", ndmin=2, comments="#")
+        except (OSError, ValueError) as exc:  # UnicodeDecodeError is a ValueError
             raise CaseError(f"{where}.surface.file: cannot read {path} as r, z rows ({exc})") from None
         if points.size == 0:
             raise CaseError(f"{where}.surface.file: {path} holds no r, z rows")
@@ -234,5 +236,11 @@ def contact_pair(mesh: Mesh, model: Model, spec: ContactSpec, base: Path, where:
         )
     except ValueError as exc:
         raise CaseError(f"{where}.slaves: {exc}") from None
+    if spec.depth is None and spec.conductance is not None:
+        # the default search depth follows the element size; heat across gaps up to
+        # conductance_gap needs the nodes that far seen, on every mesh of the case (refined too),
+        # up to half the body's smaller extent (deeper, nodes behind the mould would be caught)
+        reach = 0.5 * float(np.ptp(mesh.points, axis=0).min())
+        pair.depth = max(pair.depth, min(spec.conductance_gap, reach))
     pair.name = spec.name or (spec.surface.layer.lower() if spec.surface.layer else None)
     return pair

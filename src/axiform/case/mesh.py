@@ -14,6 +14,7 @@ from pydantic import Field, model_validator
 
 from ..fem.mesh import Mesh, MeshError, layered, read_gmsh, rectangle
 from ..fem.profile import Arc, Line, Profile, ProfileError
+from ..io.text import check_regular
 from .base import CaseError, PositiveFloat, Strict
 
 
@@ -174,6 +175,7 @@ def build_mesh(spec: MeshSpec, base: Path) -> Mesh:
             raise CaseError(f"mesh.file: no such file {path}")
         if path.is_dir():
             raise CaseError(f"mesh.file: {path} is a folder, not a gmsh file")
+        check_regular(path)
     except OSError as exc:  # a name longer than the file system allows, a folder that cannot be read
         raise CaseError(f"mesh.file: cannot read {path} ({exc.strerror or exc})") from None
     said = io.StringIO()  # meshio prints its warnings and errors itself

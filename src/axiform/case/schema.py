@@ -23,6 +23,7 @@ from pydantic import ValidationError
 
 from ..fem.mesh import MeshError
 from ..fem.selectors import SelectorError
+from ..io.text import MAX_CASE_BYTES, FileTooLarge, read_text
 from ..model.guards import boundary_crossing, free_to_slide
 from ..model.model import Model
 from ..post.thickness import default_wall
@@ -42,6 +43,7 @@ from .contact import (
     youngs_modulus,
 )
 from .loads import FixSpec, PointLoadSpec, PressureSpec, apply_loads, prescribe_fixes
+from .material import KEYS as LAW_KEYS
 from .material import MaterialSpec
 from .mesh import ArcPiece, LinePiece, MeshSpec, PieceSpec, build_mesh
 from .monitor import HISTORY_COLUMNS, Monitor, MonitorSpec, build_monitors
@@ -182,12 +184,47 @@ def out_of_range(data: Any, path: list[str | int] | None = None) -> list[str]:
     return []
 
 
+def not_table_numbers(data: Any, path: list[str | int] | None = None) -> list[str]:
+    """Every cell of a table (a list of rows: [[x, y], ...], as a curve, a temperature table, a
+    polyline or a box) that is not a number (a string, a boolean, a list, a table), and every
+    row of one that is not a list, as 'key.path: reason' lines: a table of a case holds
+    numbers only, and its validators compare and sort them."""
+    path = path or []
+    if isinstance(data, dict):
+        return [line for k, v in data.items() for line in not_table_numbers(v, [*path, str(k)])]
+    if not isinstance(data, list):
+        return []
+    if not any(isinstance(row, list) for row in data):
+        return [line for i, v in enumerate(data) for line in not_table_numbers(v, [*path, i])]
+    bad = []
+    for i, row in enumerate(data):
+        if not isinstance(row, list):
+            bad.append(f"{key_path([*path, i])}: a row of the table must be a list of numbers, got {row!r}")
+            continue
+        bad += [
+            f"{key_path([*path, i, j])}: must be a number, got {cell!r}"
+            for j, cell in enumerate(row)
+            if isinstance(cell, bool) or not isinstance(cell, int | float)
+        ]
+    return bad
+
+
+def law_keys(data: dict[str, Any]) -> dict[tuple, list[str]]:
+    """The keys [material] takes for its model (when the model is a known one), for the
+    "did you mean" of an unknown key there: C3 in a Mooney-Rivlin table is not a Yeoh C30."""
+    table = data.get("material")
+    model = table.get("model") if isinstance(table, dict) else None
+    if not isinstance(model, str) or model not in LAW_KEYS:
+        return {}
+    return {("material",): ["model", *LAW_KEYS[model], "kappa", "E", "nu", "viscoelastic"]}
+
+
 def parse(data: dict[str, Any]) -> Case:
     """Validate a case given as a dict (as TOML reads it); CaseError lists every problem with
     its key path.  Every number must be finite, and types are strict: no "80" for 80.0, no
     true for 1 (the tree goes through JSON, whose strict mode still takes arrays for tuples
     and integers for floats)."""
-    bad = not_numbers(data) or out_of_range(data)
+    bad = not_numbers(data) or not_table_numbers(data) or out_of_range(data)
     if bad:
         raise CaseError("\n".join(bad))
     try:
@@ -198,7 +235,7 @@ def parse(data: dict[str, Any]) -> Case:
             msg = err["msg"].removeprefix("Value error, ")
             if err["type"] == "extra_forbidden":
                 msg = "unknown key"
-            lines.append(f"{_loc(err['loc'])}: {msg}{did_you_mean(Case, err)}")
+            lines.append(f"{_loc(err['loc'])}: {msg}{did_you_mean(Case, err, law_keys(data))}")
         raise CaseError("\n".join(dict.fromkeys(lines))) from None
 
 
@@ -251,7 +288,9 @@ def read(path: str | Path, overrides: list[str] = ()) -> dict[str, Any]:
     """The tree of a TOML case file with KEY=VALUE overrides applied, not yet validated."""
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_bytes().decode("utf-8"))
+        data = tomllib.loads(read_text(path, MAX_CASE_BYTES))
+    except FileTooLarge as exc:
+        raise CaseError(str(exc)) from None
     except FileNotFoundError:
         raise CaseError(f"{path}: no such file") from None
     except IsADirectoryError:

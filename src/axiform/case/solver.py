@@ -102,4 +102,27 @@ def build_control(model: Model, mesh: Mesh, spec: SolverSpec) -> LoadControl | D
             stop_value,
             spec.max_steps,
         )
-    return LoadControl(1.0 if spec.target is None else spec.target, spec.steps, spec.max_dt)
+    target = 1.0 if spec.target is None else spec.target
+    if target < 0:
+        raise CaseError(
+            f"solver.target: {target:g} is before the start: under load control the load factor (the "
+            "process time) goes from 0 up to the target; reverse the loads' values instead"
+        )
+    if spec.max_dt is not None and target / spec.max_dt > MAX_STEPS:
+        raise CaseError(
+            f"solver.max_dt: {spec.max_dt:g} makes at least {target / spec.max_dt:.3g} steps from 0 to the "
+            f"target {target:g}, more than {MAX_STEPS:,}: give a longer max_dt (or a shorter target)"
+        )
+    return LoadControl(target, spec.steps, spec.max_dt)
+
+
+def check_resumed_target(spec: SolverSpec, reached: float) -> None:
+    """CaseError unless the target of a resumed load-controlled run lies beyond the load factor
+    (the process time) its checkpoint reached: a run goes forward only.  The steps max_dt makes
+    from there are bounded by build_control's check from 0."""
+    target = 1.0 if spec.target is None else spec.target
+    if spec.control == "load" and target <= reached * (1 + 1e-12):
+        raise CaseError(
+            f"solver.target: {target:g} is not beyond the load factor {reached:g} the run being resumed "
+            "has reached: give a later target"
+        )

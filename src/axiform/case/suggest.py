@@ -64,12 +64,18 @@ def nearest(word: str, choices: list[str]) -> str | None:
     return lower[found[0]] if found else None
 
 
-def did_you_mean(root: type[BaseModel], err: dict) -> str:
-    """'; did you mean "X"?' for a pydantic error (unknown key, misspelt literal), or ''."""
+def did_you_mean(root: type[BaseModel], err: dict, within: dict[tuple, list[str]] | None = None) -> str:
+    """'; did you mean "X"?' for a pydantic error (unknown key, misspelt literal), or ''.
+    within: for some tables (by key path), the keys that apply there (the keys of the
+    material law at hand, not of every law): the guess is taken among them, and where none
+    is close they are listed."""
     guess = None
     if err["type"] == "extra_forbidden" and err["loc"]:
         *table, key = err["loc"]
-        guess = nearest(str(key), table_keys(root, tuple(table)))
+        own = (within or {}).get(tuple(table))
+        guess = nearest(str(key), own if own is not None else table_keys(root, tuple(table)))
+        if guess is None and own:
+            return f"; this table takes {', '.join(own)}"
     elif err["type"] == "literal_error" and isinstance(err.get("input"), str):
         guess = nearest(err["input"], re.findall(r"'([^']*)'", str(err.get("ctx", {}).get("expected", ""))))
     return f'; did you mean "{guess}"?' if guess else ""

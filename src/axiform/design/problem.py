@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..case.schema import MAX_MAGNITUDE, MIN_MAGNITUDE, Built, CaseError, build, parse, read
+from ..io.text import read_text
 from ..model.model import Model
 from ..solve.solver import LoadControl
 
@@ -36,7 +37,7 @@ def read_target(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     (increasing) and the wanted final thickness (> 0).  Returns s, thickness (k,)."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_text(path)
     except (OSError, UnicodeDecodeError) as exc:
         raise TargetError(f"{path}: cannot read it ({getattr(exc, 'strerror', None) or exc})") from None
     rows = [(n, line) for n, line in enumerate(text.splitlines(), 1) if line.strip() and not line.startswith("#")]

@@ -28,10 +28,20 @@ import numpy as np
 
 from ..post.fields import point_fields, with_components
 from ..post.thickness import thickness_table, write_thickness_csv
+from ..solve.controls import Step
 from . import gid
 from .columns import HISTORY_COLUMNS
 from .files import atomic, contact_table, mould_outlines, write_atomic, write_pvd, write_vtu
 from .run_report import RunRecord, column_units, thickness_summary
+
+
+def initial_step(model) -> Step:
+    """The state a run starts from (step 0, t = 0), as a step for the monitors: the
+    displacements prescribed at t = 0, no reactions, the model's initial history (its
+    temperatures, untouched contact pairs, cavities at their initial volume)."""
+    u_f = np.zeros(model.n_free)
+    u = model.expand(u_f, 0.0)
+    return Step(0, 0.0, 0, [], u_f, u, np.zeros_like(u), None, model.initial_state())
 
 
 class NonFiniteResult(ArithmeticError):
@@ -186,6 +196,8 @@ class ResultsWriter:
         self._csv.writerow(header)
         earlier = _read_summary(self.out).get("contact") if resume is not None else None  # the run's maxima so far
         times = self._resume(resume, header) if resume is not None else {}
+        if resume is None:
+            self._csv.writerow(self._row(initial_step(self.model), self._values(initial_step(self.model))))
         self.record = RunRecord(self.model, earlier if times else None)
         write_atomic(self.out / "history.csv", self._history.getvalue())
         self._pvd = clear_folder(
@@ -220,7 +232,7 @@ class ResultsWriter:
         if not rows or rows[0] != header:
             raise ValueError(f"{self.out}/history.csv has other columns than this case's monitors")
         kept = [r for r in rows[1:] if r and int(r[0]) <= step]
-        if len(kept) != step:
+        if len(kept) != step + (kept[:1] != [] and int(kept[0][0]) == 0):  # with the t = 0 row, or before it
             raise ValueError(f"{self.out}/history.csv holds {len(kept)} rows up to step {step}")
         for r in kept:
             self._csv.writerow(r)
@@ -228,6 +240,15 @@ class ResultsWriter:
         self.newton_iterations = int(checkpoint["newton_iterations"])
         self.summary.update(steps=step, newton_iterations=self.newton_iterations, load_factor=float(kept[-1][1]))
         return {int(r[0]): float(r[2]) for r in kept}
+
+    def _values(self, step) -> dict[str, float]:
+        return {m.name: m.value(step) for m in self.monitors}
+
+    @staticmethod
+    def _row(step, values: dict[str, float]) -> list:
+        """A row of history.csv: step, load_factor, time (= load_factor), iterations, monitors."""
+        lam = repr(float(step.lam))
+        return [step.number, lam, lam, step.iterations] + [repr(v) for v in values.values()]
 
     def _write_summary(self):
         self.summary["wall_time_s"] = round(time.perf_counter() - self.t0, 4)
@@ -272,12 +293,9 @@ class ResultsWriter:
         flush_every_s; a step holding NaN or inf raises NonFiniteResult and nothing of it is
         written."""
         self._wait_for_vtu(wait=False)
-        values = {m.name: m.value(step) for m in self.monitors}
+        values = self._values(step)
         self._guard(step, values)
-        self._csv.writerow(
-            [step.number, repr(float(step.lam)), repr(float(step.lam)), step.iterations]
-            + [repr(v) for v in values.values()]
-        )
+        self._csv.writerow(self._row(step, values))
         if self.model.contacts:
             self._record_contact(step)
         self.steps = step.number

@@ -70,6 +70,12 @@ class PairRecord:
         }
 
 
+def pair_label(k: int, name: str | None) -> str:
+    """How a message names contact pair k: `contact[k]`, with its own name beside it
+    (`contact[k] ("plug")`) where it has one."""
+    return f'contact[{k}] ("{name}")' if name and name != f"contact[{k}]" else f"contact[{k}]"
+
+
 class RunRecord:
     """Follows the contact pairs over the converged steps (`contact_step`) and draws the
     end-of-run warnings (`warnings`)."""
@@ -127,7 +133,7 @@ class RunRecord:
         work above STABILIZATION_LIMIT of the strain energy."""
         lines = []
         for k, (rec, held) in enumerate(zip(self.pairs, step.state.contacts, strict=False)):
-            name = f"contact[{k}]" + (f' ("{rec.name}")' if rec.name != f"contact[{k}]" else "")
+            name = pair_label(k, rec.name)
             touched = rec.touched or bool(np.isfinite(np.asarray(held.first_contact, float)).any())
             if not touched:
                 lines.append(f"{name} never touched the body")

@@ -331,9 +331,12 @@ def _draw_monitors(ax, case, built) -> None:
         if m.at is None and m.reaction is None:
             continue
         monitor = next(x for x in built.monitors if x.name == m.name)
-        nodes = np.unique(monitor.dofs // model.dpn)
+        if monitor.quantity == "temperature":  # a node's temperature: the node, no dof
+            nodes, what, dof = np.array([monitor.index]), "temperature monitor", "T"
+        else:
+            nodes, dof = np.unique(monitor.dofs // model.dpn), m.dof
+            what = "monitor" if m.at is not None else "reaction monitor"
         marker = "*" if m.at is not None else "x"
-        what = "monitor" if m.at is not None else "reaction monitor"
         ax.plot(
             X[nodes, 0],
             X[nodes, 1],
@@ -341,12 +344,28 @@ def _draw_monitors(ax, case, built) -> None:
             ls="none",
             ms=10 if marker == "*" else 6,
             color=COLOURS["monitor"],
-            label=f"{what} {m.name} ({m.dof})",
+            label=f"{what} {m.name} ({dof})",
         )
         if m.at is not None:
             ax.annotate(
                 m.name, X[nodes[0]], xytext=(5, 5), textcoords="offset points", fontsize=7, color=COLOURS["monitor"]
             )
+
+
+def png_path(plot: str | Path, case_file: str | Path) -> Path:
+    """Where `check --plot PLOT` draws: PLOT, or PLOT/check.png for a folder.  ValueError
+    (saying why) for a path that is not a .png file or is the case file itself: the picture
+    is PNG only and must never overwrite the case."""
+    png = Path(plot)
+    if png.is_dir():
+        png = png / "check.png"
+    if png.suffix.lower() != ".png":
+        raise ValueError(f"{png}: the picture is a PNG file: give a path ending in .png (or a folder)")
+    if png.exists() and Path(case_file).exists() and png.resolve() == Path(case_file).resolve():
+        raise ValueError(f"{png}: the case file itself: give another path")
+    if png.exists() and not png.is_file():
+        raise ValueError(f"{png}: not a regular file")
+    return png
 
 
 def plot_check(built, path: str | Path) -> Path:

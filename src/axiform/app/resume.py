@@ -1,0 +1,154 @@
+"""What `axiform run --resume DIR` checks before it continues a run: the checkpoint of the
+folder (`resume_state`), that it fits the model at hand (`check_fit`), and that the case
+changes nothing of the physics the run has already been through (`check_frozen`).
+
+A resumed run splices its steps onto those of the run it continues, so everything that made
+those steps must be what makes the next ones: the tables of FROZEN_TABLES whole ([mesh],
+[material], [temperature], [thermal], [[convection]]), every [[contact]] key but the
+numerical ones of CONTACT_NUMERICS (its geometry, motion, friction and heat), and the loads
+([[fix]], [[pressure]], [[point_load]], [[cavity]]) up to the resume time: each key of
+theirs but `curve` unchanged, and their curve f(t) the same from t = 0 to the load factor
+the checkpoint reached (a curve may change beyond it).  A later solver.target, other solver
+numbers and more output are allowed.  The checkpoint's meta holds these tables as the case
+had them (`frozen_meta`); a checkpoint written before it (only the fingerprints of [mesh]
+and [material]) is checked on those two.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..case.schema import CaseError, fingerprint
+from ..fem.curves import Curve
+
+# tables that cannot change at all; the first two are also kept as fingerprints (the meta of
+# earlier checkpoints, which hold only these)
+FROZEN_TABLES = ("mesh", "material", "temperature", "thermal", "convection")
+FINGERPRINTED = ("mesh", "material")
+# the [[contact]] keys a resumed run may change: how contact is enforced and searched, not what touches what
+CONTACT_NUMERICS = ("name", "penalty", "tangential_penalty", "depth", "search", "stabilization")
+# the arrays of tables whose loads are frozen up to the resume time: every key but the curve
+LOADS = ("fix", "pressure", "point_load", "cavity")
+
+
+def _plain(value: Any) -> Any:
+    """The tree as JSON has it (what a checkpoint's meta gives back)."""
+    return json.loads(json.dumps(value, sort_keys=True, default=str))
+
+
+def frozen_meta(data: dict[str, Any]) -> dict[str, Any]:
+    """What a checkpoint keeps of the case (its meta): the fingerprints of FINGERPRINTED and,
+    under `physics`, the frozen tables, the [[contact]] and the load tables as the case has them."""
+    physics = {key: data.get(key) for key in (*FROZEN_TABLES, "contact", *LOADS)}
+    return {key: fingerprint(data.get(key, {})) for key in FINGERPRINTED} | {"physics": _plain(physics)}
+
+
+def _first_difference(a: Any, b: Any, where: str) -> str | None:
+    """The key path of the first place where two trees differ, or None."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        for key in sorted(set(a) | set(b)):
+            found = _first_difference(a.get(key), b.get(key), f"{where}.{key}")
+            if found:
+                return found
+        return None
+    if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            found = _first_difference(x, y, f"{where}[{i}]")
+            if found:
+                return found
+        return None
+    return None if a == b else where
+
+
+def _refuse(table: str, where: str, why: str = "differs from the run being resumed") -> CaseError:
+    brackets = f"[[{table}]]" if table in ("convection", "contact", *LOADS) else f"[{table}]"
+    return CaseError(
+        f"{table}: {why} (at {where}): {brackets} cannot change on --resume, the steps already made "
+        "would not be those of this case; start a new run instead"
+    )
+
+
+def _same_curve(old: list | None, new: list | None, until: float) -> bool:
+    """Whether two load curves (knots, or None: f(t) = t) agree from t = 0 to `until`: both are
+    piecewise linear, so they agree there when they agree at 0, `until` and every knot between."""
+    knots = [k[0] for k in (old or []) + (new or []) if 0.0 < k[0] < until]
+    f, g = Curve(old), Curve(new)
+    return all(abs(f(t) - g(t)) <= 1e-12 * max(abs(f(t)), abs(g(t))) for t in (0.0, *knots, until))
+
+
+def _check_entries(table: str, old: list, new: list, reached: float) -> None:
+    """The [[table]] entries of a resumed case against those of its run (see the module docstring)."""
+    if len(old) != len(new):
+        raise _refuse(table, table, f"{len(new)} tables, the run being resumed had {len(old)}")
+    for i, (a, b) in enumerate(zip(old, new, strict=True)):
+        if table == "contact":
+            a, b = ({k: v for k, v in x.items() if k not in CONTACT_NUMERICS} for x in (a, b))
+        elif table in LOADS:
+            if not _same_curve(a.get("curve"), b.get("curve"), reached):
+                raise _refuse(table, f"{table}[{i}].curve", f"the curve differs before the resume time {reached:g}")
+            a, b = ({k: v for k, v in x.items() if k != "curve"} for x in (a, b))
+        found = _first_difference(a, b, f"{table}[{i}]")
+        if found:
+            raise _refuse(table, found)
+
+
+def check_frozen(meta: dict[str, Any], data: dict[str, Any], reached: float) -> None:
+    """CaseError naming the table (and the key) where the case of a resumed run changes the
+    physics of the run its checkpoint (meta) was made by, up to the load factor `reached`."""
+    physics = meta.get("physics")
+    if not isinstance(physics, dict):  # a checkpoint of before the physics in its meta
+        for key in FINGERPRINTED:
+            if meta.get(key) != fingerprint(data.get(key, {})):
+                raise _refuse(key, key)
+        return
+    new = _plain({key: data.get(key) for key in physics})
+    for key in FROZEN_TABLES:
+        found = _first_difference(physics.get(key), new.get(key), key)
+        if found:
+            raise _refuse(key, found)
+    for key in ("contact", *LOADS):
+        _check_entries(key, physics.get(key) or [], new.get(key) or [], reached)
+
+
+def resume_state(folder: Path, data: dict) -> dict:
+    """The checkpoint of a results folder to resume, after checking that the case changes
+    nothing frozen (check_frozen); CaseError (exit 2) otherwise."""
+    from ..io.checkpoint import load as load_checkpoint
+
+    try:
+        there = folder.is_dir()
+    except OSError as exc:  # a name longer than the file system allows
+        raise CaseError(f"--resume: {folder}: {exc.strerror or exc}") from None
+    if not there:
+        raise CaseError(f"--resume: {folder} is not a results folder")
+    try:
+        state, meta = load_checkpoint(folder / "restart")
+    except ValueError as exc:
+        raise CaseError(f"--resume: {exc}") from None
+    path = state.get("path")
+    reached = path.get("lam", 0.0) if isinstance(path, dict) else 0.0
+    check_frozen(meta, data, float(reached) if isinstance(reached, int | float) else 0.0)
+    return state
+
+
+def check_fit(state: dict, model, folder: Path) -> None:
+    """CaseError (exit 2) naming the checkpoint file and its first item that does not fit the
+    model at hand (another number of unknowns, of contact pairs, a number where a table
+    belongs), before the solve would fail on it."""
+    from ..io.checkpoint import FILE, check_like
+
+    template = {
+        "path": {"u_f": np.zeros(model.n_free)},
+        "model": model.initial_state().to_dict(),
+        "size": 0.0,
+        "step": 0,
+        "newton_iterations": 0,
+    }
+    try:
+        check_like(state, template)
+    except ValueError as exc:
+        raise CaseError(f"--resume: {folder / 'restart' / FILE}: {exc}") from None
