@@ -194,3 +194,17 @@ def test_a_modulus_in_pa_in_an_mpa_case_is_warned(tmp_path, capsys):
     assert code == 0 and re.search(r"warning: material: a shear modulus of 1e\+06 MPa is above 10000 MPa", err), err
     code, err = check(capsys, case_with(tmp_path, lambda d: d.update(units={"pressure": "MPa"})))
     assert code == 0 and "shear modulus" not in err, err
+
+
+def test_an_error_of_the_initial_field_without_a_shift_names_the_initial_field(monkeypatch):
+    """The key blamed for a temperature field the model refuses, in a case without shift, is
+    temperature.initial (not a shift the case does not have)."""
+    from axiform.case.base import CaseError
+    from axiform.model.model import Model
+
+    def refuse(self, T, shift=None):
+        raise ValueError("every temperature must be a finite number")
+
+    monkeypatch.setattr(Model, "heat", refuse)
+    with pytest.raises(CaseError, match=r"^temperature\.initial: every temperature must be a finite number"):
+        build(parse(tomllib.loads(CASE)))
