@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """A cold mould that freezes the wall through temperature, beside the sticky mould:
 examples/cup_thermoforming.toml (the sheet sticks where it touches, no heat) and
-examples/cup_cold_mould.toml (heat flows into the 40 C mould, the colder sheet is stiffer and
+examples/cup_cold_mould.toml (heat flows into the 60 C mould, the colder sheet is stiffer and
 relaxes more slowly, it slides with friction 0.5), the same sheet, plug and vacuum.
 
 Writes results/cold_mould.png (the final wall, the time each point first touched the mould,
@@ -32,7 +32,7 @@ EXAMPLES = HERE.parent / "examples"
 RESULTS = HERE / "results"
 QUIET = ["-q", "--set", "output.plots=false", "--set", "output.vtu=false"]
 S_REPORT = {"bottom centre": 0.0, "bottom corner": 11.0, "side, mid-height": 25.0}
-CASES = {"sticky mould (no heat)": "cup_thermoforming", "cold mould (40 C, heat, friction 0.5)": "cup_cold_mould"}
+CASES = {"sticky mould (no heat)": "cup_thermoforming", "cold mould (60 C, heat, friction 0.5)": "cup_cold_mould"}
 
 
 def run(name: str, folder: Path) -> tuple[dict[str, np.ndarray], dict]:

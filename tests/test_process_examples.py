@@ -177,10 +177,10 @@ def test_coarse_straight_edged_preform_passes_the_pre_blow(element):
 @pytest.mark.slow
 def test_the_cold_mould_cools_the_skin_it_touches_and_stays_between_its_temperatures(tmp_path):
     """The cup on a cold mould (examples/cup_cold_mould.toml, 50 x 2 elements): it finishes;
-    the sheet cools where it touches the 40 C mould (to 54 C at the rim's flange, touched
-    from t = 0.1 s), never below the mould nor above the oven's 150 C (the lumped heat
-    capacity keeps backward Euler between them); the thinnest wall is the bottom corner,
-    which the vacuum reaches last, still hot."""
+    the sheet cools where it touches the 60 C mould (to 72 C at the rim's flange, touched
+    from t = 0.1 s), never below the mould nor above the oven's 150 C (the heat scheme keeps
+    the maximum principle); the thinnest wall is the bottom corner, which the vacuum reaches
+    last, still hot."""
     out = tmp_path / "out"
     assert (
         main(
@@ -202,5 +202,5 @@ def test_the_cold_mould_cools_the_skin_it_touches_and_stays_between_its_temperat
     )
     summary = json.loads((out / "summary.json").read_text())
     T = summary["temperature"]
-    assert 40.0 <= T["min"] < 60.0 and T["max"] <= 150.0 + 1e-9
+    assert 60.0 <= T["min"] < 80.0 and T["max"] <= 150.0 + 1e-9
     assert 9.0 <= summary["thickness"]["s_min"] <= 13.0 and summary["thickness"]["min"] < 0.25

@@ -133,6 +133,10 @@ class ContactSpec(Strict):
             raise ValueError("temperature (the mould's) and conductance go together")
         if self.temperature_curve is not None and self.temperature is None:
             raise ValueError("temperature_curve needs temperature")
+        if "conductance_gap" in self.model_fields_set and self.conductance is None:
+            raise ValueError(
+                "conductance_gap needs conductance (and the mould's temperature): no heat flows without them"
+            )
         return self
 
 

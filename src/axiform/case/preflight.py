@@ -14,7 +14,9 @@ fault.
   tangent (no contact) for the largest increment its curve makes over one nominal step
   (INVERTING_FRACTION of it): a value typed in other units (a pressure in Pa in an mm / MPa
   case); under displacement control (the load factor an unknown), the driven dof's step
-  target / steps instead.  Not for cavities under volume or gas control.
+  target / steps instead.  Not for cavities under volume or gas control;
+- the units' plausibility (case.plausible): tables of T out of reach of every temperature
+  of the case, a modulus in Pa in an MPa case.
 
 `preflight(built)` runs them all; nothing here writes or prints.
 """
@@ -31,6 +33,7 @@ from ..fem.elements import gradient_operator
 from ..fem.selectors import select_nodes
 from ..solve.linsolve import SingularTangentError, factorize
 from ..solve.solver import DisplacementControl
+from .plausible import modulus_units, tables_out_of_reach
 from .schema import Built
 
 # a load is flagged where this fraction of its largest step would already invert elements in
@@ -48,7 +51,14 @@ def preflight(built: Built) -> list[str]:
     check that fails on an unforeseen case gives no warning rather than stopping the run it
     only advises (each check alone raises: the tests call them one by one)."""
     out = []
-    for check in (curves_past_target, mould_checks, inverting_loads, idle_temperature):
+    for check in (
+        curves_past_target,
+        mould_checks,
+        inverting_loads,
+        idle_temperature,
+        tables_out_of_reach,
+        modulus_units,
+    ):
         try:
             out += check(built)
         except Exception:  # noqa: BLE001 - advice only: never in the way of a valid case

@@ -50,7 +50,7 @@ from .monitor import HISTORY_COLUMNS, Monitor, MonitorSpec, build_monitors
 from .output import MAX_REVOLVED_POINTS, OutputSpec, RestartSpec, Unit, UnitsSpec
 from .solver import DofRef, SolverSpec, StopSpec, build_control
 from .suggest import did_you_mean
-from .temperature import TemperatureSpec
+from .temperature import TemperatureSpec, give_temperature
 from .thermal import ConvectionSpec, ThermalSpec, build_conduction
 from .tree import key_path, not_numbers
 
@@ -342,11 +342,7 @@ def build(case: Case, base: str | Path = ".") -> Built:
     except MeshError as exc:
         raise CaseError(f"mesh: {exc}") from None
     if heat is not None:
-        try:
-            model.heat(heat.nodal(mesh), heat.build_shift())
-        except ValueError as exc:
-            key = "wlf.C2" if heat.shift is not None and heat.shift.wlf is not None else "arrhenius"
-            raise CaseError(f"temperature.shift.{key}: {exc}") from None
+        give_temperature(model, mesh, case)
     crossing = boundary_crossing(mesh.points, mesh.boundary_edges)
     if crossing is not None:
         p = mesh.points[mesh.boundary_edges[crossing[0], 0]]

@@ -20,9 +20,24 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import ValidationError, field_validator, model_validator
 
+from ..fem.curves import Curve
 from ..fem.mesh import Mesh
-from ..materials.temperature import WLF, Arrhenius, Shift, Table
+from ..materials.temperature import WLF, Arrhenius, Shift, Table, TemperatureDomainError
+from ..model.model import Model
 from .base import CaseError, PositiveFloat, Strict
+
+# [units] temperature: the spellings of degrees Celsius and of kelvin (an Arrhenius shift needs
+# the absolute temperature T + 273.15 of a case in Celsius; without the key, kelvin)
+CELSIUS = ("C", "°C", "degC", "deg C", "celsius", "Celsius")
+KELVIN = ("K", "kelvin", "Kelvin")
+
+
+def absolute_zero(unit: str | None) -> float | None:
+    """The kelvin of the unit's zero: 273.15 for degrees Celsius, 0 for kelvin and for no
+    unit (the temperatures are then taken as kelvin); None for any other unit."""
+    if unit is None or unit in KELVIN:
+        return 0.0
+    return 273.15 if unit in CELSIUS else None
 
 
 def _increasing_table(rows: list[tuple[float, float]], what: str) -> list[tuple[float, float]]:
@@ -105,13 +120,25 @@ class TemperatureSpec(Strict):
             raise ValueError("reference: the shift needs its reference temperature T_ref")
         return self
 
-    def build_shift(self) -> Shift | None:
-        """The shift of the relaxation times, or None."""
+    def build_shift(self, unit: str | None = None) -> Shift | None:
+        """The shift of the relaxation times, or None; `unit`: [units] temperature, which
+        makes the temperatures of an Arrhenius shift absolute (CaseError naming the key)."""
         if self.shift is None:
             return None
+        assert self.reference is not None  # the validator's
         if self.shift.wlf is not None:
             return WLF(self.shift.wlf.C1, self.shift.wlf.C2, self.reference)
-        return Arrhenius(self.shift.arrhenius.activation, self.reference)
+        assert self.shift.arrhenius is not None
+        offset = absolute_zero(unit)
+        if offset is None:
+            raise CaseError(
+                f'units.temperature: an Arrhenius shift needs absolute temperatures: give "C" (degrees Celsius) '
+                f'or "K" (kelvin), not {unit!r}'
+            )
+        try:
+            return Arrhenius(self.shift.arrhenius.activation, self.reference, offset)
+        except TemperatureDomainError as exc:
+            raise CaseError(f"temperature.reference: {exc}") from None
 
     def nodal(self, mesh: Mesh) -> np.ndarray:
         """The initial temperature of every node (n_nodes,)."""
@@ -138,3 +165,67 @@ class TemperatureSpec(Strict):
         if isinstance(self.initial, InitialTable):
             return float(max(v for _, v in self.initial.table))
         return float(self.initial)
+
+
+def _scaled(value: float, knots, end: float | None) -> list[tuple[float, str]]:
+    """(value x f(t), how) at every time a temperature x curve can take its extremes within
+    the run: t = 0, the end time and the knots between (all knots where the end is not
+    known); f is piecewise linear and constant outside its knots."""
+    if knots is None:
+        return [(float(value), "")]
+    curve = Curve(knots)
+    times = [float(t) for t, _ in knots]
+    if end is not None:
+        low, high = min(0.0, end), max(0.0, end)
+        times = [0.0, *(t for t in times if low <= t <= high), end]
+    return [(float(value) * curve(t), f" ({float(value):g} x its curve at t = {t:g})") for t in times]
+
+
+def boundary_temperatures(case) -> list[tuple[str, float, str]]:
+    """(key, temperature, how) of every temperature besides the initial field that the case
+    can bring into the wall: each mould's temperature x its curve, each film's ambient x its
+    curve, over the run ([solver] target under load control, else every knot)."""
+    end = float(case.solver.target) if case.solver.control == "load" and case.solver.target is not None else None
+    out = []
+    for k, c in enumerate(case.contact):
+        if c.temperature is not None:
+            out += [
+                (f"contact[{k}].temperature", v, how) for v, how in _scaled(c.temperature, c.temperature_curve, end)
+            ]
+    for i, c in enumerate(case.convection):
+        out += [(f"convection[{i}].ambient", v, how) for v, how in _scaled(c.ambient, c.curve, end)]
+    return out
+
+
+def check_boundary_temperatures(case, shift: Shift | None) -> None:
+    """CaseError naming the key of the first mould or film temperature at or below the
+    shift's pole: heat conduction would carry the wall there (the maximum principle bounds
+    it by the boundary temperatures, not above them), where a_T is not defined (past the WLF
+    pole the coldest material would relax the fastest)."""
+    if shift is None:
+        return
+    for key, value, how in sorted(boundary_temperatures(case), key=lambda item: item[1]):
+        try:
+            shift.check(np.array(value))
+        except TemperatureDomainError:
+            raise CaseError(
+                f"{key}: {value:g}{how} is at or below {shift.describe()} of temperature.shift: heat "
+                f"conduction would cool the wall there, where the shift is not defined; give a temperature "
+                f"above it, or a shift whose domain holds it"
+            ) from None
+
+
+def give_temperature(model: Model, mesh: Mesh, case) -> None:
+    """Give the model the initial temperature field and the shift of [temperature] (case.
+    temperature, not None), after checking every temperature the case can reach against the
+    shift's domain; CaseError naming the key."""
+    heat = case.temperature
+    shift = heat.build_shift(case.units.temperature)
+    try:
+        model.heat(heat.nodal(mesh), shift)
+    except ValueError as exc:
+        if shift is None:
+            raise CaseError(f"temperature.initial: {exc}") from None
+        key = "wlf.C2" if heat.shift.wlf is not None else "arrhenius"
+        raise CaseError(f"temperature.shift.{key}: {exc} (temperature.initial)") from None
+    check_boundary_temperatures(case, shift)

@@ -18,6 +18,7 @@ T_mould) through every slave node in contact.  Insulated where nothing is said. 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 from pydantic import field_validator
@@ -41,12 +42,20 @@ def _property(value: Any) -> Any:
         return float(value)
     if not isinstance(value, list) or not value or not all(isinstance(r, list) and len(r) == 2 for r in value):
         raise ValueError(f"must be a number or a table [[T, value], ...] with no holes, got {value!r}")
+    if not all(isinstance(x, int | float) and not isinstance(x, bool) for row in value for x in row):
+        raise ValueError(f"every temperature and value of the table must be a number, got {value!r}")
     T = [r[0] for r in value]
     if any(b <= a for a, b in zip(T, T[1:], strict=False)):
         raise ValueError("a table of the temperature: T must increase from row to row")
-    if not all(isinstance(v, int | float) and not isinstance(v, bool) and v > 0 for _, v in value):
+    if not all(v > 0 for _, v in value):
         raise ValueError("every value of the table must be a number > 0")
     return [[float(t), float(v)] for t, v in value]
+
+
+def _scaled(value: float, knots) -> Callable[[float], float]:
+    """t -> value x f(t) (f = 1 without knots)."""
+    curve = None if knots is None else Curve(knots)
+    return (lambda t: value) if curve is None else (lambda t: value * curve(t))
 
 
 def _as_property(value: float | list) -> Property:
@@ -107,14 +116,9 @@ def build_conduction(
                     f"depth {depth:g} (the nodes farther from the surface are not seen): give depth = "
                     f"{c.conductance_gap:g} or more, or a smaller gap"
                 )
-            curve = None if c.temperature_curve is None else Curve(c.temperature_curve)
-            mould = (lambda t, v=c.temperature: v) if curve is None else (lambda t, v=c.temperature, f=curve: v * f(t))
+            mould = _scaled(c.temperature, c.temperature_curve)
             conductances.append(Conductance(c.conductance, mould, contact_conductance(k, c.conductance_gap)))
-    model.conduct(
-        Conduction(
-            mesh,
-            *(_as_property(getattr(thermal, key)) for key in ("conductivity", "density", "specific_heat")),
-            films,
-            conductances,
-        )
+    conductivity, density, heat = (
+        _as_property(getattr(thermal, key)) for key in ("conductivity", "density", "specific_heat")
     )
+    model.conduct(Conduction(mesh, conductivity, density, heat, films, conductances))

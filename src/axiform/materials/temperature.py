@@ -4,8 +4,10 @@
   its knots (which increase strictly).
 - `WLF` and `Arrhenius`: the shift factor a_T of the relaxation times (time-temperature
   superposition): log10 a_T = -C1 (T - T_ref) / (C2 + T - T_ref) (Williams-Landel-Ferry), or
-  ln a_T = activation (1/T - 1/T_ref) with T in kelvin; the reduced time of a material point
-  advances by dxi = dt / a_T(T).
+  ln a_T = activation (1/T - 1/T_ref) with T absolute (kelvin); the reduced time of a material
+  point advances by dxi = dt / a_T(T).  Each is defined above its `pole` (T_ref - C2; absolute
+  zero): `shift` raises TemperatureDomainError at or below it, naming the place (the run
+  stops there rather than relax a wall at a_T = 1e-47).
 - `TemperatureDependent`: a law whose constants are tables, evaluated at the temperatures of
   a batch of material points (`at(T)`: a law with one value per point, the points in the order
   of the batch's rows); its scalar properties (kappa, shear_modulus: the scales of the
@@ -16,6 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -43,48 +46,99 @@ class Table:
 
     def __call__(self, T: np.ndarray | float) -> np.ndarray:
         """The value at T (any shape)."""
-        return np.interp(T, self.T, self.values)
+        return np.asarray(np.interp(T, self.T, self.values))
+
+
+class TemperatureDomainError(ValueError):
+    """A temperature beyond the domain of a shift (at or below the WLF pole, at or below
+    absolute zero for Arrhenius): a_T is not defined there."""
+
+
+def _place(T: np.ndarray, index: int) -> str:
+    """Where the value at the flat index of T lies: a node of a field (n,), an element of a
+    field per quadrature point (e, q)."""
+    if T.ndim == 2:
+        return f" at element {index // T.shape[1]}"
+    if T.ndim == 1 and T.size > 1:
+        return f" at node {index}"
+    return ""
 
 
 @dataclass(frozen=True)
 class WLF:
-    """log10 a_T = -C1 (T - reference) / (C2 + T - reference); defined while C2 + T - T_ref > 0."""
+    """log10 a_T = -C1 (T - reference) / (C2 + T - reference); defined while C2 + T - T_ref > 0,
+    above the pole T_ref - C2."""
 
     C1: float
     C2: float
     reference: float
 
-    def check(self, T: np.ndarray) -> None:
-        """ValueError where T (any shape) lies at or beyond the pole T = T_ref - C2."""
+    @property
+    def pole(self) -> float:
+        """The lowest temperature excluded: T_ref - C2."""
+        return self.reference - self.C2
+
+    def describe(self) -> str:
+        return f"the WLF pole T_ref - C2 = {self.pole:.6g}"
+
+    def check(self, T: np.ndarray | float) -> None:
+        """TemperatureDomainError where T (any shape; a node's field (n,) or the points' (e, q)
+        for the place in the message) lies at or below the pole T = T_ref - C2."""
         T = np.asarray(T, float)
         if T.size and not (self.C2 + T - self.reference > 0).all():
-            raise ValueError(
-                f"a temperature of {float(T.min()):.6g} is at or below the WLF pole T_ref - C2 = "
-                f"{self.reference - self.C2:.6g} (C2 + T - T_ref must be > 0)"
+            k = int(np.argmin(T))
+            raise TemperatureDomainError(
+                f"a temperature of {float(T.flat[k]):.6g}{_place(T, k)} is at or below {self.describe()} "
+                f"(C2 + T - T_ref must be > 0)"
             )
 
     def shift(self, T: np.ndarray | float) -> np.ndarray:
-        """a_T (same shape as T)."""
+        """a_T (same shape as T); TemperatureDomainError at or below the pole."""
+        self.check(T)
         dT = np.asarray(T, float) - self.reference
         return 10.0 ** (-self.C1 * dT / (self.C2 + dT))
 
 
 @dataclass(frozen=True)
 class Arrhenius:
-    """ln a_T = activation (1/T - 1/reference), T and the reference in kelvin, activation = E/R (K)."""
+    """ln a_T = activation (1/T_abs - 1/reference_abs), activation = E/R (K); T_abs = T + offset
+    the absolute temperature (offset 0 for temperatures in kelvin, 273.15 in degrees Celsius)."""
 
     activation: float
     reference: float
+    offset: float = 0.0
 
-    def check(self, T: np.ndarray) -> None:
-        """ValueError where T (any shape) is not a positive (kelvin) temperature."""
+    def __post_init__(self):
+        if not self.reference + self.offset > 0:
+            raise TemperatureDomainError(
+                f"the reference temperature {self.reference:.6g} is {self.reference + self.offset:.6g} K: an "
+                f"Arrhenius shift needs an absolute temperature > 0"
+            )
+
+    @property
+    def pole(self) -> float:
+        """The lowest temperature excluded: absolute zero in the case's unit."""
+        return -self.offset
+
+    def describe(self) -> str:
+        return f"absolute zero ({self.pole:.6g}; an Arrhenius shift needs T > 0 K)"
+
+    def check(self, T: np.ndarray | float) -> None:
+        """TemperatureDomainError where T (any shape) is not above absolute zero."""
         T = np.asarray(T, float)
-        if T.size and not (T > 0).all():
-            raise ValueError(f"a temperature of {float(T.min()):.6g} is not in kelvin (an Arrhenius shift needs T > 0)")
+        if T.size and not (T + self.offset > 0).all():
+            k = int(np.argmin(T))
+            raise TemperatureDomainError(
+                f"a temperature of {float(T.flat[k]):.6g}{_place(T, k)} is at or below {self.describe()}: is it "
+                f"in kelvin?"
+            )
 
     def shift(self, T: np.ndarray | float) -> np.ndarray:
-        """a_T (same shape as T)."""
-        return np.exp(self.activation * (1.0 / np.asarray(T, float) - 1.0 / self.reference))
+        """a_T (same shape as T); TemperatureDomainError at or below absolute zero."""
+        self.check(T)
+        return np.exp(
+            self.activation * (1.0 / (np.asarray(T, float) + self.offset) - 1.0 / (self.reference + self.offset))
+        )
 
 
 Shift = WLF | Arrhenius
@@ -106,7 +160,7 @@ class TemperatureDependent:
     def at(self, T: np.ndarray):
         """The law at the temperatures T of a batch of points: every table evaluated at
         T.ravel() (one value per point, the batch's rows in order)."""
-        values = {name: table(np.ravel(T)) for name, table in self.tables.items()}
+        values: dict[str, Any] = {name: table(np.ravel(T)) for name, table in self.tables.items()}
         if np.ndim(T) == 0:
             values = {name: float(v[0]) for name, v in values.items()}
         return self.make(self.fixed | values)

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..materials import InvertedElementError
+from ..materials.temperature import TemperatureDomainError
 from ..model.guards import evaluation_fault
 from ..model.model import Evaluation, Model
 from ..model.state import ModelState
@@ -48,11 +49,14 @@ def converged(ev: Evaluation, lam: float, opts: NewtonOptions, floor: float, res
 
 def evaluate_checked(model: Model, history: ModelState, u_f, lam, predicting: bool = False) -> Evaluation:
     """model.evaluate from the committed history, failing the step on an inverted element, a residual that is not finite
-    or a tangent with a free rigid translation (guards.evaluation_fault)."""
+    or a tangent with a free rigid translation (guards.evaluation_fault); ending the path (PathEnded) where a
+    temperature left the domain of the shift of the relaxation times."""
     try:
         ev = model.evaluate(u_f, lam, history, predicting=predicting)
     except InvertedElementError as exc:
         raise StepFailed(str(exc)) from exc
+    except TemperatureDomainError as exc:  # a temperature beyond the shift's pole: no step size helps
+        raise PathEnded(f"the material left the domain of its shift: {exc}") from exc
     fault = evaluation_fault(model, ev.r_full, ev.K)
     if fault:
         raise StepFailed(fault)

@@ -11,7 +11,15 @@ import numpy as np
 from ..fem.folds import folded_nodes
 from ..model.model import Model
 from .controls import DisplacementControl, LoadControl, NewtonOptions
-from .newton import StepFailed, evaluate_checked, factorize_checked, force_floor, newton_displacement, newton_load
+from .newton import (
+    PathEnded,
+    StepFailed,
+    evaluate_checked,
+    factorize_checked,
+    force_floor,
+    newton_displacement,
+    newton_load,
+)
 
 
 class PathFollowing:
@@ -107,7 +115,7 @@ class PathFollowing:
             t0 = factorize_checked(ev0.K)(ev0.dr_dlam)
             ev = evaluate_checked(self.model, self.history, self.u_f, self.lam)
             t = factorize_checked(ev.K)(ev.dr_dlam)
-        except StepFailed:
+        except (StepFailed, PathEnded):
             return None
         n = self.model.dofmap.nf
         n0, n1 = np.linalg.norm(t0[:n]), np.linalg.norm(t[:n])
