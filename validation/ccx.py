@@ -1,4 +1,4 @@
-"""CalculiX (ccx) decks and results for the benchmarks that compare with it: the node and
+"""CalculiX (ccx) decks and results for the validation scripts that compare with it: the node and
 element cards of an axiform mesh, the element faces of boundary edges, a run in a work
 folder with its wall time, and the node tables of the .dat file."""
 

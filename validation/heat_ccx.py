@@ -3,10 +3,13 @@
 same Q8 / CAX8 meshes with the same fixed time steps: a slab cooled through one face (and the
 series solution), and a tube wall under a film whose coefficient changes along the tube.
 
-    python benchmarks/heat_ccx.py
+    python validation/heat_ccx.py        (about a minute; skipped without ccx)
 
-Writes benchmarks/results/heat_ccx.md, heat_ccx.png and the decks under
-benchmarks/results/heat_ccx/ (needs ccx: apt-get install calculix-ccx).
+Writes validation/results/heat_ccx.md (the tables and the checks), heat_ccx.png and the
+decks under validation/work/heat_ccx/ (needs ccx: apt-get install calculix-ccx).  Asserts:
+ccx steps by backward Euler as axiform (1e-4 degree, its printed digits), axiform and ccx
+within 1e-3 % of T0 - T_inf on the Q8 slabs and the tube (Q4 / CAX4: 0.05 %, 0.02 %
+measured), and axiform within 0.2 % of the series.
 
 Both codes: k = 0.2, rho = 1e-9, c = 1.9e9 (mm, t, s, mJ: diffusivity 0.105 mm^2/s),
 initial 150, films h (T - 25) (the tube's bore: h (T - 80)), insulated elsewhere; ccx's
@@ -38,15 +41,16 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path[:0] = [str(ROOT / "src"), str(ROOT / "tests"), str(HERE)]
 
-from _ccx import element_faces, mesh_cards, node_tables, node_values, run  # noqa: E402
+from ccx import element_faces, mesh_cards, node_tables, node_values, run  # noqa: E402
+from checks import RESULTS, Checks, have_ccx  # noqa: E402
+from checks import WORK as WORKS  # noqa: E402
 from test_heat import ALPHA, RHO, C, K, slab_series  # noqa: E402
 
 from axiform import rectangle, select_edges, solve  # noqa: E402
 from axiform.case.schema import build, parse  # noqa: E402
 from axiform.fem.heat import Conduction, Film, constant  # noqa: E402
 
-RESULTS = HERE / "results"
-WORK = RESULTS / "heat_ccx"
+WORK = WORKS / "heat_ccx"
 T0, T_INF = 150.0, 25.0
 L = 2.0  # the slab's thickness
 BANDS = [(0.0, 10.0, 0.4), (10.0, 20.0, 0.2), (20.0, 30.0, 0.1), (30.0, 40.0, 0.05)]  # tube: z0, z1, h outside
@@ -249,21 +253,38 @@ def tube() -> dict:
 
 
 def main() -> int:
-    import shutil
-
-    if shutil.which("ccx") is None:
-        print("ccx not found (apt-get install calculix-ccx)")
-        return 1
+    if not have_ccx("heat_ccx.py"):
+        return 0
     scheme = scheme_check()
     scheme["unit"] = digits_check()
     slabs = [slab(bi) for bi in (0.5, 2.0, 10.0)] + [slab(2.0, "q4")]
     wall = tube()
-    lines = report(scheme, slabs, wall)
+    checks = check(scheme, slabs, wall)
+    lines = report(scheme, slabs, wall) + [""] + checks.table()
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "heat_ccx.md").write_text("\n".join(lines) + "\n")
     figure(slabs[1], wall)
     print("\n".join(lines))
-    return 0
+    return checks.finish()
+
+
+def check(scheme: dict, slabs: list[dict], wall: dict) -> Checks:
+    """The asserted agreements (temperatures in % of T0 - T_inf, the scheme in degrees)."""
+    checks, span = Checks(), T0 - T_INF
+    for fo, be, cn in scheme["rows"]:
+        checks.below(f"scheme, Fo {fo:.3f}: max abs(ccx - backward Euler), degrees", be, 1e-4)
+        checks.above(f"scheme, Fo {fo:.3f}: max abs(ccx - Crank-Nicolson), degrees", cn, 1.0)
+    for s in slabs:
+        agree = 1e-3 if s["element"] == "q8" else 0.05
+        for fo, v in s["fo"].items():
+            name = f"slab {s['element'].upper()} Bi {s['bi']:g} Fo {fo:g}"
+            checks.below(f"{name}: axiform - ccx, %", 100 * np.abs(v["ax"] - v["ccx"]).max() / span, agree)
+            checks.below(f"{name}: axiform - series, %", 100 * np.abs(v["ax"] - v["series"]).max() / span, 0.2)
+    for t in wall["times"]:
+        c, a, k = at(wall["ccx"]["T"], t), at(wall["ax"]["T"], t), at(wall["case"]["T"], t)
+        checks.below(f"tube t = {t:g} s: axiform - ccx, %", 100 * np.abs(a - c).max() / span, 1e-3)
+        checks.below(f"tube t = {t:g} s: whole case - Conduction, %", 100 * np.abs(k - a).max() / span, 1e-9)
+    return checks
 
 
 def report(scheme: dict, slabs: list[dict], wall: dict) -> list[str]:
@@ -272,7 +293,7 @@ def report(scheme: dict, slabs: list[dict], wall: dict) -> list[str]:
     out = [
         "# Heat conduction: axiform against CalculiX (*HEAT TRANSFER, CAX8, *FILM)",
         "",
-        "Written by `benchmarks/heat_ccx.py`; same meshes, same fixed time steps in both codes. "
+        "Written by `validation/heat_ccx.py`; same meshes, same fixed time steps in both codes. "
         "Differences are max over all nodes, in % of T0 - T_inf = 125 (the tube: of its range 150 - 25).",
         "",
         "## Which time integration ccx uses",
@@ -308,7 +329,8 @@ def report(scheme: dict, slabs: list[dict], wall: dict) -> list[str]:
     for s in slabs:
         for fo, v in s["fo"].items():
             out.append(
-                f"| {s['element'].upper()} / CAX{s['mesh'].cells.shape[1]} | {s['bi']:g} | {fo:g} | {pct(v['ax'] - v['ccx'], span)} | "
+                f"| {s['element'].upper()} / CAX{s['mesh'].cells.shape[1]} | {s['bi']:g} | {fo:g} | "
+                f"{pct(v['ax'] - v['ccx'], span)} | "
                 f"{pct(v['ax'] - v['series'], span)} | {pct(v['ccx'] - v['series'], span)} |"
             )
     out += [
