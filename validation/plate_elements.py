@@ -3,13 +3,20 @@
 plate with Q4, Q8 and SFR on the meshes 2x20, 4x40, 8x80 and a mesh with about the same
 number of unknowns for every element ("same"), against a converged Q8 reference.
 
-    .venv/bin/python benchmarks/element_study.py            # full study (about 10 min on 2 cores)
-    .venv/bin/python benchmarks/element_study.py --quick    # smoke run (about 1 min)
+    .venv/bin/python validation/plate_elements.py            # full study (about 10 min on 2 cores)
+    .venv/bin/python validation/plate_elements.py --quick    # smoke run (about 1 min)
 
-Writes benchmarks/results/element_study.md (tables, verdict on the paper's claims),
-element_study.json (all numbers and curves), element_study_fig11.png (load curves p(w) per
-element and mesh with the reference, and their errors) and element_study_fig12.png (CPU time
+Writes validation/results/plate_elements.md (tables, verdict on the paper's claims, checks),
+plate_elements.json (all numbers and curves), plate_elements_fig11.png (load curves p(w) per
+element and mesh with the reference, and their errors) and plate_elements_fig12.png (CPU time
 per element and mesh).  --quick writes the same files with the suffix _quick.
+
+Asserts (`check`): the Q8 reference's estimated error within 0.1 % at w = 1 ... 8 (0.05 %
+measured); CalculiX CAX8 within 0.01 % of axiform Q8 on the same mesh (0.005 %), where ccx
+is installed; every element's error shrinking from 2x20 to 4x40 to 8x80 at w = 2 ... 8; on
+8x80 Q8 within 0.6 % of the reference (0.47 %), SFR and Q4 within 2 % for w >= 2 (1.8 %,
+2.5 % at w = 2 for Q4: 3 % for it) and within 10 % at w = 1, where the plate bends (4.3 %,
+7.0 %).
 
 The plate (paper 4.1): R = 7.5 in, h = 0.5 in, Mooney-Rivlin C1 = 80, C2 = 20, kappa = 1e4
 psi; rim r = 7.5 clamped (ur, uz and, for SFR, rot fixed); axis r = 0: ur fixed; unit follower
@@ -52,8 +59,9 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import peers  # noqa: E402  (the plate, the runners and CalculiX, shared with peers.py)
-from peers import (
+import plate_peers as peers  # noqa: E402  (the plate, the runners and CalculiX, shared)
+from checks import WORK, Checks  # noqa: E402
+from plate_peers import (  # noqa: E402
     W_MAX,
     W_REPORT,
     at,
@@ -61,7 +69,7 @@ from peers import (
     fmt,
     linsolve_identity,
     machine,
-    mesh_name,  # noqa: E402
+    mesh_name,
     parse_mesh,
     run_axiform,
 )
@@ -175,6 +183,11 @@ def reference_study(levels, steps: int, solver: str) -> dict:
 # --------------------------------------------------------------------------------------
 # helpers
 # --------------------------------------------------------------------------------------
+def errors_of(run: dict, ref_p) -> list[float]:
+    """p / p_ref - 1 of a run at W_REPORT."""
+    return [x / q - 1 for x, q in zip(at(run["w"], run["p"]), ref_p, strict=False)]
+
+
 def err(p, ref):
     return None if p is None or ref is None else p / ref - 1.0
 
@@ -331,7 +344,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    stem = "element_study_quick" if args.quick else "element_study"
+    stem = "plate_elements_quick" if args.quick else "plate_elements"
     base = BASE_MESHES[:2] if args.quick else BASE_MESHES
     levels = [2, 4, 8] if args.quick else [int(v) for v in args.reference_levels.split(",")]
     repeat = 1 if args.quick else max(1, args.repeat)
@@ -410,7 +423,7 @@ def main(argv=None) -> int:
         axc = curve(ax["w"], ax["p"])
         wk = W_MAX * np.arange(1, args.steps + 1) / args.steps
         sched = np.maximum.accumulate(peers.OVERSHOOT * axc(np.minimum(wk, max(ax["w"]))))
-        r = peers.run_ccx(peers.plate_mesh("q8", nr, nz), "CAX8", sched, out / "peers_ccx", f"CAX8_{ccx_mesh}_study")
+        r = peers.run_ccx(peers.plate_mesh("q8", nr, nz), "CAX8", sched, WORK / "plate_elements", f"CAX8_{ccx_mesh}")
         mx, wat, d = peers.compare(r["w"], r["p"], axc, max(ax["w"]))
         pc_ccx = at(r["w"], r["p"]) if r["w"] else [None] * 5
         ccx = {
@@ -453,7 +466,7 @@ def main(argv=None) -> int:
 
     L = [f"# Element study: the clamped plate (paper 4.1, Figures 11 and 12){' — quick run' if args.quick else ''}", ""]
     L += [
-        f"Written by `benchmarks/element_study.py{' --quick' if args.quick else ''}` on "
+        f"Written by `validation/plate_elements.py{' --quick' if args.quick else ''}` on "
         f"{time.strftime('%Y-%m-%d %H:%M')}; {machine()}; axiform {af.__version__}. Total run time {total:.0f} s.",
         "",
     ]
@@ -526,8 +539,7 @@ def main(argv=None) -> int:
         f"({'below' if worst < 5e-4 else 'NOT below'} the 0.05 % aimed at); the finest computed mesh alone is "
         f"within {100 * max(abs(e) for e in ref['finest_vs_extrapolated']):.3f} % of it. The smallest element "
         "error below is "
-        f"{100 * min(abs(e) for r in runs.values() for e in [x / q - 1 for x, q in zip(at(r['w'], r['p']), ref_p, strict=False)]):.2f}"
-        " %.",
+        f"{100 * min(abs(e) for r in runs.values() for e in errors_of(r, ref_p)):.2f} %.",
         "",
     ]
     if ccx:
@@ -645,7 +657,7 @@ def main(argv=None) -> int:
     )
     L.append("")
     close = []
-    for m, (es, eq, ratios) in verdict_acc.items():
+    for m, (es, eq, _ratios) in verdict_acc.items():
         parts = []
         for w, a, b in zip(W_REPORT, es, eq, strict=False):
             parts.append(f"w={w:g}: {pc(a, '+.1f')} vs {pc(b, '+.1f')}")
@@ -716,7 +728,8 @@ def main(argv=None) -> int:
     L += [
         "## 4. The sparse factorization: why the committed axiform.solve.linsolve makes Q8 and SFR slow",
         "",
-        'axiform.solve.linsolve as committed in 5d22fce factorizes with SuperLU, permc_spec="MMD_AT_PLUS_A" and SciPy\'s '
+        'axiform.solve.linsolve as committed in 5d22fce factorizes with SuperLU, permc_spec="MMD_AT_PLUS_A" and '
+        "SciPy's "
         "default diag_pivot_thresh = 1.0 (partial pivoting). MMD on K^T + K is a symmetric ordering that assumes "
         "the pivots stay on the diagonal; on these tangents (kappa / mu = 50) SuperLU pivots off the diagonal, the "
         "ordering is lost and the fill grows. MMD_ATA and COLAMD order the columns for any row pivoting. One "
@@ -742,7 +755,9 @@ def main(argv=None) -> int:
         f"this run: {linsolve_identity()}.",
         "",
     ]
-    (out / f"{stem}.md").write_text("\n".join(L))
+    checks = check(ref, ccx, table, base)
+    L += checks.table()
+    (out / f"{stem}.md").write_text("\n".join(L) + "\n")
 
     # json + figures
     def jsonable(r):
@@ -765,7 +780,29 @@ def main(argv=None) -> int:
     figure12(table, mesh_order, mesh_labels, out / f"{stem}_fig12.png")
     print("\n".join(L))
     print(f"wrote {out / (stem + '.md')}, {stem}.json, {stem}_fig11.png, {stem}_fig12.png ({total:.0f} s)")
-    return 0
+    return checks.finish()
+
+
+# the largest |p / p_ref - 1| of each element on the finest base mesh: at w = 1 (bending), at w >= 2
+FINEST_ERROR = {"q8": (0.006, 0.006), "sfr": (0.10, 0.02), "q4": (0.10, 0.03)}
+
+
+def check(ref: dict, ccx: dict | None, table: dict, base) -> Checks:
+    """The reference converged, CalculiX agrees with it, and every element converges to it."""
+    checks = Checks()
+    for w, e in zip(W_REPORT, ref["error_estimate"], strict=True):
+        checks.below(f"reference at w = {w:g}: estimated error, %", 100 * e, 0.1)
+    if ccx is not None:
+        checks.below(f"CalculiX CAX8 {ccx['mesh']}: max abs(p_ccx / p_Q8 - 1), %", 100 * ccx["max_diff"], 0.01)
+    for el in ELEMENTS:
+        errors = [np.abs(table[(el, m)]["err"]) for m in base]
+        for k, w in enumerate(W_REPORT):
+            if w >= 2.0:
+                for coarse, fine, m in zip(errors, errors[1:], base[1:], strict=False):
+                    checks.below(f"{LABEL[el]} {m}, w = {w:g}: error over the coarser mesh's", fine[k] / coarse[k], 1.0)
+            limit = FINEST_ERROR[el][0 if w < 2.0 else 1]
+            checks.below(f"{LABEL[el]} {base[-1]}, w = {w:g}: abs(p / p_ref - 1), %", 100 * errors[-1][k], 100 * limit)
+    return checks
 
 
 if __name__ == "__main__":

@@ -3,11 +3,14 @@
 CalculiX (ccx, elements CAX8 / CAX4) and FElupe (quad8 / quad axisymmetric), on the same
 meshes, in one run: load curves p(w) compared at the same centre deflection, and wall times.
 
-    .venv/bin/python benchmarks/peers.py            # meshes 2x20 and 4x40 (a few minutes)
-    .venv/bin/python benchmarks/peers.py --quick    # 2x20 only, coarse load schedule
+    .venv/bin/python validation/plate_peers.py            # meshes 2x20 and 4x40 (a few minutes)
+    .venv/bin/python validation/plate_peers.py --quick    # 2x20 only, coarse load schedule
 
-Writes benchmarks/results/peers.md, peers.json, peers_curves.png and the CalculiX decks and
-outputs under benchmarks/results/peers_ccx/.
+Writes validation/results/plate_peers.md, plate_peers.json, plate_peers_curves.png and the
+CalculiX decks and outputs under validation/work/plate_peers/.  Asserts, for each peer that
+ran (CalculiX: apt-get install calculix-ccx; FElupe: pip install -e ".[bench]"), the largest
+|p_peer(w) / p_axiform(w) - 1| over 0.5 <= w <= 8: CAX8 0.01 % (0.0034 % measured), CAX4
+0.5 % (0.23 %: CalculiX's 3D expansion of CAX4, below), FElupe quad8 / quad 0.001 % (1e-4 %).
 
 The plate: R = 7.5 in, h = 0.5 in, Mooney-Rivlin C1 = 80 psi, C2 = 20 psi, kappa = 1e4 psi
 (CalculiX: C10 = 80, C01 = 20, D1 = 2 / kappa; FElupe: mooney_rivlin(C10, C01) plus
@@ -68,7 +71,8 @@ import axiform.solve.newton as _solver  # noqa: E402
 from axiform.solve.linsolve import SingularTangentError  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
-RESULTS = HERE / "results"
+sys.path.insert(0, str(HERE))
+from checks import RESULTS, WORK, Checks  # noqa: E402
 
 R, H = 7.5, 0.5
 C1, C2, KAPPA = 80.0, 20.0, 1.0e4
@@ -189,43 +193,13 @@ LINEAR_SOLVERS = {
 
 
 def linsolve_identity() -> str:
-    """What axiform.solve.linsolve.factorize does in this tree, in a few words, and the git state of
-    the file (the module changes while people work on it)."""
-    import inspect
-
+    """What axiform.solve.linsolve.factorize does in this run, in a few words."""
     import axiform.solve.linsolve as ls
 
-    src = inspect.getsource(ls)
-    specs = sorted(set(re.findall(r'permc_spec="([A-Z_]+)"', src)))
-    parts = []
-    if "pypardiso" in src:
-        active = getattr(ls, "_pypardiso", None) is not None
-        parts.append("MKL PARDISO via pypardiso" + (" (installed: used in this run)" if active else " (not installed)"))
-    if specs:
-        parts.append("SuperLU permc_spec=" + "/".join(specs))
-    if "diag_pivot_thresh" in src:
-        parts.append("with diag_pivot_thresh set")
-    state = ""
-    try:
-        root = Path(__file__).resolve().parents[1]
-        rev = subprocess.run(
-            ["git", "log", "-1", "--format=%h", "--", "src/axiform/linsolve.py"],
-            cwd=root,
-            capture_output=True,
-            text=True,
-            timeout=10,
-        ).stdout.strip()
-        dirty = subprocess.run(
-            ["git", "status", "--porcelain", "--", "src/axiform/linsolve.py"],
-            cwd=root,
-            capture_output=True,
-            text=True,
-            timeout=10,
-        ).stdout.strip()
-        state = f"; src/axiform/linsolve.py at commit {rev or '?'}{' with uncommitted changes' if dirty else ''}"
-    except Exception:  # noqa: BLE001
-        pass
-    return (", else ".join(parts) if parts else "see axiform.solve.linsolve") + state
+    mkl = ls._mkl() is not None  # the library it loads for PARDISO, None where there is none
+    return f"dense LAPACK up to {ls.DENSE_MAX} unknowns, then " + (
+        "MKL PARDISO (libmkl_rt found: used in this run)" if mkl else "SuperLU (no libmkl_rt: PARDISO not used)"
+    )
 
 
 @contextlib.contextmanager
@@ -732,14 +706,14 @@ def main(argv=None) -> int:
     ap.add_argument("--no-ccx", action="store_true")
     ap.add_argument("--no-felupe", action="store_true")
     ap.add_argument("--no-diagnostics", action="store_true", help="skip the CAX4 diagnostics (about 1 min)")
-    ap.add_argument("--out", default=str(RESULTS), help="results folder (default benchmarks/results)")
+    ap.add_argument("--out", default=str(RESULTS), help="results folder (default validation/results)")
     args = ap.parse_args(argv)
     meshes = ["2x20"] if args.quick else [m.strip() for m in args.meshes.split(",") if m.strip()]
     increments = 20 if args.quick else args.increments
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    stem = "peers_quick" if args.quick else "peers"
-    workdir = out / "peers_ccx"
+    stem = "plate_peers_quick" if args.quick else "plate_peers"
+    workdir = WORK / "plate_peers"
 
     ccx = None if args.no_ccx else ccx_version()
     fel = None if args.no_felupe else felupe_available()
@@ -805,7 +779,8 @@ def main(argv=None) -> int:
     # ---- report ---------------------------------------------------------------------------
     L = [f"# Peers: the clamped plate in axiform, CalculiX and FElupe{' (quick run)' if args.quick else ''}", ""]
     L += [
-        f"Written by `benchmarks/peers.py{' --quick' if args.quick else ''}` on {time.strftime('%Y-%m-%d %H:%M')}; "
+        f"Written by `validation/plate_peers.py{' --quick' if args.quick else ''}` on "
+        f"{time.strftime('%Y-%m-%d %H:%M')}; "
         f"{machine()}. axiform {af.__version__}, CalculiX {ccx or 'not run'}, FElupe {fel or 'not run'}. "
         f"Total run time {total:.0f} s.",
         "",
@@ -981,7 +956,9 @@ def main(argv=None) -> int:
             "functions and shows nothing of the kind (0.003 %).",
             "",
         ]
-    (out / f"{stem}.md").write_text("\n".join(L))
+    checks = check(runs)
+    L += checks.table()
+    (out / f"{stem}.md").write_text("\n".join(L) + "\n")
     with open(out / f"{stem}.json", "w") as f:
         json.dump(
             {"summary": summary, "runs": runs, "ccx": ccx, "felupe": fel, "diagnostics": diag, "total_s": total},
@@ -992,7 +969,28 @@ def main(argv=None) -> int:
     plot_curves(runs, out / f"{stem}_curves.png")
     print("\n".join(L))
     print(f"wrote {out / (stem + '.md')}, {stem}.json, {stem}_curves.png ({total:.0f} s)")
-    return 0
+    return checks.finish()
+
+
+# the largest |p_peer(w) / p_axiform(w) - 1| allowed, per peer and axiform element
+TOLERANCE = {("calculix", "q8"): 1e-4, ("calculix", "q4"): 5e-3, ("felupe", "q8"): 1e-5, ("felupe", "q4"): 1e-5}
+
+
+def check(runs: list[dict]) -> Checks:
+    """Each peer that ran finished and agrees with axiform within TOLERANCE."""
+    checks = Checks()
+    for case in runs:
+        for code in ("calculix", "felupe"):
+            r = case.get(code)
+            if not r:
+                continue
+            name = f"{case['mesh']} {r['element']}: {code}"
+            checks.above(f"{name} finished (1 yes, 0 no)", float(r["status"] == "finished"), 1)
+            d = r["max_diff"] if r["max_diff"] is not None else np.inf
+            checks.below(f"{name}: max abs(p_peer / p_axiform - 1), %", 100 * d, 100 * TOLERANCE[code, case["family"]])
+    if not checks.rows:
+        print("plate_peers.py: neither CalculiX nor FElupe ran: nothing compared")
+    return checks
 
 
 if __name__ == "__main__":
