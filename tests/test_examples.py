@@ -1,6 +1,8 @@
-"""Every quick example of examples/ runs with `axiform run` and its default settings, with one
-number checked against what it must be (the process examples have their own tests in
-test_process_examples.py; the slower ones are checked there on coarser meshes)."""
+"""Every quick example of examples/ runs with `axiform run` and its default settings (the
+bottle through the same Python calls), checked against what its physics must give: an exact
+or membrane answer, a balance of the forces on the body, a volume kept (the process examples
+have their own tests in test_process_examples.py; the slower ones are checked there on
+coarser meshes)."""
 
 import json
 import shutil
