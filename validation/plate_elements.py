@@ -38,7 +38,7 @@ process with time.process_time and wall time; BLAS/OpenMP threads limited to 1):
   Richardson extrapolation of the three finest with the observed order, and the change of
   that extrapolation with one more mesh as its error estimate.
 - a check of the fine Q8 curve against CalculiX CAX8 on the same mesh (8x80 by default;
-  --ccx-mesh), if ccx is installed (apt-get install calculix-ccx); see peers.py.
+  --ccx-mesh), if ccx is installed (apt-get install calculix-ccx); see plate_peers.py.
 """
 
 from __future__ import annotations
@@ -546,7 +546,7 @@ def main(argv=None) -> int:
         L += ["### Check against CalculiX", ""]
         L += [
             f"CalculiX {ccx['version']} CAX8 on the same mesh {ccx['mesh']} (load control, {ccx['increments']} "
-            f"increments, tight tolerances; see peers.py) against axiform Q8 {ccx['mesh']}: max |dp/p| = "
+            f"increments, tight tolerances; see plate_peers.py) against axiform Q8 {ccx['mesh']}: max |dp/p| = "
             f"{pc(ccx['max_diff'], '.4f')} % over 0.5 <= w <= 8 in (at w = {fmt(ccx['w_at_max'], '.2f')}); "
             f"CalculiX took {ccx['wall_s']:.1f} s wall, axiform {ccx['axiform_wall_s']:.1f} s.",
             "",

@@ -842,7 +842,7 @@ def main(argv=None) -> int:
         "'axiform': its factorization as found in the tree (" + linsolve_identity() + "). "
         "'axiform-colamd': SuperLU/COLAMD swapped in for it by this script (the factorization of the committed "
         "axiform.solve.linsolve, MMD_AT_PLUS_A with partial pivoting, loses its ordering on Q8 and SFR tangents, see "
-        "element_study.md); same curve to round-off. The wall ratio is against 'axiform'."
+        "plate_elements.md); same curve to round-off. The wall ratio is against 'axiform'."
     )
     L.append("")
     # acceptance

@@ -140,7 +140,7 @@ _stock_factorize = solver_mod.factorize
 def symmetric_factorize(K):
     """SuperLU keeping the minimum-degree ordering on K^T + K (threshold pivoting, symmetric
     mode) instead of axiform.solve.linsolve's partial pivoting, which discards it and fills L + U
-    far more (see benchmarks/sfr_edge_study.py)."""
+    far more (benchmarks/README.md § 6.6)."""
     try:
         lu = splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.01, options=dict(SymmetricMode=True))
     except RuntimeError as exc:
@@ -296,7 +296,7 @@ def main(argv=None):
         "library's, SFR 8x80 takes ~1 min and Q8 8x80 ~70 s, one sample each)",
     )
     ap.add_argument("--runs", default=None, help="folder for the run folders (default: a temporary one)")
-    ap.add_argument("--out", default=str(RESULTS), help="folder for toric_study.md and the PNGs")
+    ap.add_argument("--out", default=str(RESULTS), help="folder for toric_plate.md and the PNGs")
     args = ap.parse_args(argv)
     repeat = args.repeat or (1 if args.quick else 3)
     runs_dir = Path(args.runs) if args.runs else Path(tempfile.mkdtemp(prefix="axiform_toric_"))
