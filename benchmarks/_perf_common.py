@@ -35,11 +35,14 @@ def divisions_for_dofs(element: str, n_dofs: int) -> tuple[int, int]:
     return n, n
 
 
+TOP_DISPLACEMENT = -0.05  # the prescribed axial displacement of the ring's top face
+
+
 def build_model(
     element: str,
     divisions: tuple[int, int],
     pressure: float = 5.0,
-    top_displacement: float | None = -0.05,
+    top_displacement: float | None = TOP_DISPLACEMENT,
     pressed: float = 0.5,
     finalize: bool = True,
 ) -> Model:
@@ -58,11 +61,12 @@ def build_model(
         model.prescribe(mesh.node_sets["top"], ["uz"], top_displacement)
     left = mesh.node_sets["left"]
     model.pressure(edges_on_nodes(mesh, left[mesh.points[left, 1] <= pressed + 1e-12]), pressure)
-    model.bench_top_displacement = top_displacement or 0.0
     return model.finalize() if finalize else model
 
 
-def deformed_state(model: Model, seed: int = 0, lam: float = 0.5, noise: float = 0.01) -> tuple[np.ndarray, float]:
+def deformed_state(
+    model: Model, seed: int = 0, lam: float = 0.5, noise: float = 0.01, top_displacement: float = TOP_DISPLACEMENT
+) -> tuple[np.ndarray, float]:
     """Free unknowns u_f of a homogeneous stretch (matching the prescribed top displacement)
     plus a small random perturbation (noise x the element size), so that F != I and every
     Gauss point differs, with J well away from 0."""
@@ -71,7 +75,7 @@ def deformed_state(model: Model, seed: int = 0, lam: float = 0.5, noise: float =
     P = mesh.points
     h = mesh.size()
     u = np.zeros((mesh.n_nodes, model.dpn))
-    top = lam * getattr(model, "bench_top_displacement", 0.0)
+    top = lam * top_displacement  # the top face's prescribed uz at load factor lam
     u[:, 0] = 0.04 * (P[:, 0] - 1.0) + 0.01 + noise * h * rng.standard_normal(mesh.n_nodes)
     u[:, 1] = top * P[:, 1] + noise * h * rng.standard_normal(mesh.n_nodes)
     if model.dpn == 3:

@@ -126,28 +126,39 @@ print(json.dumps(res))
 """
 
 PROFILE_CHILD = r"""
-import cProfile, json, pstats, sys
+import cProfile, importlib, json, pstats, sys
 from axiform.cli import main
 case, out = sys.argv[1], sys.argv[2]
+# each function by its module and qualified name: its code object names the profile's entry
+# (file, first line, name); a function this tree does not have is reported as missing, not as 0
+WANT = {"total": "axiform.cli:main", "solver": "axiform.solve.solver:solve",
+        "contact term (ContactTerm.evaluate)": "axiform.model.terms:ContactTerm.evaluate",
+        "pair.evaluate": "axiform.contact.pair:ContactPair.evaluate",
+        "pair.guard": "axiform.contact.pair:ContactPair.guard",
+        "pair._traction": "axiform.contact.pair:ContactPair._traction",
+        "Polyline.local": "axiform.contact.surfaces:Polyline.local",
+        "Polyline._project": "axiform.contact.surfaces:Polyline._project",
+        "search.buckets": "axiform.contact.search:buckets",
+        "ring_areas": "axiform.contact.rings:ring_areas",
+        "solid (MixedAssembly.evaluate)": "axiform.fem.mixed:MixedAssembly.evaluate",
+        "linear solves (factorize)": "axiform.solve.linsolve:factorize"}
+def code_key(path):
+    module, name = path.split(":")
+    try:
+        obj = importlib.import_module(module)
+        for part in name.split("."):
+            obj = getattr(obj, part)
+    except (ImportError, AttributeError):
+        return None
+    code = obj.__code__
+    return (code.co_filename, code.co_firstlineno, code.co_name)
+keys = {label: code_key(path) for label, path in WANT.items()}
 pr = cProfile.Profile(); pr.enable()
 main(["run", case, "--out", out, "-q", "--set", "output.plots=false"])
 pr.disable()
 st = pstats.Stats(pr).stats
-want = {"total": ("cli.py", "main"), "solver": ("solver.py", "solve"), "contact (model._contact)": ("model.py", "_contact"),
-        "surfaces local": ("surfaces.py", "local"), "surfaces _piece_local/_project": ("surfaces.py", "_piece_local|_project"),
-        "pair.guard": ("pair.py", "guard"), "pair._traction": ("pair.py", "_traction"),
-        "pair.evaluate": ("pair.py", "evaluate"), "search.buckets": ("search.py", "buckets"),
-        "ring_areas": ("pair.py", "ring_areas"), "gauss_1d": ("elements.py", "gauss_1d"),
-        "solid (mixed.evaluate)": ("mixed.py", "evaluate"), "linear solves (linsolve)": ("linsolve.py", "_call")}
-res = {}
-for label, (file, func) in want.items():
-    names = func.split("|")
-    hit = [(v[1], v[3]) for (f, _, fn), v in st.items() if f.endswith(file) and fn in names]
-    # _project is called from _piece_local in the new tree: count the outermost only
-    if label.startswith("surfaces _piece"):
-        hit = [(v[1], v[3]) for (f, _, fn), v in st.items() if f.endswith(file) and fn == names[-1]] or \
-              [(v[1], v[3]) for (f, _, fn), v in st.items() if f.endswith(file) and fn == names[0]]
-    res[label] = [sum(h[0] for h in hit), sum(h[1] for h in hit)]
+res = {label: None if key is None else [st[key][1], st[key][3]] if key in st else [0, 0.0]
+       for label, key in keys.items()}
 print("PROFILE " + json.dumps(res))
 """
 
@@ -157,8 +168,10 @@ import json, sys, time
 from axiform.model import terms
 from axiform.solve import paths
 acc = {"contact": 0.0, "solve": 0.0}
+calls = {"contact": 0, "solve": 0}
 def timed(f, key):
     def wrapper(*a, **k):
+        calls[key] += 1
         t = time.perf_counter()
         try:
             return f(*a, **k)
@@ -172,6 +185,8 @@ for cls in (paths.LoadPath, paths.DisplacementPath):
 from axiform.cli import main
 case, out, sets = sys.argv[1], sys.argv[2], json.loads(sys.argv[3])
 main(["run", case, "--out", out, "-q", "--set", "output.plots=false"] + [a for v in sets for a in ("--set", v)])
+if 0 in calls.values():  # the tree no longer calls a wrapped function: its share would read 0
+    sys.exit(f"no call of the wrapped {[k for k, n in calls.items() if n == 0]}: update SHARE_CHILD")
 print("SHARE " + json.dumps(acc))
 """
 # the share's cases: (example, --set overrides, label)
@@ -347,7 +362,11 @@ def section_profile(trees: dict[str, Path], tmp: Path) -> str:
         line = next(s for s in (proc.stdout + proc.stderr).splitlines() if s.startswith("PROFILE "))
         res[name] = json.loads(line[len("PROFILE ") :])
     names = list(trees)
-    rows = [[label] + [f"{res[n][label][1]:.2f} s ({res[n][label][0]})" for n in names] for label in res[names[0]]]
+    rows = [
+        [label]
+        + [f"{res[n][label][1]:.2f} s ({res[n][label][0]})" if res[n][label] else "not in the tree" for n in names]
+        for label in res[names[0]]
+    ]
     return (
         "### Profile of the cup example (cProfile, cumulative seconds and calls)\n\n"
         "cProfile adds a cost to every Python call: the many small calls of contact weigh more "

@@ -183,7 +183,7 @@ def run(
         reps = repeat if n <= 150_000 else 1
         t_eval = None
         for _ in range(max(reps, 2)):
-            _, t = timed(lambda: model.evaluate(u_f, lam))
+            _, t = timed(lambda m=model, u=u_f, t=lam: m.evaluate(u, t))
             t_eval = tmin(t_eval, t)
         del ev
         asym = abs(K - K.T).max() / abs(K).max()
@@ -211,8 +211,8 @@ def run(
                 if r.get("error"):
                     continue
                 try:
-                    (solve, fill), tf = timed(lambda: available[name](K))
-                    X, ts = timed(lambda: solve(B))  # noqa: F821
+                    (solve, fill), tf = timed(lambda f=available[name], K=K: f(K))
+                    X, ts = timed(lambda s=solve, B=B: s(B))
                 except Exception as exc:  # noqa: BLE001  (a solver that fails is reported)
                     r["error"] = f"{type(exc).__name__}: {exc}"[:80]
                     log(f"  {name}: failed: {r['error']}")
@@ -253,7 +253,7 @@ def sensitivity(element: str, target: int, names: list[str], log) -> str:
                 f"{abs(K - K.T).max() / abs(K).max():.0e}",
             ]
             for name in names:
-                (solve, fill), t = timed(lambda: available[name](K))
+                (solve, fill), t = timed(lambda f=available[name], K=K: f(K))
                 if hasattr(solve, "release"):
                     solve.release()
                 cells.append(f"{t.cpu:.2f} / {fill / 1e6:.1f}M" if fill else f"{t.cpu:.2f}")

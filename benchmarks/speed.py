@@ -10,7 +10,7 @@ Sections (each a table in benchmarks/results/speed.md):
 - process: the whole process of the plate Q8 4x40 to w = 8 in (`axiform run`, a fresh Python
   each time) before / after, with its default outputs and with VTU and plots off, against
   FElupe (a fresh Python: import, mesh, 44 pressure steps to 32.7 psi placed where axiform's
-  curve has w = 8 k / 44, as benchmarks/peers.py does, Newton to 1e-8) and CalculiX CAX8 (ccx
+  curve has w = 8 k / 44, as validation/plate_peers.py does, Newton to 1e-8) and CalculiX CAX8 (ccx
   on the same mesh, the same 44 pressures, default and tight tolerances);
   `import axiform.cli` alone.  Interleaved repeats, minimum wall time of each.
 - newton: one Newton iteration (evaluate + factorize + solve with two right-hand sides) at
@@ -215,11 +215,11 @@ def section_process(trees: dict[str, Path], repeat: int, tmp: Path) -> str:
         )
         jobs[f"import axiform.cli ({name})"] = ([py, "-c", "import axiform.cli"], env_for(src))
     jobs["python -c pass"] = ([py, "-c", "pass"], env_for(SRC))
-    # the peers' 44 pressures: where axiform's load curve reaches w = 8 k / 44 (as benchmarks/peers.py)
-    sys.path.insert(0, str(HERE))
+    # the peers' 44 pressures: where axiform's load curve reaches w = 8 k / 44 (as validation/plate_peers.py)
+    sys.path.insert(0, str(ROOT / "validation"))
     sys.path.insert(0, str(SRC))
     import numpy as np
-    from peers import curve, run_axiform
+    from plate_peers import curve, run_axiform
 
     ref = run_axiform("q8", 40, 4)
     pressures = curve(ref["w"], ref["p"])(8.0 * np.arange(1, 45) / 44)
@@ -239,7 +239,7 @@ def section_process(trees: dict[str, Path], repeat: int, tmp: Path) -> str:
         pass
     ccx = shutil.which("ccx")
     if ccx:
-        from peers import ccx_deck
+        from plate_peers import ccx_deck
 
         import axiform as af
 

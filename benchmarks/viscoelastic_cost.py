@@ -70,7 +70,6 @@ def ring(element: str, formulation: str, material, n: int) -> Model:
     model = Model(mesh, material, formulation=formulation)
     model.fix(mesh.node_sets["bottom"], ["uz"])
     model.prescribe(mesh.node_sets["top"], ["uz"], -0.05)
-    model.bench_top_displacement = -0.05
     left = mesh.node_sets["left"]
     model.pressure(edges_on_nodes(mesh, left[mesh.points[left, 1] <= 0.5 + 1e-12]), 5.0)
     return model.finalize()

@@ -29,7 +29,7 @@ from .terms import CavityTerm, Constraint, ContactTerm, PointLoadTerm, PressureT
 DOF_NAMES = {"ur": 0, "uz": 1, "rot": 2}
 SFR_EDGE_RULES = ("tie", "fix", "free")
 FORMULATIONS = ("mixed", "displacement")
-# the pressure space of each mixed element (benchmarks/MIXED.md measures P0 against P1 for SFR)
+# the pressure space of each mixed element (benchmarks/README.md § 6.5 measured P0 against P1 for SFR)
 PRESSURE_SPACE = {"q4": "p0", "q8": "p1", "sfr": "p0"}
 
 

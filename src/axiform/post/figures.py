@@ -29,7 +29,7 @@ def colormap(name: str):
 def save(fig, path: str | Path, dpi: float = DPI, **savefig: Any) -> Path | None:
     """Write `fig` to `path` (PNG unless the name or format= says otherwise) at `dpi`; None
     for no figure.  A PNG at zlib's fastest level: the plate's three pictures saved in
-    0.37 s instead of 0.40 s, the files 13 % larger (benchmarks/README.md § 3.9).  The
+    0.37 s instead of 0.40 s, the files 13 % larger (benchmarks/README.md § 3.6).  The
     figure holds no global state: it is freed with its last reference.  Written whole to a
     temporary name beside `path`, then renamed over it: a reader sees the old picture or the
     new one, never a part.  A figure's layout (constrained) is done here at `dpi`, then the

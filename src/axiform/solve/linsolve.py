@@ -10,11 +10,11 @@ The solver is chosen by the size n of K (benchmarks/README.md § 3.2 measured ea
   nested dissection above; symbolic factorization) once for each sparsity pattern, then
   phase 22 (numerical factorization) for each K and phase 33 for each solve.  pypardiso
   installs MKL; only the library it brings is used here, found when first needed.  Its
-  solver object, driven phase by phase, was measured slower (benchmarks/README.md § 3.9:
+  solver object, driven phase by phase, was measured slower (benchmarks/README.md § 3.6:
   its import and constructor look for MKL through site-packages, 0.24 to 0.40 s a process,
   and each call converts the indices to one-based and builds its pointers, +0.1 ms = +9 to
   13 % for a factorization and solve at 1e3 unknowns), so this module keeps its own binding,
-  typed and guarded (benchmarks/README.md § 3.9);
+  typed and guarded (benchmarks/README.md § 3.6);
 - without MKL (not x86-64): SciPy's SuperLU with the column ordering minimum degree on
   K^T K (MMD_ATA), computed once per pattern and then given as the natural order of the
   permuted K.  A column ordering bounds the fill whatever rows partial pivoting picks;
@@ -146,7 +146,7 @@ class _Pardiso:
     for its phases.  The arguments are typed (_mkl: argtypes); the pointers to the scalars,
     the handle and the pattern are made once per pattern, those to the values and the
     right-hand sides per call (building every pointer on every call cost 10 to 20 us a call,
-    as pypardiso does: benchmarks/README.md § 3.9)."""
+    as pypardiso does: benchmarks/README.md § 3.6)."""
 
     def __init__(self, lib: ctypes.CDLL):
         self.lib = lib
