@@ -57,7 +57,7 @@ def sphere(element, kappa, formulation, space):
     model.fix(select_nodes(mesh, {"set": "start"}), ["uz"])
     model.fix(select_nodes(mesh, {"set": "end"}), ["ur"])
     model.pressure(select_edges(mesh, {"set": "inner"}), P)
-    model.finalize()
+    model = model.finalize()
     res = solve(model, LoadControl(1.0, 10))
     if res.status != "finished":
         return np.nan
@@ -70,7 +70,7 @@ def plate(element, divisions, kappa, formulation, w=6.0, space=None):
     model.fix(select_nodes(mesh, {"r": 7.5}), ["ur", "uz", "rot"])
     model.fix(select_nodes(mesh, {"r": 0.0}), ["ur"])
     model.pressure(select_edges(mesh, {"z": 0.0}), 1.0)
-    model.finalize()
+    model = model.finalize()
     c = int(model.dof(select_nodes(mesh, {"r": 0.0, "z": 0.25})[0], "uz"))
     res = solve(model, DisplacementControl(c, w, 12))
     return res.last.lam if res.status == "finished" else np.nan

@@ -113,7 +113,7 @@ def plate(element: str, nt: int, nr: int, rule: str = "tie", rim_rot: bool = Fal
     model.fix(rim, ["ur", "uz", "rot"] if rim_rot else ["ur", "uz"])
     model.fix(select_nodes(mesh, {"r": 0.0}), ["ur"])
     model.pressure(select_edges(mesh, {"z": 0.0}), 1.0)
-    model.finalize()
+    model = model.finalize()
     top = select_nodes(mesh, {"r": 0.0, "z": THICK})[0]
     bottom = select_nodes(mesh, {"r": 0.0, "z": 0.0})[0]
     c = int(model.dof(top, "uz"))
@@ -155,7 +155,7 @@ def small_deflection(element: str, nt: int, nr: int, kappa: float, w: float = 0.
     model.fix(select_nodes(mesh, {"r": RADIUS}), ["ur", "uz"])
     model.fix(select_nodes(mesh, {"r": 0.0}), ["ur"])
     model.pressure(select_edges(mesh, {"z": 0.0}), 1.0)
-    model.finalize()
+    model = model.finalize()
     c = int(model.dof(select_nodes(mesh, {"r": 0.0, "z": THICK})[0], "uz"))
     res = solve(model, DisplacementControl(c, w, 1))
     assert res.status == "finished", res.message
@@ -169,7 +169,7 @@ def cylinder(element: str, nr: int, rule: str = "tie") -> dict:
     model.fix(select_nodes(mesh, {"z": 0.0}), ["uz"])
     model.fix(select_nodes(mesh, {"z": H}), ["uz"])
     model.pressure(select_edges(mesh, {"r": A}), 1.0)
-    model.finalize()
+    model = model.finalize()
     c = int(model.dof(select_nodes(mesh, {"r": A, "z": 0.0})[0], "ur"))
     held = np.concatenate([select_edges(mesh, {"z": 0.0}), select_edges(mesh, {"z": H})])
     t0 = time.perf_counter()

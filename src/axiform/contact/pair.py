@@ -188,9 +188,6 @@ class ContactPair:
         self.search = search
         self.stabilization = stabilization  # None: decided by the model (Model.finalize)
         self.name: str | None = None  # a label for plots and summary.json (case file: [[contact]] name)
-        # the nodes' projection found by `guard` with the mid-points' (one pass over the pieces),
-        # for the `evaluate` of the same u and state that follows it: (x, x_prev, projection)
-        self._projected = None
 
     def initial_state(self) -> ContactState:
         """The history before the first step: no node touched, positions at the reference."""
@@ -215,19 +212,17 @@ class ContactPair:
         state: ContactState,
         predicting: bool = False,
         guard_force: np.ndarray | None = None,
+        projection=None,
     ) -> ContactTrial:
         """The pair at displacements u (n_nodes, 2) and process time lam, from the committed
         history `state`: forces on the slave nodes, their derivatives (`ContactTrial`) and the
         trial state.  predicting: the tangent of a step's first iteration (nodes resting on
         the surface get the penalty in it, see the class).  guard_force: the mid-point guards'
-        forces (m, 2) of the same state (`guard`), for the report."""
+        forces (m, 2) of the same state (`guard`), for the report; projection: the nodes'
+        projection that `guard` found at the same u and state (None: projected here)."""
         xa = self.X + u[self.nodes]
         x = xa - self.surface.offset(lam)
-        held, self._projected = self._projected, None
-        if held is not None and held[1] is state.x_prev and np.array_equal(held[0], x):
-            proj = held[2]  # found by `guard` at these very positions
-        else:
-            proj = self.surface.local(x, state.x_prev, self.depth, self.search)
+        proj = projection if projection is not None else self.surface.local(x, state.x_prev, self.depth, self.search)
         if guard_force is None:
             guard_force = np.zeros((len(self.edges) if self.guarded else 1, 2))
         if self._idle(proj, state, predicting):
@@ -339,7 +334,8 @@ class ContactPair:
         Returns per edge over `guard_dofs` the force on the body F (m, 2 dpn), its derivative
         K = dF/du (m, 2 dpn, 2 dpn), the rate K_x velocity (m, 2 dpn) of a surface moving
         with velocity (2,) (the force depends on x_m - offset(lam)), and the force on each
-        mid-point (m, 2); F, K and the rate are None where no guard acts."""
+        mid-point (m, 2); F, K and the rate are None where no guard acts; and the slave
+        nodes' projection, found in the same pass (for `evaluate` at the same u and state)."""
         e = self.edges
         dpn = u.shape[1]
         un = u[self.nodes]
@@ -353,11 +349,10 @@ class ContactPair:
         nodes, proj = self.surface.local_sets(
             [(x, state.x_prev, self.depth), (mid, mid_prev, self.depth + self.guard_allowance.max())], self.search
         )
-        self._projected = (x, state.x_prev, nodes)
         m = len(e)
         g = proj.g + self.guard_allowance
         if not (proj.active & (g < 0.0)).any():  # no mid-point behind its allowance: no force
-            return None, None, None, np.zeros((m, 2))
+            return None, None, None, np.zeros((m, 2)), nodes
         fn, dfn = _normal_law(g, proj.active, self.guard_kn, self.smoothing)
         w = self.guard_weight
         force = (w * fn)[:, None] * proj.n  # on the mid-point (m, 2)
@@ -371,13 +366,14 @@ class ContactPair:
                 np.broadcast_to(quarter[:, None, :, None, :], (m, 2, 2, 2, 2)).reshape(m, 4, 4),
                 np.concatenate((0.5 * Kv,) * 2, axis=1),
                 force,
+                nodes,
             )
         P = np.zeros((m, 2, 2, dpn))  # d x_m / d (node, dof)
         P[:, 0, :, 0] = P[:, 1, :, 1] = 0.5
         P[:, :, 0, 2], P[:, :, 1, 2] = self.guard_arm, -self.guard_arm
         P = P.reshape(m, 2, 2 * dpn)
         PT = P.transpose(0, 2, 1)  # (m, 2 dpn, 2): stacked matrix products, not einsums on tiny operands
-        return (PT @ force[..., None])[..., 0], PT @ (Kx @ P), (PT @ Kv[..., None])[..., 0], force
+        return (PT @ force[..., None])[..., 0], PT @ (Kx @ P), (PT @ Kv[..., None])[..., 0], force, nodes
 
     def rate(self, trial: ContactTrial, velocity: np.ndarray) -> np.ndarray:
         """d f / d lambda at fixed u of the evaluation `trial` divided by -1, per slave node
