@@ -42,6 +42,7 @@ from .contact import (
     contact_pair,
     youngs_modulus,
 )
+from .gravity import GravitySpec, build_gravity
 from .loads import FixSpec, PointLoadSpec, PressureSpec, apply_loads, prescribe_fixes
 from .material import MaterialSpec
 from .mesh import ArcPiece, LinePiece, MeshSpec, PieceSpec, build_mesh
@@ -116,6 +117,7 @@ class Case(Strict):
     temperature: TemperatureSpec | None = None
     thermal: ThermalSpec | None = None
     convection: list[ConvectionSpec] = []
+    gravity: GravitySpec | None = None
 
 
 # the names pydantic gives the members of a union in an error's location: not keys
@@ -283,12 +285,13 @@ class Built:
 
 def _loaded(case: Case) -> bool:
     """Whether something loads the case: a value of a [[pressure]], [[point_load]] or [[fix]],
-    a moving mould, a loaded cavity, heat flowing in or out."""
+    a moving mould, a loaded cavity, heat flowing in or out, the body's weight."""
     moving = any(c.motion.ur or c.motion.uz for c in case.contact)
     gas = any(c.control != "pressure" or c.pressure for c in case.cavity)
     loads = [*case.pressure, *case.point_load, *case.fix]
     heated = case.thermal is not None and bool(case.convection or any(c.conductance for c in case.contact))
-    return any(item.value for item in loads) or moving or gas or heated
+    weight = case.gravity is not None and case.gravity.g != 0.0
+    return any(item.value for item in loads) or moving or gas or heated or weight
 
 
 def build(case: Case, base: str | Path = ".") -> Built:
@@ -335,7 +338,8 @@ def build(case: Case, base: str | Path = ".") -> Built:
         pairs = [contact_pair(mesh, model, c, base, f"contact[{i}]") for i, c in enumerate(case.contact)]
         for pair in pairs:
             model.contact(pair)
-        build_conduction(model, mesh, case.thermal, case.convection, case.contact)
+        build_conduction(model, mesh, case.thermal, case.convection, case.contact, case.material.density)
+        build_gravity(model, mesh, case.gravity, case.material.density)
         control = build_control(model, mesh, case.solver)
         if not _loaded(case):
             raise CaseError(
