@@ -280,7 +280,7 @@ def singular(element: str, names: list[str], log) -> str:
     mesh = rectangle((1.0, 2.0), (0.0, 1.0), (30, 30), element)
     model = Model(mesh, MATERIAL, formulation="displacement")
     model.pressure(mesh.edge_sets["left"], 5.0)
-    model.finalize()
+    model = model.finalize()
     u_f, lam = deformed_state(model)
     ev = model.evaluate(u_f, lam)
     K, b = ev.K.tocsr(), -ev.r

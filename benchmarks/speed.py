@@ -100,7 +100,7 @@ model.fix(mesh.node_sets["bottom"], ["uz"])
 model.prescribe(mesh.node_sets["top"], ["uz"], -0.05)
 left = mesh.node_sets["left"]
 model.pressure(edges_on_nodes(mesh, left[mesh.points[left, 1] <= 0.5 + 1e-12]), 5.0)
-model.finalize()
+model = model.finalize()
 rng = np.random.default_rng(0)
 P, h = mesh.points, mesh.size()
 u = np.zeros((mesh.n_nodes, model.dpn))
@@ -142,7 +142,7 @@ mesh = af.rectangle((1.0, 2.0), (0.0, 1.0), (n, n), "sfr")
 model = af.Model(mesh, af.MooneyRivlin(80.0, 20.0, 1e4), formulation="displacement")
 model.fix(mesh.node_sets["bottom"], ["uz"])
 model.pressure(edges_on_nodes(mesh, mesh.node_sets["left"]), 20.0)
-model.finalize()
+model = model.finalize()
 rows = [rss()]
 kw = {"keep": 1} if "keep" in af.solve.__code__.co_varnames else {}
 res = af.solve(model, af.LoadControl(1.0, steps), af.NewtonOptions(growth=1.0), on_step=lambda s: rows.append(rss()),

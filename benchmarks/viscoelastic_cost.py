@@ -72,18 +72,18 @@ def ring(element: str, formulation: str, material, n: int) -> Model:
     model.prescribe(mesh.node_sets["top"], ["uz"], -0.05)
     left = mesh.node_sets["left"]
     model.pressure(edges_on_nodes(mesh, left[mesh.points[left, 1] <= 0.5 + 1e-12]), 5.0)
-    return model.finalize()
+    return model
 
 
 def committed_state(model: Model):
     """A committed state with history: the initial one carried to T_COMMITTED at half the
     deformation (an elastic law: its state, with no history)."""
     start = model.initial_state()
-    if not start.solid:
+    if not model.solid_state(start):
         return start
     u_half, _ = deformed_state(model, seed=1, lam=0.25)
     state = model.evaluate(u_half, T_COMMITTED, start, tangent=False).trial
-    assert np.abs(state.solid["h"]).max() > 0
+    assert np.abs(model.solid_state(state)["h"]).max() > 0
     return state
 
 
@@ -94,10 +94,10 @@ def time_evaluations(n: int, repeats: int) -> dict:
         laws = {"elastic": MATERIAL} | {name: Viscoelastic(MATERIAL, p) for name, p in SERIES.items()}
         laws[SHIFTED] = laws["3 terms"]
         for name, law in laws.items():
-            model = ring(element, formulation, law, n)
+            built = ring(element, formulation, law, n)
             if name == SHIFTED:
-                model.heat(150.0 - 30.0 * (model.mesh.points[:, 0] - 1.0), WLF_SHIFT)
-                model.finalize()
+                built.heat(150.0 - 30.0 * (built.mesh.points[:, 0] - 1.0), WLF_SHIFT)
+            model = built.finalize()
             u_f, _ = deformed_state(model, lam=0.5)
             models[element, formulation, name] = (model, u_f, committed_state(model))
     times: dict = {}

@@ -127,10 +127,10 @@ def test_a_failed_run_keeps_the_contact_table_of_its_last_step(tmp_path, monkeyp
     import meshio
 
     from axiform.cli import main
-    from axiform.model import model as model_module
+    from axiform.model import system as model_module
 
     calls = {"n": 0}
-    evaluate = model_module.Model.evaluate
+    evaluate = model_module.System.evaluate
 
     def crash_later(self, *args, **kwargs):
         calls["n"] += 1
@@ -138,7 +138,7 @@ def test_a_failed_run_keeps_the_contact_table_of_its_last_step(tmp_path, monkeyp
             raise RuntimeError("a fault in the law")
         return evaluate(self, *args, **kwargs)
 
-    monkeypatch.setattr(model_module.Model, "evaluate", crash_later)
+    monkeypatch.setattr(model_module.System, "evaluate", crash_later)
     out = tmp_path / "out"
     toric = Path(__file__).resolve().parents[1] / "examples" / "toric_plate.toml"
     assert (

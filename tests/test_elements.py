@@ -50,7 +50,7 @@ def test_patch_solved_with_boundary_prescribed(element, formulation):
     for n in boundary:
         model.prescribe([n], ["ur"], exact[n, 0])
         model.prescribe([n], ["uz"], exact[n, 1])
-    model.finalize()
+    model = model.finalize()
     res = solve(model, LoadControl(1.0, 4), NewtonOptions(tolerance=1e-12))
     assert res.status == "finished"
     u = res.last.u.reshape(-1, model.dpn)
@@ -95,7 +95,7 @@ def test_pressure_resultant_is_pressure_times_projected_area(element):
     mesh = rectangle((0.0, 2.0), (0.0, 0.5), (4, 2), element)
     model = Model(mesh, LAW)
     model.pressure(select_edges(mesh, {"z": 0.5}), 1.0)
-    model.finalize()
+    model = model.finalize()
     u = full_vector(model, homogeneous(mesh.points, a=0.2, d=0.1))
     f, _ = model.external_load(u, 1.0)
     fz = f.reshape(-1, model.dpn)[:, 1].sum()
@@ -140,7 +140,7 @@ def test_sfr_zero_mode_removed_on_every_body():
     mesh = Mesh(np.vstack([a.points, b.points]), np.vstack([a.cells, b.cells + a.n_nodes]), a.element)
     model = Model(mesh, LAW)
     model.fix(select_nodes(mesh, {"z": 0.0}), ["ur", "uz"])
-    model.finalize()
+    model = model.finalize()
     assert len(model.dofmap.prescribed_ref) == 2 * 6 + 2  # ur, uz on 6 base nodes, one theta per body
     K = model.evaluate(np.zeros(model.n_free), 0.0).K.toarray()
     s = np.linalg.svd(K, compute_uv=False)

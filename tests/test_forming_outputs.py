@@ -150,7 +150,9 @@ def test_vtu_fields_thickness_and_first_contact():
     model = built.model
     pair = model.contacts[0]
     start = model.initial_state()
-    held = replace(start.contacts[0], first_contact=np.where(np.arange(len(pair.nodes)) % 3 == 0, 0.5, np.nan))
+    held = replace(
+        model.contact_states(start)[0], first_contact=np.where(np.arange(len(pair.nodes)) % 3 == 0, 0.5, np.nan)
+    )
     fields = point_fields(model, np.zeros(model.n_full), replace(start, contacts=(held,)))
     expect = np.full(model.mesh.n_nodes, -1.0)
     expect[pair.nodes] = np.nan_to_num(held.first_contact, nan=-1.0)
@@ -168,8 +170,12 @@ def test_vtu_fields_first_contact_per_piece():
     plug, mould = model.contacts
     start = model.initial_state()
     held = (
-        replace(start.contacts[0], first_contact=np.where(np.arange(len(plug.nodes)) % 2 == 0, 0.5, np.nan)),
-        replace(start.contacts[1], first_contact=np.where(np.arange(len(mould.nodes)) % 3 == 0, 1.5, np.nan)),
+        replace(
+            model.contact_states(start)[0], first_contact=np.where(np.arange(len(plug.nodes)) % 2 == 0, 0.5, np.nan)
+        ),
+        replace(
+            model.contact_states(start)[1], first_contact=np.where(np.arange(len(mould.nodes)) % 3 == 0, 1.5, np.nan)
+        ),
     )
     fields = point_fields(model, np.zeros(model.n_full), replace(start, contacts=held))
     for k, pair in enumerate(held):

@@ -120,8 +120,8 @@ def test_arc_length_finishes_the_stage_once_the_wall_is_frozen(content, knot):
         assert res.status == "finished", (control, res.message)
         lam = np.array([s.lam for s in res.steps])
         assert lam[-1] == 1.0 and (np.diff(lam) > 0).all() and np.isclose(lam, knot, rtol=0, atol=1e-14).any()
-        assert (res.last.state.contacts[0].stuck).all()
-        cavity = res.last.state.cavities[0]
+        assert (built.model.contact_states(res.last.state)[0].stuck).all()
+        cavity = built.model.cavity_states(res.last.state)[0]
         assert (cavity.pressure + 0.1) * cavity.volume == pytest.approx(content, rel=1e-9)
         ends[control] = cavity.pressure
     assert ends["arc-length"] == pytest.approx(ends["load"], rel=1e-9)

@@ -345,7 +345,7 @@ def test_thick_sphere_with_each_law_against_its_radial_solution(law):
     model.fix(select_nodes(mesh, {"set": "start"}), ["uz"])
     model.fix(select_nodes(mesh, {"set": "end"}), ["ur"])
     model.pressure(select_edges(mesh, {"set": "inner"}), p)
-    model.finalize()
+    model = model.finalize()
     res = solve(model, LoadControl(1.0, 5))
     assert res.status == "finished" and res.newton_iterations <= 25
     node = select_nodes(mesh, {"set": "inner", "z": 0.0})

@@ -1,6 +1,6 @@
 """axiform.solve.linsolve: dense LAPACK, PARDISO (analysis kept per pattern) and SuperLU (ordering
-kept per pattern) give the same solutions; a new pattern is analysed anew; an old solve
-function refuses after a new factorization; threads keep their own factorizations."""
+kept per pattern) give the same solutions; a new pattern is analysed anew; a factorization
+keeps answering after later ones; threads factorize side by side."""
 
 import threading
 
@@ -21,7 +21,7 @@ def _tangent(element: str, divisions, seed: int = 0):
     model.fix(mesh.node_sets["bottom"], ["uz"])
     left = mesh.node_sets["left"]
     model.pressure(edges_on_nodes(mesh, left[mesh.points[left, 1] <= 0.5 + 1e-12]), 5.0)
-    model.finalize()
+    model = model.finalize()
     rng = np.random.default_rng(seed)
     u_f = 0.002 * rng.standard_normal(model.n_free)
     ev = model.evaluate(u_f, 0.5)
@@ -57,8 +57,9 @@ def test_pattern_kept_and_renewed(monkeypatch, name):
     K1, B = _tangent("q4", (7, 6), seed=1)
     K2, _ = _tangent("q4", (7, 6), seed=2)  # same pattern, other values
     K3, B3 = _tangent("sfr", (5, 5))  # another pattern
+    solver = ls.LinearSolver()
     for K, b in ((K1, B), (K2, B), (K3, B3), (K1, B)):
-        x = ls.factorize(K)(b)
+        x = solver.factorize(K)(b)
         assert np.abs(K @ x - b).max() <= 1e-10 * np.abs(b).max()
 
 
@@ -69,22 +70,31 @@ def test_pardiso_analysis_once_per_pattern(monkeypatch):
     calls = []
     original = ls._Pardiso.analyse
     monkeypatch.setattr(ls._Pardiso, "analyse", lambda self, K: calls.append(K.shape) or original(self, K))
-    if ls._STATE.pardiso is not None:  # start from no analysis
-        ls._STATE.pardiso.release()
+    solver = ls.LinearSolver()
     for K in (K1, K2, K1, sp.csr_matrix(K2.toarray())):  # the last: a copy, equal pattern
-        ls.factorize(K)(B)
+        solver.factorize(K)(B)
     assert len(calls) == 1
+    held = solver.factorize(K1)  # held while the next is made: a second handle, analysed once
+    for K in (K2, K1, K2):
+        solver.factorize(K)(B)
+    held(B)
+    assert len(calls) == 2
 
 
-def test_old_factorization_refused(monkeypatch):
+def test_a_factorization_answers_after_later_ones(monkeypatch):
+    """A factorization owns its factors: later ones (of the same solver, the same pattern)
+    leave its answers as they were."""
     _backend(monkeypatch, "pardiso")
     K1, B = _tangent("q4", (7, 6), seed=1)
     K2, _ = _tangent("q4", (7, 6), seed=2)
-    first = ls.factorize(K1)
-    first(B)
-    ls.factorize(K2)
-    with pytest.raises(RuntimeError, match="replaced"):
-        first(B)
+    solver = ls.LinearSolver()
+    first = solver.factorize(K1)
+    x1 = first(B)
+    second = solver.factorize(K2)
+    assert np.array_equal(first(B), x1)
+    x2 = second(B)
+    assert np.abs(K1 @ x1 - B).max() <= 1e-10 * np.abs(B).max()
+    assert np.abs(K2 @ x2 - B).max() <= 1e-10 * np.abs(B).max()
 
 
 def test_singular_dense():
@@ -127,7 +137,6 @@ def test_pardiso_typed_and_guarded(monkeypatch):
     assert len(argtypes) == 16 and ctypes.c_void_p not in argtypes
     assert ls._mkl().MKL_Set_Num_Threads_Local.argtypes == [ctypes.c_int]
     monkeypatch.setattr(ls, "_INT32_MAX", K.nnz - 1)
-    ls._STATE.pardiso.release()
     with pytest.raises(ValueError, match="32-bit"):
         ls.factorize(K)
 
@@ -146,14 +155,15 @@ def test_pardiso_one_and_several_rhs(monkeypatch):
         assert solve(B[:, :1]).shape == (K.shape[0], 1)
 
 
-def test_threads_keep_their_own(monkeypatch):
+def test_threads_share_a_solver(monkeypatch):
     _backend(monkeypatch, "pardiso")
     problems = [_tangent("q4", (8, 7), seed=s) for s in range(2)] + [_tangent("sfr", (6, 6), seed=3)]
     errors = []
+    solver = ls.LinearSolver()
 
     def work(K, B):
         for _ in range(20):
-            x = ls.factorize(K)(B)
+            x = solver.factorize(K)(B)
             errors.append(np.abs(K @ x - B).max() / np.abs(B).max())
 
     threads = [threading.Thread(target=work, args=p) for p in problems]
@@ -169,12 +179,18 @@ def test_threads_by_size(monkeypatch):
     same answer either way."""
     _backend(monkeypatch, "pardiso")
     K, B = _tangent("q4", (7, 6))
+    threads = []
+    original = ls._Pardiso.analyse
+
+    def analyse(self, K):
+        original(self, K)
+        threads.append(self.threads)
+
+    monkeypatch.setattr(ls._Pardiso, "analyse", analyse)
     x1 = ls.factorize(K)(B)
-    assert ls._STATE.pardiso.threads == 1
     monkeypatch.setattr(ls, "PARALLEL_MIN", 0)
-    ls._STATE.pardiso.release()
     x0 = ls.factorize(K)(B)
-    assert ls._STATE.pardiso.threads == 0
+    assert threads == [1, 0]
     assert np.abs(x1 - x0).max() <= 1e-12 * np.abs(x0).max()
 
 

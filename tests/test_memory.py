@@ -48,7 +48,7 @@ def test_thousand_steps_memory_flat():
 
 
 def test_steps_hold_results_not_the_tangent():
-    model = _ring()
+    model = _ring().finalize()
     result = solve(model, LoadControl(1.0, 4))
     assert result.n_steps == len(result.steps) == 4
     held = {f.name for f in Step.__dataclass_fields__.values()}

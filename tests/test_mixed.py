@@ -34,7 +34,7 @@ def sphere_bore(element: str, kappa_over_mu: float, formulation: str, pressure_s
     model.fix(select_nodes(mesh, {"set": "start"}), ["uz"])
     model.fix(select_nodes(mesh, {"set": "end"}), ["ur"])
     model.pressure(select_edges(mesh, {"set": "inner"}), P)
-    model.finalize()
+    model = model.finalize()
     res = solve(model, LoadControl(1.0, 5))
     assert res.status == "finished", res.message
     node = select_nodes(mesh, {"set": "inner", "z": 0.0})
@@ -76,7 +76,7 @@ def test_tangent_of_the_other_pressure_spaces(element, space):
     model = Model(mesh, MR(0.4, 0.1, 50.0), formulation="mixed", pressure_space=space)
     model.fix(select_nodes(mesh, {"z": 0.0}), ["uz"])
     model.pressure(select_edges(mesh, {"r": 0.3}), 0.7)
-    model.finalize()
+    model = model.finalize()
     u_f = 0.02 * np.random.default_rng(3).standard_normal(model.n_free)
     K = model.evaluate(u_f, 1.1).K.toarray()
     num, _ = difference_tangent(model, u_f, 1.1, 1e-6)

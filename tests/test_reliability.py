@@ -115,10 +115,10 @@ def test_kill_9_leaves_files_that_parse(tmp_path):
 
 
 def test_an_unexpected_error_sets_failed_and_exit_3(tmp_path, monkeypatch, capsys):
-    from axiform.model import model as model_module
+    from axiform.model import system as model_module
 
     calls = {"n": 0}
-    evaluate = model_module.Model.evaluate
+    evaluate = model_module.System.evaluate
 
     def crash_later(self, *args, **kwargs):
         calls["n"] += 1
@@ -126,7 +126,7 @@ def test_an_unexpected_error_sets_failed_and_exit_3(tmp_path, monkeypatch, capsy
             raise RuntimeError("a fault in the law")
         return evaluate(self, *args, **kwargs)
 
-    monkeypatch.setattr(model_module.Model, "evaluate", crash_later)
+    monkeypatch.setattr(model_module.System, "evaluate", crash_later)
     out = tmp_path / "out"
     assert main(["run", str(PLATE), "--out", str(out), "--set", "output.plots=false"]) == 3
     cap = capsys.readouterr()
@@ -400,7 +400,7 @@ def test_a_mechanism_never_converges_through_the_python_api():
     built = build(case, PLATE.parent)
     model = built.model
     model.fixed = {d: v for d, v in model.fixed.items() if d % model.dpn != 1}  # uz free everywhere
-    model.finalize()
+    model = model.finalize()
     result = solve(model, built.control, built.options)
     assert result.status == "stopped" and not result.steps
     assert "step 1:" in result.message and "a mechanism" in result.message

@@ -88,14 +88,14 @@ def test_the_run_maxima_and_the_stabilization(ring_run):
     out, model, result, steps, _ = ring_run
     summary = json.loads((out / "summary.json").read_text())
     lower, upper, far = summary["contact"]
-    forces = [abs(model.contacts[1].report(s.state.contacts[1])["force_z"]) for s in steps]
+    forces = [abs(model.contacts[1].report(model.contact_states(s.state)[1])["force_z"]) for s in steps]
     assert upper["max_force_z"] == pytest.approx(max(forces)) and upper["max_force_z"] > 0
     assert upper["touched"] and lower["touched"] and not far["touched"]
     assert far["max_force_r"] == far["max_force_z"] == far["max_penetration_ratio"] == 0.0
     # the penalty sinks the plates about 0.006 into a wall of about 2.8 (measured in test_stabilization)
     assert 0 < upper["max_penetration_ratio"] < 0.01
     stab = summary["stabilization"]
-    work = sum(held.damping_work for held in result.last.state.contacts)
+    work = sum(held.damping_work for held in model.contact_states(result.last.state))
     assert stab["work"] == pytest.approx(work) and stab["strain_energy"] == pytest.approx(
         model.strain_energy(result.last.u)
     )
@@ -136,7 +136,10 @@ def fake_model(stabilization=0.0, energy=1.0):
     mesh = rectangle((0.0, 2.0), (0.0, 0.3), (4, 2), "q4")
     top = np.flatnonzero(np.isclose(mesh.points[:, 1], 0.3))
     pair = SimpleNamespace(name="punch", nodes=top, stabilization=stabilization)
-    return SimpleNamespace(mesh=mesh, contacts=[pair], strain_energy=lambda u: energy), top
+    model = SimpleNamespace(
+        mesh=mesh, contacts=[pair], strain_energy=lambda u: energy, contact_states=lambda state: state.terms
+    )
+    return model, top
 
 
 def report(nodes, gap, status):
@@ -147,7 +150,7 @@ def test_a_penetration_above_5_percent_of_the_wall_is_a_warning():
     model, top = fake_model()
     rec = RunRecord(model)
     x = model.mesh.points.copy()
-    state = SimpleNamespace(contacts=[SimpleNamespace(first_contact=np.full(len(top), np.nan), damping_work=0.0)])
+    state = SimpleNamespace(terms=[SimpleNamespace(first_contact=np.full(len(top), np.nan), damping_work=0.0)])
     gap = np.zeros(len(top))
     gap[2] = -0.018  # 6 % of 0.3
     table = thickness_table(model.mesh, np.zeros_like(x))
@@ -170,7 +173,7 @@ def test_stabilization_work_above_1_percent_of_the_strain_energy_is_a_warning():
     model, top = fake_model(stabilization=0.1, energy=10.0)
     rec = RunRecord(model)
     held = SimpleNamespace(first_contact=np.full(len(top), 0.5), damping_work=0.2)
-    step = SimpleNamespace(state=SimpleNamespace(contacts=[held]), u=None)
+    step = SimpleNamespace(state=SimpleNamespace(terms=[held]), u=None)
     stab = rec.stabilization(step)
     assert stab == {"work": 0.2, "strain_energy": 10.0, "ratio": pytest.approx(0.02)}
     (line,) = rec.warnings(step, stab)  # touched (first_contact), no penetration

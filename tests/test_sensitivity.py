@@ -100,7 +100,7 @@ def test_free_tube_under_volume_control(formulation):
 
 def test_sticky_mould_with_nodes_freezing_at_different_steps_mixed():
     sens = check_against_forward_differences(tube("mixed", contact={"sticky": True}))
-    pair, held = sens.model.contacts[0], sens.solve.last.state.contacts[0]
+    pair, held = sens.model.contacts[0], sens.model.contact_states(sens.solve.last.state)[0]
     assert np.unique(held.first_contact[~np.isnan(held.first_contact)]).size >= 3  # froze over several steps
     assert (pair.report(held)["status"] == 3).sum() >= 5  # of the 7 outer nodes, 5 frozen (and 1 touching)
     assert pair.report(held)["penetration"] < 0.05  # the mould holds the tube
@@ -116,7 +116,7 @@ def test_coulomb_friction_on_the_mould(formulation):
     # (up to 24 Newton iterations in the mixed element) are not cut back
     tree["solver"].update(growth=1.0, max_iterations=30)
     sens = check_against_forward_differences(tree)
-    pair, held = sens.model.contacts[0], sens.solve.last.state.contacts[0]
+    pair, held = sens.model.contacts[0], sens.model.contact_states(sens.solve.last.state)[0]
     assert (pair.report(held)["status"] > 0).sum() >= 5
     assert np.unique(held.first_contact[~np.isnan(held.first_contact)]).size >= 3
     assert pair.report(held)["penetration"] < 0.05

@@ -7,7 +7,7 @@ table, against central differences of whole forward solves; and the same derivat
 the history held at its base value (dh/ds ignored), or of the elastic law, which are wrong
 by far more than the tolerance.  And the tube cooled by a film while it is blown, its
 relaxation times shifted by the temperature (WLF): the shadows' temperatures are advanced by
-heat conduction after each step as the solver's are (Model.settle)."""
+heat conduction after each step as the solver's are (System.settle)."""
 
 import copy
 
@@ -80,7 +80,7 @@ def forward(model, built, times):
     return (
         thickness_table(model.mesh, u.reshape(-1, model.dpn)[:, :2])["thickness"],
         u,
-        result.last.state.cavities[0].pressure,
+        model.finalize().cavity_states(result.last.state)[0].pressure,
     )
 
 
@@ -135,7 +135,7 @@ def agree_with_differences(tree: dict, sens, built, pressure: bool = False) -> N
 def test_derivatives_carry_the_history_of_the_prony_series(control, formulation, element):
     tree = tube(control, formulation, element)
     sens, built = differentiate(tree)
-    assert np.abs(sens.solve.last.state.solid["h"]).max() > 0
+    assert np.abs(sens.model.solid_state(sens.solve.last.state)["h"]).max() > 0
     agree_with_differences(tree, sens, built, pressure=control == "volume")
     # the history matters: held at its base value, or without the series, the derivative is off
     scale = np.abs(sens.dthickness_ds).max()

@@ -99,7 +99,7 @@ def test_constants_as_tables_are_the_law_at_the_temperature(element, formulation
     assert np.abs(hot / plain - 1).max() < 1e-12
     model, top = bar(law, 1.0, 155.0, element=element, formulation=formulation)
     model.heat(140.0 + 20.0 * model.mesh.points[:, 1])
-    model.finalize()
+    model = model.finalize()
     _, graded = history(model, top, 1.0, 2)
     _, cold = history(*bar(MooneyRivlin(0.6, 0.1, 400.0), 1.0, element=element, formulation=formulation), 1.0, 2)
     assert plain[-1] < graded[-1] < cold[-1]
@@ -117,7 +117,7 @@ def test_the_tangent_with_tables_and_a_shift_matches_differences():
     )
     model, _ = bar(Viscoelastic(law, PRONY), 0.1, 150.0, WLF(17.44, 51.6, 150.0), "q8", "mixed")
     model.heat(140.0 + 20.0 * model.mesh.points[:, 1], WLF(17.44, 51.6, 150.0))
-    model.finalize()
+    model = model.finalize()
     res = solve(model, LoadControl(0.05, 2), CUTS)
     held = res.last.state
     u_f = res.last.u_f + 1e-3 * np.random.default_rng(3).standard_normal(model.n_free)

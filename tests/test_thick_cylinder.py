@@ -58,7 +58,7 @@ def cylinder(element: str, nr: int, kappa: float, p_ref: float = 1.0, formulatio
     model.fix(select_nodes(mesh, {"z": 0.0}), ["uz"])
     model.fix(select_nodes(mesh, {"z": H}), ["uz"])
     model.pressure(select_edges(mesh, {"r": A}), p_ref)
-    model.finalize()
+    model = model.finalize()
     return mesh, model
 
 

@@ -27,7 +27,7 @@ def bar_forces(element: str, formulation: str, steps: int, rate: float, duration
     model.fix(select_nodes(mesh, {"r": 0.0}), ["ur"])
     for node, z in enumerate(mesh.points[:, 1]):
         model.prescribe([node], ["uz"], rate * z)
-    model.finalize()
+    model = model.finalize()
     top = model.dof(select_nodes(mesh, {"z": 1.0}), "uz")
     res = solve(model, LoadControl(duration, steps), NewtonOptions(tolerance=1e-11))
     assert res.status == "finished" and res.n_steps == steps, res.message
@@ -78,7 +78,7 @@ def sphere(load):
     model.fix(mesh.node_sets["start"], ["uz"])
     model.fix(mesh.node_sets["end"], ["ur"])
     cavity = load(model, mesh)
-    model.finalize()
+    model = model.finalize()
     return model, int(model.dof(mesh.fibres[0][-1], "ur")), cavity
 
 

@@ -307,14 +307,14 @@ def run_axiform(friction: bool, penalty: float, element: str, formulation: str |
     def record(step):
         t.append(step.lam)
         uz.append(step.u[centre])
-        fz.append(punch.report(step.state.contacts[0])["force_z"])
+        fz.append(punch.report(built.model.contact_states(step.state)[0])["force_z"])
 
     start = time.perf_counter()
     res = solve(built.model, built.control, built.options, on_step=record)
     wall = time.perf_counter() - start
     top = np.flatnonzero(np.abs(built.model.mesh.points[:, 1] - 0.3) < 1e-9)
     x = built.model.mesh.points[top] + res.last.u.reshape(-1, built.model.dpn)[top, :2]
-    rep = punch.report(res.last.state.contacts[0])
+    rep = punch.report(built.model.contact_states(res.last.state)[0])
     return {
         "t": np.array(t),
         "uz": np.array(uz),

@@ -108,7 +108,7 @@ def plate_model(element: str, nr: int, nz: int, kappa: float = KAPPA):
     model.fix(af.select_nodes(mesh, {"r": R}), ["ur", "uz", "rot"])
     model.fix(af.select_nodes(mesh, {"r": 0.0}), ["ur"])
     model.pressure(af.select_edges(mesh, {"z": 0.0}), 1.0)
-    model.finalize()
+    model = model.finalize()
     centre = int(model.dof(af.select_nodes(mesh, {"r": 0.0, "z": H})[0], "uz"))
     return model, centre
 
@@ -496,7 +496,7 @@ def cax4_diagnostics(workdir: Path) -> dict:
             model.fix(af.select_nodes(mesh, {"z": 0.0}), ["uz"])
             model.fix(af.select_nodes(mesh, {"z": length}), ["uz"])
             model.pressure(af.select_edges(mesh, {"r": a}), p)
-            model.finalize()
+            model = model.finalize()
             res = af.solve(model, af.LoadControl(1.0, 1))
             bore = af.select_nodes(mesh, {"r": a})
             u_ax = float(res.steps[-1].u[model.dof(bore, "ur")].mean())

@@ -22,7 +22,7 @@ folder unless given).  Measured per run: wall time and CPU time (time.process_ti
 threads) of the solve minus the time spent writing results, Newton iterations, steps (60
 nominal; more means cut-backs), and the split of the time between element assembly,
 contact, and the linear solver (SuperLU, axiform.solve.linsolve: factorization + solves), taken by
-wrapping Model.evaluate, ContactPair.evaluate and axiform.solve.newton.factorize_checked (the library is
+wrapping System.evaluate, ContactPair.evaluate and axiform.solve.newton.factorize_checked (the library is
 not changed).  Times are medians of --repeat runs (3; 1 for runs over 20 s and with --quick),
 all runs of a repeat done one after the other, round robin.
 
@@ -76,7 +76,7 @@ import axiform.solve.paths as _paths  # noqa: E402
 from axiform.case.schema import build, load  # noqa: E402
 from axiform.contact.pair import ContactPair  # noqa: E402
 from axiform.io.results import ResultsWriter  # noqa: E402
-from axiform.model.model import Model  # noqa: E402
+from axiform.model.system import System  # noqa: E402
 from axiform.solve.linsolve import SingularTangentError  # noqa: E402
 from axiform.solve.solver import solve  # noqa: E402
 
@@ -111,7 +111,7 @@ class Timers:
 
 
 TIMERS = Timers()
-_orig_eval, _orig_contact, _orig_fact = Model.evaluate, ContactPair.evaluate, solver_mod.factorize_checked
+_orig_eval, _orig_contact, _orig_fact = System.evaluate, ContactPair.evaluate, solver_mod.factorize_checked
 
 
 def _evaluate(self, *a, **k):
@@ -130,7 +130,7 @@ def _factorize(K):
     return TIMERS.wrap("linear", solve)
 
 
-Model.evaluate = _evaluate
+System.evaluate = _evaluate
 ContactPair.evaluate = _contact
 for _module in (solver_mod, _paths, _arc):  # each imports factorize_checked by name
     _module.factorize_checked = _factorize
@@ -416,7 +416,7 @@ def report(summary, symmetric, runs, ref_key, repeat, total, args, runs_dir):
         "## Cost (library as it is)",
         "",
         "wall / CPU: the solve (CPU = process time, all threads).  Split of the wall time: "
-        "assembly (Model.evaluate without contact), contact (ContactPair.evaluate: local search "
+        "assembly (System.evaluate without contact), contact (ContactPair.evaluate: local search "
         "and law), linear (axiform.solve.linsolve: SuperLU factorization + solves).  Steps: 60 nominal, "
         "more means cut-backs.  CPU / Q8: against Q8 on the same mesh (same elements) or on the "
         "mesh whose dof count was matched."

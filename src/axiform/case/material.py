@@ -8,7 +8,8 @@ given: the law's mu then stands for E / (2 (1 + nu)).  Every number must be fini
 range; an error names the key (material.KEY) or, for a missing or cross-key problem, the table.
 A constant other than Ogden's lists may be a table of the temperature [[T, value], ...]
 (T increasing, every value in range; piecewise linear, constant outside), which needs the
-case's [temperature].
+case's [temperature].  `density` (> 0, mass per unit reference volume) is the material's own,
+for its weight ([gravity]) and its heat capacity ([thermal] density defaults to it).
 """
 
 from __future__ import annotations
@@ -126,6 +127,7 @@ class MaterialSpec(BaseModel):
     E: Tabled = None
     nu: Tabled = None
     viscoelastic: ViscoelasticSpec | None = None
+    density: Annotated[float, Field(gt=0)] | None = None  # mass per unit reference volume ([gravity], [thermal])
 
     @field_validator(*_RANGE, mode="before")
     @classmethod

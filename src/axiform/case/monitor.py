@@ -14,7 +14,7 @@ from ..fem.cavity import Cavity
 from ..fem.mesh import Mesh
 from ..fem.selectors import select_nodes
 from ..io.columns import HISTORY_COLUMNS
-from ..model.model import Model
+from ..model.system import System
 from .base import CaseError, DofName, Selector, Strict, one_node
 
 # characters a monitor name may not hold (besides the unprintable ones): the CSV separators and quotes
@@ -94,51 +94,49 @@ class Monitor:
     pair: ContactPair | None = None
     quantity: str = ""
     cavity: Cavity | None = None
-    index: int = 0  # of the pair or cavity in the model (the state's order); the node of a temperature
+    index: int = 0  # the place of the pair's or cavity's term (ModelState.terms); the node of a temperature
 
     def value(self, step) -> float:
         """The monitored scalar at a converged step (solve.solver.Step), read off its
         displacements, reactions or committed state."""
         if self.cavity is not None:
-            held = step.state.cavities[self.index]
+            held = step.state.terms[self.index]
             return float(held.pressure if self.quantity == "pressure" else held.volume)
         if self.quantity == "temperature":
             return float(step.state.temperature[self.index])
         if self.pair is not None:
-            return float(self.pair.report(step.state.contacts[self.index])[_CONTACT_QUANTITY[self.quantity]])
+            return float(self.pair.report(step.state.terms[self.index])[_CONTACT_QUANTITY[self.quantity]])
         if self.reaction:
             return float(step.r_full[self.dofs].sum())
         return float(step.u[self.dofs].sum())
 
 
 def build_monitors(
-    model: Model,
+    model: System,
     mesh: Mesh,
     specs: list[MonitorSpec],
     cavities: dict[str, Cavity],
-    pairs: list[ContactPair],
     element: str,
 ) -> list[Monitor]:
-    """The monitors of the [[monitor]] tables, over the case's cavities (by name), contact pairs
-    (in [[contact]] order) and element (named in the error for a rotation it lacks)."""
+    """The monitors of the [[monitor]] tables of a finalized model, over the case's cavities
+    (by name), contact pairs (in [[contact]] order: the model's) and element (named in the
+    error for a rotation it lacks)."""
     monitors = []
     for i, m in enumerate(specs):
         if m.cavity is not None:
             if m.cavity not in cavities:
                 raise CaseError(f"monitor[{i}].cavity: no [[cavity]] is named '{m.cavity}'")
             cavity = cavities[m.cavity]
+            slot = model.cavity_slots[model.cavities.index(cavity)]
             assert m.quantity is not None, "a cavity monitor has a quantity (_one)"
-            monitors.append(Monitor(m.name, cavity=cavity, quantity=m.quantity, index=model.cavities.index(cavity)))
+            monitors.append(Monitor(m.name, cavity=cavity, quantity=m.quantity, index=slot))
             continue
         if m.contact is not None:
-            if m.contact >= len(pairs):
-                raise CaseError(f"monitor[{i}].contact: there are {len(pairs)} [[contact]] tables (from 0)")
+            if m.contact >= len(model.contacts):
+                raise CaseError(f"monitor[{i}].contact: there are {len(model.contacts)} [[contact]] tables (from 0)")
             assert m.quantity is not None, "a contact monitor has a quantity (_one)"
-            monitors.append(
-                Monitor(
-                    m.name, pair=pairs[m.contact], quantity=m.quantity, index=model.contacts.index(pairs[m.contact])
-                )
-            )
+            pair, slot = model.contacts[m.contact], model.contact_slots[m.contact]
+            monitors.append(Monitor(m.name, pair=pair, quantity=m.quantity, index=slot))
             continue
         if m.quantity == "temperature":
             if model.temperature is None:

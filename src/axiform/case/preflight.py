@@ -187,10 +187,10 @@ def _step_increment(curve, t_end: float, steps: int) -> float:
     return float(np.abs(np.diff(f)).max())
 
 
-def _contact_free(model):
-    """The model without its contact pairs (the reference tangent of the body and its loads)."""
-    copy = dataclasses.replace(model, contacts=[])
-    return copy.finalize()
+def _contact_free(builder):
+    """The system of the model without its contact pairs (the reference tangent of the body
+    and its loads), from the model as built (model.model.Model)."""
+    return dataclasses.replace(builder, contacts=[]).finalize()
 
 
 def _gradients(model, u_full: np.ndarray) -> tuple[float, float]:
@@ -204,11 +204,11 @@ def _gradients(model, u_full: np.ndarray) -> tuple[float, float]:
     return float(np.abs(g).max()), float(det.min())
 
 
-def _reference_tangent(model):
+def _reference_tangent(builder):
     """The contact-free copy of the model, its evaluation at rest (u = 0, t = 0) and the
     factorization of its tangent; None where there is none (held by its moulds alone)."""
     try:
-        body = _contact_free(model)
+        body = _contact_free(builder)
         ev = body.evaluate(np.zeros(body.n_free), 0.0)
         if not np.all(np.isfinite(ev.K.data)):
             return None
@@ -252,7 +252,7 @@ def _driven_step(built: Built, reference) -> list[str]:
 def inverting_loads(built: Built) -> list[str]:
     """Loads that invert elements within one nominal step, by a linear estimate (under
     displacement control: the driven dof's step)."""
-    reference = _reference_tangent(built.model)
+    reference = _reference_tangent(built.builder)
     if reference is None:
         return []  # held by its moulds alone: no reference tangent without them
     if isinstance(built.control, DisplacementControl):

@@ -26,6 +26,7 @@ from ..fem.selectors import SelectorError
 from ..io.text import MAX_CASE_BYTES, FileTooLarge, read_text
 from ..model.guards import boundary_crossing, free_to_slide
 from ..model.model import Model
+from ..model.system import System
 from ..post.thickness import default_wall
 from ..solve.solver import ArcLengthControl, DisplacementControl, LoadControl, NewtonOptions
 from .base import CaseError, CurveKnots, CurveMixin, DofName, PositiveFloat, Selector, Strict
@@ -42,6 +43,7 @@ from .contact import (
     contact_pair,
     youngs_modulus,
 )
+from .gravity import GravitySpec, build_gravity
 from .loads import FixSpec, PointLoadSpec, PressureSpec, apply_loads, prescribe_fixes
 from .material import KEYS as LAW_KEYS
 from .material import MaterialSpec
@@ -118,6 +120,7 @@ class Case(Strict):
     temperature: TemperatureSpec | None = None
     thermal: ThermalSpec | None = None
     convection: list[ConvectionSpec] = []
+    gravity: GravitySpec | None = None
 
 
 # the names pydantic gives the members of a union in an error's location: not keys
@@ -308,13 +311,27 @@ def read(path: str | Path, overrides: list[str] = ()) -> dict[str, Any]:
 
 @dataclass
 class Built:
-    """What a case turns into: the model, the path-following control, Newton options, monitors."""
+    """What a case turns into: the finalized model (model.system.System), the path-following
+    control, Newton options, monitors, and the model as built (`builder`, model.model.Model:
+    for a variant of it, e.g. without its contact pairs)."""
 
     case: Case
-    model: Model
+    model: System
     control: LoadControl | DisplacementControl | ArcLengthControl
     options: NewtonOptions
     monitors: list[Monitor]
+    builder: Model
+
+
+def _loaded(case: Case) -> bool:
+    """Whether something loads the case: a value of a [[pressure]], [[point_load]] or [[fix]],
+    a moving mould, a loaded cavity, heat flowing in or out, the body's weight."""
+    moving = any(c.motion.ur or c.motion.uz for c in case.contact)
+    gas = any(c.control != "pressure" or c.pressure for c in case.cavity)
+    loads = [*case.pressure, *case.point_load, *case.fix]
+    heated = case.thermal is not None and bool(case.convection or any(c.conductance for c in case.contact))
+    weight = case.gravity is not None and case.gravity.g != 0.0
+    return any(item.value for item in loads) or moving or gas or heated or weight
 
 
 def build(case: Case, base: str | Path = ".") -> Built:
@@ -357,14 +374,10 @@ def build(case: Case, base: str | Path = ".") -> Built:
         pairs = [contact_pair(mesh, model, c, base, f"contact[{i}]") for i, c in enumerate(case.contact)]
         for pair in pairs:
             model.contact(pair)
-        build_conduction(model, mesh, case.thermal, case.convection, case.contact)
-        monitors = build_monitors(model, mesh, case.monitor, cavities, pairs, case.mesh.element)
+        build_conduction(model, mesh, case.thermal, case.convection, case.contact, case.material.density)
+        build_gravity(model, mesh, case.gravity, case.material.density)
         control = build_control(model, mesh, case.solver)
-        moving = any(c.motion.ur or c.motion.uz for c in case.contact)
-        gas = any(c.control != "pressure" or c.pressure for c in case.cavity)
-        loads = [*case.pressure, *case.point_load, *case.fix]
-        heated = case.thermal is not None and (case.convection or any(c.conductance for c in case.contact))
-        if not any(item.value for item in loads) and not moving and not gas and not heated:
+        if not _loaded(case):
             raise CaseError(
                 "pressure: nothing loads the model: every [[pressure]], [[point_load]] and [[fix]] "
                 "value is zero (or absent), no [[contact]] surface moves and no [[cavity]] is loaded"
@@ -383,11 +396,15 @@ def build(case: Case, base: str | Path = ".") -> Built:
         loaded = model.pressures + getattr(model, "cavities", [])
         mesh.set_wall(case.mesh.wall or default_wall(mesh.points, [p.nodes for p in loaded]))
     try:
-        model.finalize()
+        system = model.finalize()
     except ValueError as exc:  # a tied fibre rotation prescribed twice
         raise CaseError(f"fix: {exc}") from None
+    try:
+        monitors = build_monitors(system, mesh, case.monitor, cavities, case.mesh.element)
+    except SelectorError as exc:
+        raise CaseError(str(exc)) from None
     s = case.solver
     options = NewtonOptions(
         tolerance=s.tolerance, max_iterations=s.max_iterations, min_step=s.min_step, growth=s.growth
     )
-    return Built(case, model, control, options, monitors)
+    return Built(case, system, control, options, monitors, model)

@@ -3,7 +3,7 @@
 
     [thermal]
     conductivity = 0.2            # k (a number > 0, or a table [[T, value], ...])
-    density = 1.0e-9              # rho, of the reference configuration
+    density = 1.0e-9              # rho, of the reference configuration (absent: [material] density)
     specific_heat = 1.9e9         # c (k / (rho c) is the diffusivity)
     [[convection]]
     on = { set = "outer" }        # boundary edges (as [[pressure]] on)
@@ -66,7 +66,7 @@ class ThermalSpec(Strict):
     """The [thermal] table (see the module docstring)."""
 
     conductivity: Any
-    density: Any
+    density: Any = None  # absent: the material's ([material] density)
     specific_heat: Any
 
     @field_validator("conductivity", "density", "specific_heat", mode="before")
@@ -89,10 +89,16 @@ class ConvectionSpec(CurveMixin):
 
 
 def build_conduction(
-    model: Model, mesh: Mesh, thermal: ThermalSpec | None, convection: list[ConvectionSpec], contacts: list
+    model: Model,
+    mesh: Mesh,
+    thermal: ThermalSpec | None,
+    convection: list[ConvectionSpec],
+    contacts: list,
+    density: float | None = None,
 ) -> None:
     """Give the model its heat conduction ([thermal], the films, the contact conductances of
-    the [[contact]] tables `contacts`); CaseError naming the key where one is missing."""
+    the [[contact]] tables `contacts`; `density`: the material's, for a [thermal] without
+    one); CaseError naming the key where one is missing."""
     if thermal is None:
         if convection:
             raise CaseError("convection: a film needs the case's [thermal] (conductivity, density, specific_heat)")
@@ -102,6 +108,9 @@ def build_conduction(
         return
     if model.temperature is None:
         raise CaseError("thermal: heat conduction needs the initial temperature: add [temperature] initial = ...")
+    rho = thermal.density if thermal.density is not None else density
+    if rho is None:
+        raise CaseError("thermal.density: missing (give it here, or the material's: [material] density)")
     films = [
         Film(select_edges(mesh, c.on.model_dump(), f"convection[{i}].on"), c.h, c.ambient_of_time())
         for i, c in enumerate(convection)
@@ -118,7 +127,5 @@ def build_conduction(
                 )
             mould = _scaled(c.temperature, c.temperature_curve)
             conductances.append(Conductance(c.conductance, mould, contact_conductance(k, c.conductance_gap)))
-    conductivity, density, heat = (
-        _as_property(getattr(thermal, key)) for key in ("conductivity", "density", "specific_heat")
-    )
-    model.conduct(Conduction(mesh, conductivity, density, heat, films, conductances))
+    conductivity, heat = _as_property(thermal.conductivity), _as_property(thermal.specific_heat)
+    model.conduct(Conduction(mesh, conductivity, _as_property(rho), heat, films, conductances))

@@ -12,7 +12,6 @@ import numpy as np
 from ..fem.mesh import Mesh
 from .guard import guard_forces
 from .law import Law, Traction, damping, traction, updated_multipliers
-from .projection import Projection
 from .report import pair_report
 from .rings import edge_heights, pole_rows, ring_areas, slave_edges
 from .state import ContactSeen, ContactState, ContactTrial
@@ -181,9 +180,6 @@ class ContactPair:
         self.search = search
         self.stabilization = stabilization  # None: decided by the model (Model.finalize)
         self.name: str | None = None  # a label for plots and summary.json (case file: [[contact]] name)
-        # the nodes' projection found by `guard` with the mid-points' (one pass over the pieces),
-        # for the `evaluate` of the same u and state that follows it: (x, x_prev, projection)
-        self._projected: tuple[np.ndarray, np.ndarray, Projection] | None = None
 
     @property
     def law(self) -> Law:
@@ -220,19 +216,17 @@ class ContactPair:
         state: ContactState,
         predicting: bool = False,
         guard_force: np.ndarray | None = None,
+        projection=None,
     ) -> ContactTrial:
         """The pair at displacements u (n_nodes, 2) and process time lam, from the committed
         history `state`: forces on the slave nodes, their derivatives (`ContactTrial`) and the
         trial state.  predicting: the tangent of a step's first iteration (nodes resting on
         the surface get the penalty in it, see the class).  guard_force: the mid-point guards'
-        forces (m, 2) of the same state (`guard`), for the report."""
+        forces (m, 2) of the same state (`guard`), for the report; projection: the nodes'
+        projection that `guard` found at the same u and state (None: projected here)."""
         xa = self.X + u[self.nodes]
         x = xa - self.surface.offset(lam)
-        held, self._projected = self._projected, None
-        if held is not None and held[1] is state.x_prev and np.array_equal(held[0], x):
-            proj = held[2]  # found by `guard` at these very positions
-        else:
-            proj = self.surface.local(x, state.x_prev, self.depth, self.search)
+        proj = projection if projection is not None else self.surface.local(x, state.x_prev, self.depth, self.search)
         if guard_force is None:
             guard_force = np.zeros((len(self.edges) if self.guarded else 1, 2))
         if self._idle(proj, state, predicting):
@@ -335,7 +329,8 @@ class ContactPair:
         Returns per edge over `guard_dofs` the force on the body F (m, 2 dpn), its derivative
         K = dF/du (m, 2 dpn, 2 dpn), the rate K_x velocity (m, 2 dpn) of a surface moving
         with velocity (2,) (the force depends on x_m - offset(lam)), and the force on each
-        mid-point (m, 2); F, K and the rate are None where no guard acts."""
+        mid-point (m, 2); F, K and the rate are None where no guard acts; and the slave
+        nodes' projection, found in the same pass (for `evaluate` at the same u and state)."""
         e = self.edges
         dpn = u.shape[1]
         un = u[self.nodes]
@@ -349,10 +344,9 @@ class ContactPair:
         nodes, proj = self.surface.local_sets(
             [(x, state.x_prev, self.depth), (mid, mid_prev, self.depth + self.guard_allowance.max())], self.search
         )
-        self._projected = (x, state.x_prev, nodes)
-        return guard_forces(
+        return *guard_forces(
             proj, self.guard_allowance, self.guard_kn, self.guard_weight, self.smoothing, velocity, self.guard_arm, dpn
-        )
+        ), nodes
 
     def rate(self, trial: ContactTrial, velocity: np.ndarray) -> np.ndarray:
         """d f / d lambda at fixed u of the evaluation `trial` divided by -1, per slave node

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..case.schema import MAX_MAGNITUDE, MIN_MAGNITUDE, Built, CaseError, build, parse, read
 from ..io.text import read_text
-from ..model.model import Model
+from ..model.system import System
 from ..solve.solver import LoadControl
 
 BOUNDS = (0.2, 5.0)  # design bounds, times the initial thickness
@@ -81,7 +81,7 @@ class CaseDesign(ABC):
     def case_tree(self, values: np.ndarray) -> dict[str, Any]:
         """The case tree with the design's values in it."""
 
-    def model(self, values: np.ndarray) -> Model:
+    def model(self, values: np.ndarray) -> System:
         """The finalized model of the case with the design's values."""
         return build(parse(self.case_tree(values)), self.base).model
 

@@ -5,7 +5,7 @@ At each converged step n the residual R_n(u_n; s, h_{n-1}) = 0 holds, h_{n-1} th
 committed at the step before (contact stick points, sticky nodes and where they froze,
 positions for the crossing test; the h_i of a viscoelastic law's Prony series and the
 isochoric stress they were updated with, per quadrature point; the nodes' temperature where
-heat conduction advances it after each step, Model.settle), and h_n = H(u_n; s, h_{n-1}).
+heat conduction advances it after each step, System.settle), and h_n = H(u_n; s, h_{n-1}).
 Differentiating,
 
     K_n du_n/ds = -( dR_n/ds |_u  +  dR_n/dh dh_{n-1}/ds )
@@ -39,8 +39,9 @@ import numpy as np
 
 from ..fem.constraints import DofMap
 from ..model.model import Model
+from ..model.system import System
 from ..post.thickness import thickness_table
-from ..solve.linsolve import factorize
+from ..solve.linsolve import LinearSolver, factorize
 from ..solve.solver import LoadControl, NewtonOptions, SolveResult, Step, solve
 
 RELATIVE_STEP = 1e-6  # the difference step of the semi-analytic residual, relative to |s_k|
@@ -65,7 +66,7 @@ class Sensitivity:
     meshes; None otherwise) and dthickness_ds its derivative (stations, m)."""
 
     solve: SolveResult
-    model: Model
+    model: System
     design: np.ndarray
     dx_ds: np.ndarray
     du_ds: list[np.ndarray] = field(default_factory=list)
@@ -83,7 +84,7 @@ class Sensitivity:
         return self.dx_ds + du
 
 
-def _same_numbering(base: Model, other: Model, k: int) -> None:
+def _same_numbering(base: System, other: System, k: int) -> None:
     if (
         other.mesh.n_nodes != base.mesh.n_nodes
         or other.n_free != base.n_free
@@ -99,22 +100,22 @@ def _same_numbering(base: Model, other: Model, k: int) -> None:
         )
 
 
-def _dofmap(model: Model) -> DofMap:
+def _dofmap(model: System) -> DofMap:
     """The dof numbering of a finalized model."""
     if model.dofmap is None:
         raise ValueError("the model is not finalized: it has no dof numbering")
     return model.dofmap
 
 
-def has_history(model: Model) -> bool:
+def has_history(model: System) -> bool:
     """Whether the residual of a step depends on the history committed before it: contact
     pairs, a law with memory (materials.viscoelastic), or a temperature that heat conduction
-    advances step by step (Model.settle)."""
-    return bool(model.contacts) or bool(model.initial_state().solid) or model.conduction is not None
+    advances step by step (System.settle)."""
+    return bool(model.contacts) or bool(model.solid_state(model.initial_state())) or model.conduction is not None
 
 
 def sensitivity(
-    build: Callable[[np.ndarray], Model],
+    build: Callable[[np.ndarray], Model | System],
     design: np.ndarray,
     control: LoadControl,
     options: NewtonOptions | None = None,
@@ -125,7 +126,7 @@ def sensitivity(
     """Solve the model build(design) under load control and differentiate every converged
     state with respect to the design variables (module docstring).
 
-    build: design s (m,) -> an unsolved Model (finalized or not) with the same mesh topology,
+    build: design s (m,) -> an unsolved Model, or its System (Model.finalize), with the same mesh topology,
     supports and loads for every s, only the reference geometry (or constants) changed.
     on_step(step, du_ds): called after each converged step with dU/ds (n_full, m).
     Returns a Sensitivity; its dthickness_ds is d(final thickness)/ds (stations, m)."""
@@ -136,8 +137,7 @@ def sensitivity(
     h = relative_step * np.where(s != 0, np.abs(s), 1.0)
 
     def built(x):
-        model = build(x)
-        return model.finalize() if model.dofmap is None else model
+        return build(x).finalize()  # a Model finalized, a System as it is
 
     model = built(s)
     shadows = []
@@ -155,6 +155,7 @@ def sensitivity(
     dm = model.dofmap
     out = Sensitivity(SolveResult("running"), model, s, dx_ds)
 
+    linear = LinearSolver()  # the analysis of the tangent's pattern, kept from step to step
     lag_state = model.initial_state()  # the history h_{n-1}: the tangent K_n is taken with it
     shadow_states = [[plus.initial_state(), minus.initial_state()] for plus, minus in shadows]
 
@@ -168,7 +169,7 @@ def sensitivity(
             dR[:, k] = (
                 plus.evaluate(u_f, lam, s_plus, tangent=False).r - minus.evaluate(u_f, lam, s_minus, tangent=False).r
             ) / (2 * h[k])
-        du_f = -np.asarray(factorize(ev.K)(dR)).reshape(model.n_free, m)
+        du_f = -np.asarray(factorize(ev.K, linear)(dR)).reshape(model.n_free, m)
         if history:
             for k, (pair, states) in enumerate(zip(shadows, shadow_states, strict=False)):
                 for j, (shadow, sign) in enumerate(zip(pair, (1.0, -1.0), strict=False)):
@@ -188,13 +189,13 @@ def sensitivity(
     last = out.solve.last
     if last is not None:
         u2 = last.u.reshape(-1, model.dpn)[:, :2]
-        out.thickness = thickness_table(model.mesh, u2, () if last.state is None else last.state.contacts)
+        out.thickness = thickness_table(model.mesh, u2, model.contact_states(last.state))
         if out.thickness is not None:
             out.dthickness_ds = thickness_derivative(model, u2, out.dx_final_ds())
     return out
 
 
-def thickness_derivative(model: Model, u: np.ndarray, dx: np.ndarray) -> np.ndarray:
+def thickness_derivative(model: System, u: np.ndarray, dx: np.ndarray) -> np.ndarray:
     """d thickness / ds (stations, m) of the wall at the nodal displacements u (n_nodes, 2),
     the current positions moving by dx (n_nodes, 2, m) per unit of each design variable:
     central differences of the measured thickness along each dx (the thickness is a smooth

@@ -306,7 +306,7 @@ class ResultsWriter:
         if self.model.cavities:
             self.summary["cavities"] = {
                 c.name: {"pressure": float(held.pressure), "volume": float(held.volume), "initial_volume": float(c.V0)}
-                for c, held in zip(self.model.cavities, step.state.cavities, strict=False)
+                for c, held in zip(self.model.cavities, self.model.cavity_states(step.state), strict=True)
             }
         if step.number % self.every == 0:
             self._write_fields(step)
@@ -328,7 +328,10 @@ class ResultsWriter:
         are written by the next `_flush`."""
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
         x = self.model.mesh.points + u
-        reports = [pair.report(held) for pair, held in zip(self.model.contacts, step.state.contacts, strict=False)]
+        reports = [
+            pair.report(held)
+            for pair, held in zip(self.model.contacts, self.model.contact_states(step.state), strict=True)
+        ]
         self._contact = (reports, x, float(step.lam))
         self.record.contact_step(
             step, reports, x, thickness_table(self.model.mesh, u) if self.model.mesh.fibres is not None else None
@@ -358,7 +361,7 @@ class ResultsWriter:
         self._last_written = step.number
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
         T = step.state.temperature
-        self._thickness = thickness_table(mesh, u, step.state.contacts, T)
+        self._thickness = thickness_table(mesh, u, self.model.contact_states(step.state), T)
         if self._thickness is not None:
             self.summary["thickness"] = thickness_summary(self._thickness)
         if T is not None:
@@ -396,7 +399,7 @@ class ResultsWriter:
     def _write_thickness_step(self, step):
         """thickness/step_NNNN.csv: the thickness table of one step."""
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
-        table = thickness_table(self.model.mesh, u, step.state.contacts, step.state.temperature)
+        table = thickness_table(self.model.mesh, u, self.model.contact_states(step.state), step.state.temperature)
         if table is not None:
             write_thickness_csv(self.out / "thickness" / f"step_{step.number:04d}.csv", table)
 

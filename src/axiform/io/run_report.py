@@ -116,7 +116,7 @@ class RunRecord:
         """{work, strain_energy, ratio} of the last step where a pair is stabilized, else None."""
         if not any(getattr(p, "stabilization", 0.0) for p in self.model.contacts):
             return None
-        work = float(sum(held.damping_work for held in step.state.contacts))
+        work = float(sum(held.damping_work for held in self.model.contact_states(step.state)))
         energy = float(self.model.strain_energy(step.u))
         return {"work": work, "strain_energy": energy, "ratio": work / energy if energy > 0 else float("inf")}
 
@@ -132,7 +132,7 @@ class RunRecord:
         of the wall, slave nodes that passed through the mould (contact.checks), stabilization
         work above STABILIZATION_LIMIT of the strain energy."""
         lines = []
-        for k, (rec, held) in enumerate(zip(self.pairs, step.state.contacts, strict=False)):
+        for k, (rec, held) in enumerate(zip(self.pairs, self.model.contact_states(step.state), strict=False)):
             name = pair_label(k, rec.name)
             touched = rec.touched or bool(np.isfinite(np.asarray(held.first_contact, float)).any())
             if not touched:

@@ -7,13 +7,17 @@ a CaseError naming the key.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import scipy.sparse as sp
 
 from ..fem.graphs import connected_components
 
 
-def _crossing_pairs(a: np.ndarray, b: np.ndarray, skip: np.ndarray, block: int = 2048) -> tuple[int, int] | None:
+def _crossing_pairs(
+    a: np.ndarray, b: np.ndarray, skip: Callable[[np.ndarray, np.ndarray], np.ndarray], block: int = 2048
+) -> tuple[int, int] | None:
     """The first pair (i, j), i < j, of segments a[i]-b[i], a[j]-b[j] ((n, 2) arrays) that
     cross, touch or overlap, leaving out the pairs skip(i, j) marks (neighbours that share an
     end); skip is a function of two index arrays returning a boolean array.  Work in blocks
@@ -96,43 +100,22 @@ def free_to_slide(n_nodes: int, cells: np.ndarray, held_uz: np.ndarray, touching
     return [int(b) for b in used if not held[b]]
 
 
-_MODES: list = []  # [(dofmap, modes)] of the last model asked about
-
-
-def rigid_translations(model) -> sp.csc_matrix:
-    """Unit translations along z of the bodies that no prescribed uz holds, as columns over
-    the free equations, (n_free, k): zero-energy modes of the tangent unless contact (or a
-    tie) resists them.  Cached for the model's current numbering."""
-    dm = model.dofmap
-    if _MODES and _MODES[0][0] is dm:
-        return _MODES[0][1]
-    body = bodies(model.mesh.n_nodes, model.mesh.cells)
-    uz = np.arange(model.mesh.n_nodes) * model.dpn + 1
-    eq = dm.eq[uz]
-    held = np.zeros(body.max() + 1, dtype=bool)
-    held[body[eq >= dm.nf]] = True
-    free = (eq < dm.nf) & ~held[body]
-    _, col = np.unique(body[free], return_inverse=True)
-    modes = sp.csc_matrix((np.ones(free.sum()), (eq[free], col)), shape=(dm.nf, col.max(initial=-1) + 1))
-    _MODES[:] = [(dm, modes)]
-    return modes
-
-
-def evaluation_fault(model, r_full: np.ndarray, K: sp.spmatrix | None) -> str | None:
+def evaluation_fault(system, r_full: np.ndarray, K: sp.spmatrix | None) -> str | None:
     """What makes a state unusable, with its place: a residual (r_full, (n_full,)) that is not
     finite (node, dof, an element holding the node), or a tangent K (n_free, n_free) left
-    without stiffness against a rigid translation along z (a mechanism)."""
+    without stiffness against a rigid translation along z (a mechanism; the system's
+    rigid_modes)."""
     bad = np.flatnonzero(~np.isfinite(r_full))
     if bad.size:
-        node, k = divmod(int(bad[0]), model.dpn)
-        element = int(np.argmax((model.mesh.cells == node).any(axis=1)))
+        node, k = divmod(int(bad[0]), system.dpn)
+        element = int(np.argmax((system.mesh.cells == node).any(axis=1)))
         return (
             f"the residual is not finite at node {node} ({('ur', 'uz', 'rot')[k]}, element {element}): "
             "an overflow of the material law or a collapsed element"
         )
     if K is None or not K.nnz:
         return None
-    modes = rigid_translations(model)
+    modes = system.rigid_modes
     if not modes.shape[1]:
         return None
     # ||K m||_1 against ||K||_1 ||m||_1: zero to round-off for a free mode, about 1 / (nodes of

@@ -1,19 +1,19 @@
-"""The state of a model between steps: the history of every term that has one, as of one
-converged step (contact pairs, cavities; later the materials' quadrature points).
+"""The state of a model between steps: the history of every term of the residual, as of one
+converged step (contact pairs, cavities, a material's quadrature points), and the nodes'
+temperature.
 
-States are immutable values: a term's `evaluate(u, t, state)` returns the trial state it
-would have if its evaluation were accepted; the solver holds the committed state and
-commits the trial of the accepted evaluation only, so an evaluation made after a run, or
-by a failed attempt, changes nothing that is written or reported.
+States are immutable values: a term's `evaluate(u, t, state, context)` returns the trial
+state it would have if its evaluation were accepted; the solver holds the committed state and
+commits the trial of the accepted evaluation only, so an evaluation made after a run, or by a
+failed attempt, changes nothing that is written or reported.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
-
-from ..contact.state import ContactState
 
 
 @dataclass(frozen=True)
@@ -23,29 +23,37 @@ class CavityState:
     pressure: float
     volume: float
 
+    def to_dict(self) -> dict[str, float]:
+        """The pressure and volume (a checkpoint)."""
+        return {"pressure": float(self.pressure), "volume": float(self.volume)}
+
+
+def saved(state: Any) -> Any:
+    """A term's state as plain numbers and arrays: None for a term without history, a copy of
+    the arrays of a history per quadrature point (a dict of arrays (e, q, ...)), else the
+    state's own `to_dict()`."""
+    if state is None:
+        return None
+    if hasattr(state, "to_dict"):
+        return state.to_dict()
+    return {k: np.array(v, copy=True) for k, v in state.items()}
+
 
 @dataclass(frozen=True)
 class ModelState:
-    """The committed (or trial) history of a model at process time t: one ContactState per
-    contact pair, one CavityState per cavity, in the model's order, and the solid's history
-    per quadrature point (`solid`: a dict of arrays (e, q, ...), empty for elastic laws,
-    which have none), and the nodes' temperature (n,) (None without one).  dt = t_trial -
+    """The committed (or trial) history of a model at process time t: one state per term of
+    the residual, in the system's order of its terms (`terms`; None for a term without
+    history; model.system.System reads a kind of them: contact_states, cavity_states,
+    solid_state), and the nodes' temperature (n_nodes,) (None without one).  dt = t_trial -
     t_committed is what a term integrates over."""
 
     t: float
-    contacts: tuple[ContactState, ...] = ()
-    cavities: tuple[CavityState, ...] = ()
-    solid: dict = field(default_factory=dict)
+    terms: tuple[Any, ...] = ()
     temperature: np.ndarray | None = None
 
     def to_dict(self) -> dict:
-        """Plain arrays and numbers (a checkpoint)."""
-        out = {
-            "t": float(self.t),
-            "contacts": [c.to_dict() for c in self.contacts],
-            "cavities": [{"pressure": c.pressure, "volume": c.volume} for c in self.cavities],
-            "solid": {k: np.array(v, copy=True) for k, v in self.solid.items()},
-        }
+        """Plain arrays and numbers (a checkpoint): t, one entry per term, the temperature."""
+        out: dict[str, Any] = {"t": float(self.t), "terms": [saved(s) for s in self.terms]}
         if self.temperature is not None:
             out["temperature"] = np.array(self.temperature, copy=True)
         return out

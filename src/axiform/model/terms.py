@@ -1,53 +1,24 @@
-"""The terms of the residual, each behind one call: `evaluate(u, t, state) -> Contribution`.
+"""The terms of the residual, each behind the protocol of model.protocol.Term: the body's
+internal forces (displacement or mixed form), the follower pressures, the point loads, each
+contact pair, each gas cavity (gravity: model.gravity).
 
-R(u, t) = f_int(u) - f_ext(u, t) - f_contact(u, t) - sum p g(u) is the sum of its terms'
-contributions: the solid (displacement or mixed form), the follower pressures, the point
-loads, each contact pair, each gas cavity.  A term keeps nothing between calls: it is
-handed its committed history `state` (None where it has none) and returns, with its part of
-R, of dR/dt and of the tangent dR/du, the `trial` state it would have if this evaluation
-were accepted.  The model sums the contributions (model.Model.evaluate); the solver commits
-the trial states of the accepted evaluation only.
-
-Arrays: u (n_full,) all dofs of the mesh, node by node; each term's tangent comes as element
-matrices, one array per block of dofs it declares (`blocks`: (m, k) dof tables whose sparse
-positions the model computes once).
+Arrays: u (n_full,) all dofs of the mesh, node by node.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from ..contact.pair import ContactPair
 from ..contact.state import ContactState
 from ..fem.cavity import Cavity
-from ..fem.curves import Curve
+from ..fem.curves import PROPORTIONAL, Curve
 from ..fem.loads import FollowerPressure
 from ..materials.viscoelastic import Memory
+from .protocol import Constraint, Contribution, EvaluationContext, assemble, stateless
 from .state import CavityState
-
-
-@dataclass
-class Contribution:
-    """One term at one state: its part r (n_full,) of the residual R, of dR/dt at fixed u
-    (n_full,) or None, of the tangent dR/du as element matrices K (one (m, k, k) array per
-    block of the term, or None for a block that adds nothing; empty when not asked), the applied external load it
-    holds (n_full,)
-    or None, the assembled magnitudes of its element forces (n_full,) or None (the scale
-    of the residual), and its trial state."""
-
-    r: np.ndarray
-    dr_dt: np.ndarray | None = None
-    K: tuple[np.ndarray, ...] = ()
-    load: np.ndarray | None = None
-    magnitude: np.ndarray | None = None
-    trial: object = None
-
-
-def assemble(dofs: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
-    """Element vectors values (m, k) summed into a full vector (n,) at dofs (m, k)."""
-    return np.bincount(dofs.ravel(), weights=values.ravel(), minlength=n)
 
 
 class SolidTerm:
@@ -60,6 +31,8 @@ class SolidTerm:
     at the temperatures of its start) the law's constants that are tables of T are taken at
     the points' T, and with a shift of the relaxation times (materials.temperature) each
     point's history advances by its reduced time dxi = dt / a_T(T)."""
+
+    border: tuple[tuple[np.ndarray, bool], ...] = ()
 
     def __init__(self, assembly, n_full: int, shift=None):
         self.assembly = assembly
@@ -82,15 +55,22 @@ class SolidTerm:
             return {}
         return prony.initial(self.assembly.dV.shape) | {"t": np.zeros(())}
 
-    def evaluate(
-        self,
-        u: np.ndarray,
-        t: float,
-        state: dict | None = None,
-        tangent: bool = True,
-        temperature: np.ndarray | None = None,
-    ) -> Contribution:
-        """state: the solid's history per point (or None); temperature: the nodes' T (n,) or None."""
+    def restore(self, saved: Any) -> dict:
+        """The history per point of a checkpoint, checked against this law's (the same arrays
+        and shapes)."""
+        start = self.initial_state()
+        solid = {k: np.asarray(v) for k, v in (saved or {}).items()}
+        if solid.keys() != start.keys() or any(v.shape != start[k].shape for k, v in solid.items()):
+            raise ValueError("the saved state has another history of the solid than this model's material")
+        return solid
+
+    def curves(self) -> tuple[Curve, ...]:
+        return ()
+
+    def evaluate(self, u: np.ndarray, t: float, state: dict | None, context: EvaluationContext) -> Contribution:
+        """state: the solid's history per point (empty or None for an elastic law); the
+        context's temperature: the nodes' T (n,) or None."""
+        tangent, temperature = context.tangent, context.temperature
         if tangent not in self._scratch:
             self._scratch[tangent] = self.assembly.buffers(tangent)
         key = None if temperature is None else temperature.tobytes()
@@ -112,7 +92,7 @@ class SolidTerm:
             trial=trial,
         )
 
-    def step_factors(self, dt: float, temperature_key: bytes | None) -> tuple[np.ndarray, ...]:
+    def step_factors(self, dt: float, temperature_key: bytes | None) -> Any:
         """The Prony factors of a step dt (each point's reduced time dt / a_T under a shift, at
         the temperature field of `temperature_key`, the memo's): computed once per step, then
         reused by the step's iterations."""
@@ -127,18 +107,31 @@ class SolidTerm:
 
 class PressureTerm:
     """A follower pressure value x f(t) on boundary edges (eq. 14): R -= f(t) f_p(u), with its
-    load stiffness; dR/dt = -f'(t) f_p(u)."""
+    load stiffness; dR/dt = -f'(t) f_p(u).  No history; nothing (an empty contribution)
+    where f(t) and f'(t) are zero."""
+
+    border: tuple[tuple[np.ndarray, bool], ...] = ()
 
     def __init__(self, pressure: FollowerPressure, n_full: int):
         self.pressure = pressure
         self.n_full = n_full
         self.blocks = (pressure.dofs,)
 
-    def evaluate(self, u: np.ndarray, t: float, state=None, tangent: bool = True) -> Contribution | None:
+    def initial_state(self) -> None:
+        return None
+
+    def restore(self, saved: Any) -> None:
+        stateless(saved, "a pressure")
+
+    def curves(self) -> tuple[Curve, ...]:
+        return (self.pressure.curve,)
+
+    def evaluate(self, u: np.ndarray, t: float, state: None, context: EvaluationContext) -> Contribution:
         curve = self.pressure.curve
         f, df = curve(t), curve.slope(t)
         if f == 0.0 and df == 0.0:
-            return None
+            return Contribution()
+        tangent = context.tangent
         fe, Ke = self.pressure.evaluate(u, tangent)
         fp = assemble(self.pressure.dofs, fe, self.n_full)
         load = f * fp
@@ -147,15 +140,25 @@ class PressureTerm:
 
 class PointLoadTerm:
     """Forces value x f(t) at dofs (the total force on each revolved ring), grouped by
-    curve: {curve: full vector of the values}."""
+    curve: {curve: full vector of the values (n_full,)}.  No history, no stiffness."""
 
-    blocks = ()
+    blocks: tuple[np.ndarray, ...] = ()
+    border: tuple[tuple[np.ndarray, bool], ...] = ()
 
     def __init__(self, by_curve: dict[Curve, np.ndarray], n_full: int):
         self.by_curve = by_curve
         self.n_full = n_full
 
-    def evaluate(self, u: np.ndarray, t: float, state=None, tangent: bool = True) -> Contribution:
+    def initial_state(self) -> None:
+        return None
+
+    def restore(self, saved: Any) -> None:
+        stateless(saved, "the point loads")
+
+    def curves(self) -> tuple[Curve, ...]:
+        return tuple(self.by_curve)
+
+    def evaluate(self, u: np.ndarray, t: float, state: None, context: EvaluationContext) -> Contribution:
         load = np.zeros(self.n_full)
         rate = np.zeros(self.n_full)
         for curve, values in self.by_curve.items():
@@ -168,30 +171,45 @@ class ContactTerm:
     """A contact pair (contact.pair.ContactPair): R -= f_c at the slave nodes (and at the
     nodes of the guarded edges), K -= df_c/du over three blocks (the slave nodes, the slave
     edges through the current ring areas, the guarded edges); a moving surface adds
-    dR/dt = (df_c/dx) velocity.  Its state is the pair's ContactState."""
+    dR/dt = (df_c/dx) velocity.  Its state is the pair's ContactState.  `pair`: the pair as
+    the system uses it (its stabilization decided, model.system.build_system)."""
+
+    border: tuple[tuple[np.ndarray, bool], ...] = ()
 
     def __init__(self, pair: ContactPair, dpn: int, n_full: int):
         self.pair = pair
         self.dpn = dpn
         self.n_full = n_full
         self.node_dofs = pair.dofs(dpn)  # (n, 2)
-        self.guard_dofs = pair.guard_dofs(dpn) if pair.guarded else None  # (m, 2 dpn)
+        self.guard_dofs = pair.guard_dofs(dpn)  # (m, 2 dpn), used where the pair is guarded
         self.blocks = (self.node_dofs, pair.edge_dofs(dpn)) + ((self.guard_dofs,) if pair.guarded else ())
 
-    def evaluate(
-        self, u: np.ndarray, t: float, state: ContactState, tangent: bool = True, predicting: bool = False
-    ) -> Contribution:
+    def initial_state(self) -> ContactState:
+        return self.pair.initial_state()
+
+    def restore(self, saved: Any) -> ContactState:
+        return self.pair.initial_state().from_dict(saved)
+
+    def curves(self) -> tuple[Curve, ...]:
+        return (getattr(self.pair.surface, "curve", PROPORTIONAL),)
+
+    def evaluate(self, u: np.ndarray, t: float, state: ContactState, context: EvaluationContext) -> Contribution:
+        """The slave nodes' forces; with guarded edges, the nodes are projected with the
+        mid-points in one pass (ContactPair.guard) and that projection handed to
+        ContactPair.evaluate."""
         pair = self.pair
+        tangent = context.tangent
         velocity = pair.surface.velocity(t)
         moving = bool(velocity.any())
         u_nodes = u.reshape(-1, self.dpn)
         n = self.n_full
         dr = None
-        fg, guard_force, guard_K = None, None, ()
+        fg, rate, guard_force, projection = None, None, None, None
+        guard_K: tuple[np.ndarray | None, ...] = ()
         if pair.guarded:  # the mid-points of straight edges (ContactPair.guard)
-            fg, Kg, rate, guard_force = pair.guard(u_nodes, t, velocity, state)
+            fg, Kg, rate, guard_force, projection = pair.guard(u_nodes, t, velocity, state)
             guard_K = (None if Kg is None else -Kg,)
-        trial = pair.evaluate(u_nodes[:, :2], t, state, predicting, guard_force)
+        trial = pair.evaluate(u_nodes[:, :2], t, state, context.predicting, guard_force, projection)
         # the slave nodes' dofs are distinct: their forces are placed, not summed
         r = np.zeros(n)
         r[self.node_dofs.ravel()] = -trial.f.ravel()
@@ -200,48 +218,41 @@ class ContactTerm:
             dr[self.node_dofs.ravel()] = pair.rate(trial, velocity).ravel()
         if fg is not None:  # edges share nodes: summed (np.bincount, not the slower np.add.at)
             r -= np.bincount(self.guard_dofs.ravel(), fg.ravel(), n)
-            if moving:
+            if moving and dr is not None and rate is not None:
                 dr += np.bincount(self.guard_dofs.ravel(), rate.ravel(), n)
         K = tuple(None if Ke is None else -Ke for Ke in (trial.K, trial.coupling)) + guard_K if tangent else ()
         return Contribution(r, dr, K, trial=trial.state)
-
-
-@dataclass
-class Constraint:
-    """The constraint row of a cavity whose pressure is an unknown: C(u, p, t) = 0 (volume
-    control: V - V(t); gas control: (p + ambient) V - content(t)), its rate dC/dt at fixed
-    u, the factor c_u of dC/du = c_u g, dC/dp, the scale C is measured against, and g = dV/du
-    (n_full,)."""
-
-    value: float
-    rate: float
-    c_u: float
-    c_p: float
-    scale: float
-    g: np.ndarray
 
 
 class CavityTerm:
     """A gas cavity (fem.cavity.Cavity) at gauge pressure p: R -= p g, g = dV/du, and
     K -= p dg/du.  Under pressure control p = value x f(t) (and dR/dt = -p'(t) g); under
     volume or gas control p is an unknown of the system, handed in by the model, and the
-    term adds its constraint row (`constraint`).  Its state is the CavityState (p, V)."""
+    term adds its constraint row (Contribution.constraint): p is then its one unknown
+    (`border`), handed in by the system (EvaluationContext.unknowns).  Its state is the
+    CavityState (p, V)."""
 
     def __init__(self, cavity: Cavity, n_full: int):
         self.cavity = cavity
         self.n_full = n_full
         self.blocks = (cavity.dofs,)
+        # an unknown pressure: its constraint's support, and whether dC/dp is not zero (gas)
+        self.border = ((cavity.dofs, cavity.control == "gas"),) if cavity.unknown else ()
 
-    def evaluate(
-        self,
-        u: np.ndarray,
-        t: float,
-        state: CavityState | None = None,
-        tangent: bool = True,
-        pressure: float | None = None,
-    ) -> tuple[Contribution, Constraint | None]:
+    def initial_state(self) -> CavityState:
+        """At the initial volume, no gauge pressure."""
+        return CavityState(0.0, self.cavity.V0)
+
+    def restore(self, saved: Any) -> CavityState:
+        return CavityState(float(saved["pressure"]), float(saved["volume"]))
+
+    def curves(self) -> tuple[Curve, ...]:
+        return (self.cavity.curve,)
+
+    def evaluate(self, u: np.ndarray, t: float, state: CavityState, context: EvaluationContext) -> Contribution:
         cav = self.cavity
-        p = cav.target(t)[0] if pressure is None else pressure
+        tangent = context.tangent
+        p = float(context.unknowns[0]) if cav.unknown else cav.target(t)[0]
         V, ge, He = cav.evaluate(u, tangent)
         g = assemble(cav.dofs, ge, self.n_full)
         dr, constraint = None, None
@@ -254,4 +265,4 @@ class CavityTerm:
                 constraint = Constraint(absolute * V - goal, -rate, absolute, V, cav.ambient * cav.V0, g)
         else:
             dr = -cav.target(t)[1] * g
-        return Contribution(-p * g, dr, (-p * He,) if tangent else (), trial=CavityState(p, V)), constraint
+        return Contribution(-p * g, dr, (-p * He,) if tangent else (), trial=CavityState(p, V), constraint=constraint)

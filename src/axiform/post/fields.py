@@ -34,7 +34,7 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
     x = solid.gradient(u_full)
     T = (state or model.initial_state()).temperature  # the nodes' (n,) or None
     P = solid.stress(x, temperature=None if T is None else solid.point_values(T))  # mixed: with the element pressure
-    history = (state.solid if state is not None else {}).get("h")
+    history = (model.solid_state(state) if state is not None else {}).get("h")
     if history is not None:  # a law with memory: S = S_law - sum h_i, P = F S
         P = P - f_times(x, history.sum(axis=-2))
     J = x[..., 4] * (x[..., 0] * x[..., 3] - x[..., 1] * x[..., 2])
@@ -72,7 +72,7 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
     if table is not None:
         out["thickness"] = nodal_thickness(mesh, table)
     if model.contacts:
-        history = (state or model.initial_state()).contacts
+        history = model.contact_states(state or model.initial_state())
         pressure = np.zeros(mesh.n_nodes)
         for pair, held in zip(model.contacts, history, strict=False):
             rep = pair.report(held)

@@ -55,7 +55,7 @@ class ArcLengthPath(PathFollowing):
             self.nominal = control.arc_length
         else:
             ev = evaluate_checked(model, self.history, self.u_f, 0.0)
-            t = -factorize_checked(ev.K)(ev.dr_dlam)
+            t = -factorize_checked(ev.K, self.linear)(ev.dr_dlam)
             self.nominal = self.load_step * self._norm(t)
             if not self.nominal > 0:  # nothing responds to the load yet (a tool still in the air)
                 self.nominal = self.load_step * span
@@ -93,7 +93,7 @@ class ArcLengthPath(PathFollowing):
             dlam = np.copysign(self.load_step, lam_new - self.lam)
             guess = self.u_f + dlam / (lam_new - self.lam) * (u_new - self.u_f)
             u_new, lam_new, its, res, ev = newton_load(
-                self.model, self.history, self.u_f, self.lam + dlam, self.opts, self.floor, guess
+                self.model, self.history, self.u_f, self.lam + dlam, self.opts, self.floor, self.linear, guess
             )
         if (
             not self.loaded
@@ -110,12 +110,20 @@ class ArcLengthPath(PathFollowing):
             )
         c = self.control
         if self._crossed(self.lam, lam_new, c.target):
-            out = newton_load(self.model, self.history, self.u_f, c.target, self.opts, self.floor)
+            out = newton_load(self.model, self.history, self.u_f, c.target, self.opts, self.floor, self.linear)
             self._landed = True
             return out
         if self.stop is not None and self._crossed(self.u_f[self.stop], u_new[self.stop], c.stop_value):
             out = newton_displacement(
-                self.model, self.history, self.u_f, self.lam, self.stop, c.stop_value, self.opts, self.floor
+                self.model,
+                self.history,
+                self.u_f,
+                self.lam,
+                self.stop,
+                c.stop_value,
+                self.opts,
+                self.floor,
+                self.linear,
             )
             self._landed = True
             return out
@@ -148,7 +156,7 @@ class ArcLengthPath(PathFollowing):
         dlam = self.load_step * dl / self.nominal if self.nominal > 0 else self.load_step
         lam = self.lam + np.sign(target) * dlam if dlam < ahead[near] * (1 - 1e-9) else stops[near]
         self.loaded = True
-        return newton_load(self.model, self.history, self.u_f, lam, self.opts, self.floor)
+        return newton_load(self.model, self.history, self.u_f, lam, self.opts, self.floor, self.linear)
 
     def _check_on_path(self, du, predictor):
         """Fail a converged step whose increment du leaves the direction of its predictor (the
@@ -205,7 +213,7 @@ class ArcLengthPath(PathFollowing):
         at, t, start = self._tangent
         if at is not self.u_f:
             ev = evaluate_checked(model, self.history, self.u_f, self.lam)
-            t = -factorize_checked(ev.K)(ev.dr_dlam)  # du/dlambda along the tangent
+            t = -factorize_checked(ev.K, self.linear)(ev.dr_dlam)  # du/dlambda along the tangent
             start = ev.force_norm
         if not self._norm(t) > 0:
             # the structure does not respond to the load (only a tool moves, not touching yet)
@@ -226,8 +234,7 @@ class ArcLengthPath(PathFollowing):
             if converged(ev, lam, opts, self.floor, residuals):
                 self._check_on_path(du, predictor)
                 return self.u_f + du, lam, it, residuals, ev
-            solve = factorize_checked(ev.K)
-            ab = solve(np.column_stack([-ev.r, -ev.dr_dlam]))
+            ab = factorize_checked(ev.K, self.linear)(np.column_stack([-ev.r, -ev.dr_dlam]))
             a, b = ab[:, 0], ab[:, 1]
             # ||du + a + dl b||_W = dl: a quadratic in the load correction (Crisfield)
             da = du + a

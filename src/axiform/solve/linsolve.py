@@ -25,8 +25,11 @@ PARDISO does not fail on a zero pivot: it replaces pivots below 1e-13 |K| and co
 (iparm[13]).  Such a K is singular: it goes to SuperLU, which raises on an exact zero pivot
 or answers (b in the range of K: an unloaded rigid mode, harmless), as dense LU does.
 
-Only the latest factorization of each thread can be used: factorize() replaces it, and a
-solve function of an earlier one raises.  Each thread keeps its own solver state.
+A LinearSolver keeps the work of each sparsity pattern (PARDISO's analysis, SuperLU's
+ordering) from one factorization to the next; each Factorization it gives owns its factors
+for as long as it is held (a PARDISO handle is lent to it, and taken back for the next
+factorization once it is dropped), so a solve never goes stale.  `factorize(K)` without a
+solver analyses K afresh.
 """
 
 from __future__ import annotations
@@ -36,6 +39,7 @@ import glob
 import os
 import sys
 import threading
+import weakref
 from collections.abc import Callable
 
 import numpy as np
@@ -88,7 +92,7 @@ def _mkl() -> ctypes.CDLL | None:
     PARALLEL_MIN unknowns PARDISO runs on one thread, which leaves nothing spinning)."""
     global _MKL
     if _MKL is not False:
-        return _MKL
+        return _MKL if isinstance(_MKL, ctypes.CDLL) else None
     _MKL = None
     for path in filter(None, _mkl_candidates()):
         try:
@@ -167,8 +171,8 @@ class _Pardiso:
         self._p_iparm = self.iparm.ctypes.data_as(_I32P)
         self._dummy = np.zeros(1)
         self.threads = 0  # 0: MKL's own setting
-        self.indptr = self.indices = None
-        self.token: object | None = None
+        self.indptr: np.ndarray | None = None
+        self.indices: np.ndarray | None = None
 
     def _call(self, phase: int, data: np.ndarray, b: np.ndarray | None = None, x: np.ndarray | None = None) -> int:
         if self.threads:
@@ -202,7 +206,7 @@ class _Pardiso:
         return self.error.value
 
     def same_pattern(self, K: sp.csr_matrix) -> bool:
-        if self.indptr is None or K.shape[0] != self.n.value:
+        if self.indptr is None or self.indices is None or K.shape[0] != self.n.value:
             return False
         if _address(K.indices) == _address(self._src_indices) and _address(K.indptr) == _address(self._src_indptr):
             return True  # the arrays of the analysed matrix (kept alive here), not a copy
@@ -230,7 +234,6 @@ class _Pardiso:
 
     def factor(self, data: np.ndarray) -> None:
         """Phase 22: numerical factorization of the values data (in the analysed pattern)."""
-        self.token = None
         error = self._call(22, data)
         if error:
             raise SingularTangentError(f"PARDISO factorization failed (error {error})")
@@ -257,64 +260,119 @@ class _Pardiso:
         if self.indptr is not None:
             self._call(-1, self._dummy)
             self.indptr = None
-        self.token = None
+
+    def __del__(self):
+        try:
+            self.release()
+        except Exception:  # the library already unloaded (interpreter exit): nothing to free
+            pass
 
 
-# ---- per-thread state --------------------------------------------------------------------
-class _State(threading.local):
-    pardiso: _Pardiso | None = None
-    superlu_pattern: tuple | None = None  # (indptr, indices, perm_c) of the last SuperLU ordering
+# ---- factorizations ------------------------------------------------------------------------
+class Factorization:
+    """K^-1 of one tangent: call it with b (n,) or several right-hand sides (n, k).  It owns
+    its factors while it is held (`solve` functions never go stale); with PARDISO, dropping
+    it hands its handle (and the analysis of its pattern) back to the LinearSolver that made
+    it, for the next factorization."""
+
+    def __init__(self, solve: Solve):
+        self._solve = solve
+
+    def __call__(self, b: np.ndarray) -> np.ndarray:
+        return self._solve(b)
 
 
-_STATE = _State()
+class LinearSolver:
+    """Factorizes tangents one after the other, keeping the work of each sparsity pattern:
+    PARDISO handles, each with the ordering and symbolic factorization (phase 11) of its
+    pattern, lent to the factorizations alive and taken back when they are dropped (a
+    matrix of a pattern already analysed goes to a handle that holds it: phases 22 and 33
+    only); SuperLU's column ordering of the last pattern.  Thread-safe: a handle serves one
+    factorization at a time."""
 
+    def __init__(self):
+        self._idle: list[_Pardiso] = []  # handles no factorization holds, the last used last
+        self._lock = threading.Lock()
+        self._superlu_pattern: tuple | None = None  # (indptr, indices, perm_c) of the last SuperLU ordering
 
-def _factorize_pardiso(K: sp.csr_matrix, lib: ctypes.CDLL) -> Solve:
-    s = _STATE.pardiso
-    if s is None:
-        s = _STATE.pardiso = _Pardiso(lib)
-    if not s.same_pattern(K):
-        s.analyse(K)
-    data = np.ascontiguousarray(K.data, dtype=float)
-    s.factor(data)
-    if s.iparm[13] > 0:
-        return _factorize_superlu(K)
-    token = s.token = object()
+    def factorize(self, K: sp.spmatrix) -> Factorization:
+        """K^-1 (dense LU up to DENSE_MAX unknowns, else PARDISO, else SuperLU)."""
+        n = K.shape[0]
+        if n <= DENSE_MAX:
+            return Factorization(_factorize_dense(K))
+        if K.format != "csr":
+            K = K.tocsr()
+        if not K.has_sorted_indices:
+            K = K.sorted_indices()
+        if np.any(np.diff(K.indptr) == 0):
+            raise SingularTangentError("the tangent has an empty row")
+        lib = _mkl()
+        if lib is not None:
+            return self._pardiso(K, lib)
+        return Factorization(self._superlu(K))
 
-    def solve(b: np.ndarray) -> np.ndarray:
-        if s.token is not token:
-            raise RuntimeError("this factorization was replaced by a later factorize() call")
-        return _check(s.solve(data, np.asarray(b, dtype=float)))
+    def _take(self, K: sp.csr_matrix, lib: ctypes.CDLL) -> _Pardiso:
+        """An idle handle: one that holds K's pattern, else the one left longest (analysed
+        anew), else a new one."""
+        with self._lock:
+            for k, s in enumerate(self._idle):
+                if s.same_pattern(K):
+                    return self._idle.pop(k)
+            if self._idle:
+                return self._idle.pop(0)
+        return _Pardiso(lib)
 
-    return solve
+    def _give_back(self, handle: _Pardiso) -> None:
+        with self._lock:
+            self._idle.append(handle)
 
+    def _pardiso(self, K: sp.csr_matrix, lib: ctypes.CDLL) -> Factorization:
+        s = self._take(K, lib)
+        try:
+            if not s.same_pattern(K):
+                s.analyse(K)
+            data = np.ascontiguousarray(K.data, dtype=float)
+            s.factor(data)
+        except BaseException:
+            self._give_back(s)
+            raise
+        if s.iparm[13] > 0:
+            self._give_back(s)
+            return Factorization(self._superlu(K))
 
-def _factorize_superlu(K: sp.csr_matrix) -> Solve:
-    """SuperLU with the MMD_ATA column ordering of the last matrix of the same pattern."""
-    from scipy.sparse.linalg import splu
+        def solve(b: np.ndarray) -> np.ndarray:
+            return _check(s.solve(data, np.asarray(b, dtype=float)))
 
-    A = K.tocsc()
-    A.sort_indices()
-    held = _STATE.superlu_pattern
-    try:
-        if held is not None and np.array_equal(held[0], A.indptr) and np.array_equal(held[1], A.indices):
-            order = held[2]  # the columns in the order of the first factorization
-            lu = splu(A[:, order], permc_spec="NATURAL")
+        out = Factorization(solve)
+        weakref.finalize(out, self._give_back, s)
+        return out
 
-            def solve(b: np.ndarray) -> np.ndarray:
-                y = lu.solve(b)
-                x = np.empty_like(y)
-                x[order] = y
-                return _check(x)
+    def _superlu(self, K: sp.csr_matrix) -> Solve:
+        """SuperLU with the MMD_ATA column ordering of the last matrix of the same pattern."""
+        from scipy.sparse.linalg import splu
 
-            return solve
-        lu = splu(A, permc_spec="MMD_ATA")
-    except RuntimeError as exc:  # "Factor is exactly singular"
-        raise SingularTangentError(str(exc)) from exc
-    order = np.empty_like(lu.perm_c)
-    order[lu.perm_c] = np.arange(lu.perm_c.size)
-    _STATE.superlu_pattern = (A.indptr.copy(), A.indices.copy(), order)
-    return lambda b: _check(lu.solve(b))
+        A = K.tocsc()
+        A.sort_indices()
+        held = self._superlu_pattern
+        try:
+            if held is not None and np.array_equal(held[0], A.indptr) and np.array_equal(held[1], A.indices):
+                order = held[2]  # the columns in the order of the first factorization
+                lu = splu(A[:, order], permc_spec="NATURAL")
+
+                def solve(b: np.ndarray) -> np.ndarray:
+                    y = lu.solve(b)
+                    x = np.empty_like(y)
+                    x[order] = y
+                    return _check(x)
+
+                return solve
+            lu = splu(A, permc_spec="MMD_ATA")
+        except RuntimeError as exc:  # "Factor is exactly singular"
+            raise SingularTangentError(str(exc)) from exc
+        order = np.empty_like(lu.perm_c)
+        order[lu.perm_c] = np.arange(lu.perm_c.size)
+        self._superlu_pattern = (A.indptr.copy(), A.indices.copy(), order)
+        return lambda b: _check(lu.solve(b))
 
 
 def _factorize_dense(K: sp.spmatrix) -> Solve:
@@ -337,21 +395,10 @@ def _factorize_dense(K: sp.spmatrix) -> Solve:
     return solve
 
 
-def factorize(K: sp.spmatrix) -> Solve:
-    """A function b -> K^-1 b for b (n,) or several right-hand sides (n, k)."""
-    n = K.shape[0]
-    if n <= DENSE_MAX:
-        return _factorize_dense(K)
-    if K.format != "csr":
-        K = K.tocsr()
-    if not K.has_sorted_indices:
-        K = K.sorted_indices()
-    if np.any(np.diff(K.indptr) == 0):
-        raise SingularTangentError("the tangent has an empty row")
-    lib = _mkl()
-    if lib is not None:
-        return _factorize_pardiso(K, lib)
-    return _factorize_superlu(K)
+def factorize(K: sp.spmatrix, solver: LinearSolver | None = None) -> Factorization:
+    """K^-1 for b (n,) or several right-hand sides (n, k), by `solver` (which keeps the
+    analysis of each pattern; default: a new one, which analyses K afresh)."""
+    return (solver or LinearSolver()).factorize(K)
 
 
 def _permutation_parity(p: np.ndarray) -> int:

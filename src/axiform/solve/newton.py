@@ -9,11 +9,12 @@ import numpy as np
 
 from ..materials import InvertedElementError
 from ..materials.temperature import TemperatureDomainError
+from ..model.evaluation import Evaluation
 from ..model.guards import evaluation_fault
-from ..model.model import Evaluation, Model
 from ..model.state import ModelState
+from ..model.system import System
 from .controls import NewtonOptions
-from .linsolve import SingularTangentError, factorize
+from .linsolve import Factorization, LinearSolver, SingularTangentError
 
 
 class StepFailed(Exception):
@@ -28,7 +29,7 @@ def reference_force(ev: Evaluation, lam: float, floor: float) -> float:
     return max(ev.force_scale, floor)
 
 
-def force_floor(model: Model) -> float:
+def force_floor(model: System) -> float:
     """A force too small to matter: 1e-12 of mu * L^2 for the body's size L."""
     m = model.material
     mu = getattr(m, "shear_modulus", 1.0)
@@ -47,7 +48,7 @@ def converged(ev: Evaluation, lam: float, opts: NewtonOptions, floor: float, res
     return (norm <= opts.tolerance * ref or norm <= ev.noise) and ev.constraint_error <= opts.tolerance
 
 
-def evaluate_checked(model: Model, history: ModelState, u_f, lam, predicting: bool = False) -> Evaluation:
+def evaluate_checked(model: System, history: ModelState, u_f, lam, predicting: bool = False) -> Evaluation:
     """model.evaluate from the committed history, failing the step on an inverted element, a residual that is not finite
     or a tangent with a free rigid translation (guards.evaluation_fault); ending the path (PathEnded) where a
     temperature left the domain of the shift of the relaxation times."""
@@ -63,11 +64,12 @@ def evaluate_checked(model: Model, history: ModelState, u_f, lam, predicting: bo
     return ev
 
 
-def factorize_checked(K):
-    """K^-1 as a function; a singular tangent (at factorization or solve) fails the step."""
+def factorize_checked(K, linear: LinearSolver):
+    """K^-1 as a function (by the path's linear solver); a singular tangent (at factorization
+    or solve) fails the step."""
     message = "singular tangent ({}): is the model supported against rigid motion?"
     try:
-        solve = factorize(K)
+        solve: Factorization = linear.factorize(K)
     except SingularTangentError as exc:
         raise StepFailed(message.format(exc)) from exc
 
@@ -80,18 +82,18 @@ def factorize_checked(K):
     return checked
 
 
-def newton_load(model, history, u_f, lam, opts, floor, guess=None):
+def newton_load(model, history, u_f, lam, opts, floor, linear, guess=None):
     """Newton at fixed lambda from a predicted state `guess`, and if that fails (or the guess
     is not admissible) from the last converged state u_f."""
     if guess is not None:
         try:
-            return _newton_load_from(model, history, guess.copy(), lam, opts, floor)
+            return _newton_load_from(model, history, guess.copy(), lam, opts, floor, linear)
         except StepFailed:
             pass
-    return _newton_load_from(model, history, u_f.copy(), lam, opts, floor)
+    return _newton_load_from(model, history, u_f.copy(), lam, opts, floor, linear)
 
 
-def _newton_load_from(model, history, u_f, lam, opts, floor):
+def _newton_load_from(model, history, u_f, lam, opts, floor, linear):
     """Newton at fixed lambda from u_f.  With contact, a correction that raises the residual
     is shortened (halved up to three times): the active set and the stick/slip states change
     between iterations, and a full step can overshoot.  If no shortened step lowers the
@@ -108,7 +110,7 @@ def _newton_load_from(model, history, u_f, lam, opts, floor):
             return u_f, lam, it, residuals, ev
         if it == opts.max_iterations:
             break
-        du = -factorize_checked(ev.K)(ev.r)
+        du = -factorize_checked(ev.K, linear)(ev.r)
         trial = evaluate_checked(model, history, u_f + du, lam)
         if model.contacts and trial.force_norm > ev.force_norm:
             full = (du, trial)
@@ -123,19 +125,19 @@ def _newton_load_from(model, history, u_f, lam, opts, floor):
     raise StepFailed(f"no convergence in {opts.max_iterations} iterations")
 
 
-def newton_displacement(model, history, u_f, lam, c, target, opts, floor, guess=None):
+def newton_displacement(model, history, u_f, lam, c, target, opts, floor, linear, guess=None):
     """Newton with u_f[c] driven to target and lambda unknown (bordered system):
     du = a + dlam b, K a = -R, K b = -dR/dlambda, dlam chosen so that u_c reaches target.
     Starts from a predicted (u, lambda) `guess`, and if that fails from the converged state."""
     if guess is not None:
         try:
-            return _newton_displacement_from(model, history, guess[0].copy(), guess[1], c, target, opts, floor)
+            return _newton_displacement_from(model, history, guess[0].copy(), guess[1], c, target, opts, floor, linear)
         except StepFailed:
             pass
-    return _newton_displacement_from(model, history, u_f.copy(), lam, c, target, opts, floor)
+    return _newton_displacement_from(model, history, u_f.copy(), lam, c, target, opts, floor, linear)
 
 
-def _newton_displacement_from(model, history, u_f, lam, c, target, opts, floor):
+def _newton_displacement_from(model, history, u_f, lam, c, target, opts, floor, linear):
     residuals: list[float] = []
     for it in range(opts.max_iterations + 1):
         ev = evaluate_checked(model, history, u_f, lam)
@@ -145,8 +147,7 @@ def _newton_displacement_from(model, history, u_f, lam, c, target, opts, floor):
             residuals.append(ev.force_norm)
         if it == opts.max_iterations:
             break
-        solve = factorize_checked(ev.K)
-        ab = solve(np.column_stack([-ev.r, -ev.dr_dlam]))
+        ab = factorize_checked(ev.K, linear)(np.column_stack([-ev.r, -ev.dr_dlam]))
         a, b = ab[:, 0], ab[:, 1]
         if abs(b[c]) < 1e-300:
             raise StepFailed("the driven dof does not respond to the load")

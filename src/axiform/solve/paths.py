@@ -6,11 +6,14 @@ arc_length.py).
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from ..fem.folds import folded_nodes
-from ..model.model import Model
+from ..model.system import System
 from .controls import DisplacementControl, LoadControl, NewtonOptions
+from .linsolve import LinearSolver
 from .newton import (
     PathEnded,
     StepFailed,
@@ -27,9 +30,10 @@ class PathFollowing:
 
     max_steps = 10**9
 
-    def __init__(self, model: Model, opts: NewtonOptions):
+    def __init__(self, model: System, opts: NewtonOptions):
         self.model = model
         self.opts = opts
+        self.linear = LinearSolver()  # the analysis of the tangent's pattern, kept for the path
         self.floor = force_floor(model)
         self.u_f = np.zeros(model.n_free)
         self.lam = 0.0
@@ -38,7 +42,7 @@ class PathFollowing:
     def clip(self, size: float) -> float:
         return size
 
-    _state_keys = ("u_f", "lam")
+    _state_keys: tuple[str, ...] = ("u_f", "lam")
 
     def state(self) -> dict:
         """What the path needs to go on from its last converged step (restart)."""
@@ -71,7 +75,9 @@ class PathFollowing:
         free within an element of that end: the body is sliding off that end."""
         size = self.model.mesh.size()
         u = self.model.expand(self.u_f, self.lam).reshape(-1, self.model.dpn)
-        for k, (pair, held) in enumerate(zip(self.model.contacts, self.history.contacts, strict=False)):
+        for k, (pair, held) in enumerate(
+            zip(self.model.contacts, self.model.contact_states(self.history), strict=True)
+        ):
             ends = _open_ends(pair.surface)
             # an end on the axis is no end a body slides off: the outline goes on mirrored
             ends = ends[np.abs(ends[:, 0] + pair.surface.offset(self.lam)[0]) > 1e-9 * size]
@@ -79,7 +85,8 @@ class PathFollowing:
                 continue
             touching = held.seen.status > 0
             left = np.isfinite(held.first_contact) & ~touching
-            gap_at_end = np.linalg.norm(held.seen.proj.point[:, None, :] - ends[None], axis=2).min(axis=1)
+            proj: Any = held.seen.proj
+            gap_at_end = np.linalg.norm(proj.point[:, None, :] - ends[None], axis=2).min(axis=1)
             node_to_end = np.linalg.norm(held.seen.x[:, None, :] - ends[None], axis=2).min(axis=1)
             off = (touching & (gap_at_end < 1e-2 * size)) | (left & (node_to_end < size))
             if off.any():
@@ -112,14 +119,14 @@ class PathFollowing:
         nothing responds to the load at the start."""
         try:
             ev0 = evaluate_checked(self.model, self.model.initial_state(), np.zeros_like(self.u_f), 0.0)
-            t0 = factorize_checked(ev0.K)(ev0.dr_dlam)
+            t0 = factorize_checked(ev0.K, self.linear)(ev0.dr_dlam)
             ev = evaluate_checked(self.model, self.history, self.u_f, self.lam)
-            t = factorize_checked(ev.K)(ev.dr_dlam)
+            t = factorize_checked(ev.K, self.linear)(ev.dr_dlam)
         except (StepFailed, PathEnded):
             return None
         n = self.model.dofmap.nf
         n0, n1 = np.linalg.norm(t0[:n]), np.linalg.norm(t[:n])
-        return n0 / n1 if n0 > 0 and n1 > 0 else None
+        return float(n0 / n1) if n0 > 0 and n1 > 0 else None
 
     def accept(self, u_f, lam, size):
         self.u_f, self.lam = u_f, lam
@@ -172,7 +179,7 @@ class LoadPath(PathFollowing):
         if guess is not None and self.previous is not None:
             du, h = self.previous
             guess += (dlam * dlam / (h * h)) * (h * self.rate - du)
-        out = newton_load(self.model, self.history, self.u_f, lam, self.opts, self.floor, guess)
+        out = newton_load(self.model, self.history, self.u_f, lam, self.opts, self.floor, self.linear, guess)
         self.converged = out[4]
         return out
 
@@ -180,7 +187,7 @@ class LoadPath(PathFollowing):
         """du_f/dlambda = -K^-1 dR/dlambda (n_free,) at the evaluation ev of the state (u_f,
         lam) (None: evaluated at the last converged state); zeros where that fails (the
         predictor is then that state).  A law with memory moves R with t at fixed u (the
-        stress relaxes), which dR/dlambda of the loads does not hold: Model.relaxation_rate
+        stress relaxes), which dR/dlambda of the loads does not hold: System.relaxation_rate
         adds it (without it the guesses of a viscoelastic stretch blow moulding missed, 164 ->
         266 steps)."""
         try:
@@ -188,7 +195,7 @@ class LoadPath(PathFollowing):
                 ev = evaluate_checked(self.model, self.history, self.u_f, self.lam)
                 u_f, lam = self.u_f, self.lam
             dr = ev.dr_dlam + self.model.relaxation_rate(u_f, lam, self.history, 1e-6 * abs(self.nominal))
-            return -factorize_checked(ev.K)(dr)
+            return -factorize_checked(ev.K, self.linear)(dr)
         except StepFailed:
             return np.zeros_like(self.u_f)
 
@@ -243,7 +250,7 @@ class DisplacementPath(PathFollowing):
             ratio = (goal - self.reached) / dprev
             guess = (self.u_f + ratio * du, self.lam + ratio * dlam)
         return newton_displacement(
-            self.model, self.history, self.u_f, self.lam, self.c, goal, self.opts, self.floor, guess
+            self.model, self.history, self.u_f, self.lam, self.c, goal, self.opts, self.floor, self.linear, guess
         )
 
     def accept(self, u_f, lam, size):

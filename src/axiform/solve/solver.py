@@ -14,6 +14,7 @@ import time
 from collections.abc import Callable
 
 from ..model.model import Model
+from ..model.system import System
 from .arc_length import ArcLengthPath
 from .controls import ArcLengthControl, DisplacementControl, LoadControl, NewtonOptions, SolveResult, Step
 from .newton import PathEnded, StepFailed
@@ -33,7 +34,7 @@ __all__ = [
 
 
 def solve(
-    model: Model,
+    model: Model | System,
     control: LoadControl | DisplacementControl | ArcLengthControl,
     options: NewtonOptions | None = None,
     on_step: Callable[[Step], None] | None = None,
@@ -45,23 +46,18 @@ def solve(
     state after it (path, step size, counts, contact and cavity history).  The result keeps
     all steps, or only the latest `keep` (memory flat in the number of steps: a writer that
     takes each step as it comes needs keep=1).  `resume`: a checkpoint to continue from; the
-    steps then go on with the same numbers and sizes as in an uninterrupted run."""
+    steps then go on with the same numbers and sizes as in an uninterrupted run.
+    `model`: a System, or a Model, which is finalized here (Model.finalize)."""
+    system = model.finalize()
     opts = options or NewtonOptions()
-    if model.dofmap is None:
-        model.finalize()
     t0 = time.perf_counter()
-    if isinstance(control, ArcLengthControl):
-        path = ArcLengthPath(model, control, opts)
-    elif isinstance(control, DisplacementControl):
-        path = DisplacementPath(model, control, opts)
-    else:
-        path = LoadPath(model, control, opts)
+    path = _path(system, control, opts)
     result = SolveResult("finished")
     size = path.nominal
     first = 1
     if resume is not None:
         path.restore(resume["path"])
-        path.history = model.restore(resume["model"])
+        path.history = system.restore(resume["model"])
         size = float(resume["size"])
         first = int(resume["step"]) + 1
         result.newton_iterations = int(resume["newton_iterations"])
@@ -85,8 +81,8 @@ def solve(
                 break
             continue
         path.accept(u_new, lam_new, trial)
-        u_full = model.expand(u_new, lam_new)
-        path.history = model.settle(path.history, ev.trial, u_full)  # the trial of the accepted u only
+        u_full = system.expand(u_new, lam_new)
+        path.history = system.settle(path.history, ev.trial, u_full)  # the trial of the accepted u only
         result.newton_iterations += its
         if its <= opts.easy_iterations:
             size *= opts.growth
@@ -113,6 +109,15 @@ def solve(
             break
     result.wall_time_s = time.perf_counter() - t0
     return result
+
+
+def _path(system: System, control, opts: NewtonOptions) -> LoadPath | DisplacementPath | ArcLengthPath:
+    """The path-following scheme of the control."""
+    if isinstance(control, ArcLengthControl):
+        return ArcLengthPath(system, control, opts)
+    if isinstance(control, DisplacementControl):
+        return DisplacementPath(system, control, opts)
+    return LoadPath(system, control, opts)
 
 
 def _stop_message(step: int, failure: str, cause: str) -> str:
