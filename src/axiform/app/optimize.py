@@ -286,6 +286,12 @@ def run(
             result = optimize(design, target, method, max_iter, tolerance, smoothness, progress)
         except Interrupted as exc:
             result = progress.interrupted(method, tolerance, exc)
+        except Exception:
+            # a signal raises where the program is: library code that catches what it raises
+            # (NumPy's comparisons do) may hand on another exception; the signal is recorded
+            if stops.signum is None:
+                raise
+            result = progress.interrupted(method, tolerance, Interrupted(stops.signum))
         else:
             try:
                 final, code = run_final(out_dir, design, result, quiet)
