@@ -83,8 +83,13 @@ def _superlu(permc: str, **kw):
     return factor
 
 
+# the analysis of the pattern kept from one factorization to the next, as a run keeps it (a tree
+# from before LinearSolver: its module-level factorize keeps it)
+_SRC = linsolve.LinearSolver().factorize if hasattr(linsolve, "LinearSolver") else linsolve.factorize
+
+
 def _src(K):
-    return linsolve.factorize(K), None
+    return _SRC(K), None
 
 
 def src_solver() -> str:

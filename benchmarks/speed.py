@@ -92,7 +92,11 @@ from axiform.fem.mesh import edges_on_nodes
 NEWTON_SCRIPT = (
     SCRIPT_PRELUDE
     + r"""
-from axiform.solve.linsolve import factorize
+try:  # the analysis of the pattern kept from one factorization to the next, as a run keeps it
+    from axiform.solve.linsolve import LinearSolver
+    factorize = LinearSolver().factorize
+except ImportError:  # a tree from before LinearSolver: its module-level factorize keeps it
+    from axiform.solve.linsolve import factorize
 element, formulation, n = sys.argv[2], sys.argv[3], int(sys.argv[4])
 mesh = af.rectangle((1.0, 2.0), (0.0, 1.0), (n, n), element)
 model = af.Model(mesh, af.MooneyRivlin(80.0, 20.0, 1e4), formulation=formulation)

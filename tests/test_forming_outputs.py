@@ -145,6 +145,14 @@ def test_thickness_csv_columns_and_first_contact(tmp_path):
     assert [k for k in one if k not in UNWRITTEN] == list(COLUMNS)  # one piece: first_contact alone
 
 
+def with_contacts(model, state, held):
+    """The model state with the contact pairs' states `held` in their places."""
+    terms = list(state.terms)
+    for slot, pair_state in zip(model.contact_slots, held, strict=True):
+        terms[slot] = pair_state
+    return replace(state, terms=tuple(terms))
+
+
 def test_vtu_fields_thickness_and_first_contact():
     built = build(load(EXAMPLES / "toric_plate.toml"), EXAMPLES)
     model = built.model
@@ -153,7 +161,7 @@ def test_vtu_fields_thickness_and_first_contact():
     held = replace(
         model.contact_states(start)[0], first_contact=np.where(np.arange(len(pair.nodes)) % 3 == 0, 0.5, np.nan)
     )
-    fields = point_fields(model, np.zeros(model.n_full), replace(start, contacts=(held,)))
+    fields = point_fields(model, np.zeros(model.n_full), with_contacts(model, start, (held,)))
     expect = np.full(model.mesh.n_nodes, -1.0)
     expect[pair.nodes] = np.nan_to_num(held.first_contact, nan=-1.0)
     assert np.array_equal(fields["first_contact"], expect)
@@ -177,7 +185,7 @@ def test_vtu_fields_first_contact_per_piece():
             model.contact_states(start)[1], first_contact=np.where(np.arange(len(mould.nodes)) % 3 == 0, 1.5, np.nan)
         ),
     )
-    fields = point_fields(model, np.zeros(model.n_full), replace(start, contacts=held))
+    fields = point_fields(model, np.zeros(model.n_full), with_contacts(model, start, held))
     for k, pair in enumerate(held):
         expect = np.full(model.mesh.n_nodes, -1.0)
         expect[pair.nodes] = np.nan_to_num(pair.first_contact, nan=-1.0)

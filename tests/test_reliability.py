@@ -398,7 +398,7 @@ def test_a_mechanism_never_converges_through_the_python_api():
     translation in the tangent at the first evaluation and converges no step."""
     case = load(PLATE, ["solver.steps=4"])
     built = build(case, PLATE.parent)
-    model = built.model
+    model = built.builder
     model.fixed = {d: v for d, v in model.fixed.items() if d % model.dpn != 1}  # uz free everywhere
     model = model.finalize()
     result = solve(model, built.control, built.options)
@@ -462,7 +462,7 @@ def test_a_step_with_nan_is_stopped_not_written(tmp_path, monkeypatch, capsys):
     is refused by the results writer: exit 1, the node named, nothing of it written."""
     from axiform.solve import solver as solver_module
 
-    expand = solver_module.Model.expand
+    expand = solver_module.System.expand
     count = {"n": 0}
 
     def poisoned(self, u_f, lam):
@@ -473,7 +473,7 @@ def test_a_step_with_nan_is_stopped_not_written(tmp_path, monkeypatch, capsys):
             u[7] = np.inf
         return u
 
-    monkeypatch.setattr(solver_module.Model, "expand", poisoned)
+    monkeypatch.setattr(solver_module.System, "expand", poisoned)
     out = tmp_path / "out"
     assert main(["run", str(PLATE), "--out", str(out), "-q", "--set", "output.plots=false"]) == 1
     cap = capsys.readouterr()
