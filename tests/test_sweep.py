@@ -96,6 +96,7 @@ def test_sweep_failure_recorded_and_resume(sweep_dir, capsys):
         "status",
         "exit_code",
         "steps",
+        "load_factor",
         "wall_time_s",
         "message",
         "w_center",
@@ -119,6 +120,7 @@ def test_sweep_failure_recorded_and_resume(sweep_dir, capsys):
         assert float(r["w_center"]) == pytest.approx(1.0, rel=1e-12)
         assert float(r["rim_force_z"]) == summary["monitors"]["rim_force_z"]
         assert int(r["steps"]) == summary["steps"] == 4
+        assert float(r["load_factor"]) == summary["load_factor"] > 0  # where the run ended
         # over the run, from history.csv: not only the last value (a monitor back at 0 at the end)
         history = np.genfromtxt(out / "cases" / r["case"] / "history.csv", delimiter=",", names=True)
         assert float(r["w_center_min"]) == history["w_center"].min() < float(r["w_center_max"])
@@ -200,3 +202,42 @@ def test_bad_workers_and_out(sweep_dir, capsys):
     (sweep_dir / "a_file").write_text("")
     assert main(args + ["--out", str(sweep_dir / "a_file")]) == 2
     assert "--out" in capsys.readouterr().err
+
+
+WLF_PLATE = PLATE.replace(
+    '[material]\nmodel = "mooney-rivlin"\nC1 = 80.0\nC2 = 20.0\nkappa = 1.0e4',
+    '[material]\nmodel = "neo-hooke"\nC1 = 80.0\nkappa = 1.0e4\nviscoelastic = { g = [0.5], tau = [1.0] }\n'
+    "[temperature]\ninitial = 100.0\nreference = 100.0\nshift = { wlf = { C1 = 17.4, C2 = 51.6 } }",
+).replace('control = "displacement"\ndof = { at = { r = 0.0, z = 0.5 }, dof = "uz" }\ntarget = 1.0', 'control = "load"')
+
+
+def test_every_case_is_built_before_any_runs(tmp_path, capsys):
+    """Case 2 below the WLF pole (T_ref - C2 = 48.4) is found before case 1 runs."""
+    assert "neo-hooke" in WLF_PLATE and 'control = "load"' in WLF_PLATE
+    (tmp_path / "plate.toml").write_text(WLF_PLATE)
+    (tmp_path / "s.toml").write_text('case = "plate.toml"\n[vary]\n"temperature.initial" = [100.0, 40.0]\n')
+    out = tmp_path / "out"
+    assert main(["sweep", str(tmp_path / "s.toml"), "--out", str(out), "--workers", "1"]) == 2
+    err = capsys.readouterr().err
+    assert "case 2 (temperature.initial = 40.0) is invalid" in err and "WLF pole" in err, err
+    assert not (out / "cases" / "0001").exists()
+
+
+def test_inline_tables_are_swept(tmp_path):
+    (tmp_path / "plate.toml").write_text(WLF_PLATE)
+    (tmp_path / "s.toml").write_text(
+        'case = "plate.toml"\n[vary]\n"temperature.initial" = [100.0, '
+        '{ along = "r", table = [[0.0, 110.0], [7.5, 100.0]] }]\n'
+        '"material.viscoelastic" = [{ g = [0.5], tau = [1.0] }, { g = [0.3], tau = [2.0] }]\n'
+    )
+    sweep = load_sweep(tmp_path / "s.toml")
+    assert sweep.overrides(2) == [
+        'temperature.initial={ along = "r", table = [[0.0, 110.0], [7.5, 100.0]] }',
+        "material.viscoelastic={ g = [0.5], tau = [1.0] }",
+    ]
+    out = tmp_path / "out"
+    assert main(["sweep", str(tmp_path / "s.toml"), "--out", str(out), "--workers", "1"]) == 0
+    rows = stress_rows(out / "sweep.csv")
+    assert [r["status"] for r in rows] == ["finished"] * 4
+    assert rows[3]["material.viscoelastic"] == "{ g = [0.3], tau = [2.0] }"
+    assert float(rows[3]["load_factor"]) == 1.0

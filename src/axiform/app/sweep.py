@@ -13,11 +13,13 @@ At most 10,000 cases (MAX_CASES); a date or time is no case value.
 Case k (k = 1, 2, ...; the last key of [vary] varies fastest) runs in DIR/cases/NNNN/
 (NNNN = k, four digits) through the same code as `axiform run CASE --set KEY=VALUE ... --out
 DIR/cases/NNNN`: a normal results folder.  DIR/sweep.csv has one row per case (case, the
-varied keys, status, exit_code, steps, wall_time_s, message, the last value of every
-monitor, thickness_min (the thinnest wall at the end, meshes with a wall), then M_min and
-M_max of every monitor M over the run, from the case's history.csv), rewritten as cases finish; DIR/sweep.png plots
-the report monitor against the
-varied keys.  A case that fails or stops keeps its row; a second run of the same command
+varied keys, status, exit_code, steps, load_factor (where the run ended: the final load
+factor or time), wall_time_s, message, the last value of every monitor, thickness_min (the
+thinnest wall at the end, meshes with a wall), then M_min and M_max of every monitor M over
+the run, from the case's history.csv), rewritten as cases finish; DIR/sweep.png plots the
+report monitor against the varied keys.  Every case is built before any runs (an invalid
+one: exit 2).  A case value may be an inline table ({ along = "r", table = [...] }).  A case
+that fails or stops keeps its row; a second run of the same command
 skips the cases whose summary.json says "finished" for the same case text (resume).
 
 Dask distributed runs the cases: a LocalCluster of N single-threaded worker processes
@@ -45,7 +47,7 @@ from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, Field, StrictStr, ValidationError, field_validator, model_validator
 
-from ..case.schema import HISTORY_COLUMNS, CaseError, fingerprint, parse, read
+from ..case.schema import HISTORY_COLUMNS, CaseError, build, fingerprint, parse, read
 from ..io.text import MAX_CASE_BYTES, FileTooLarge, read_text
 from ..post.sweep_plots import plot_sweep
 from .console import ProgressLine
@@ -54,20 +56,29 @@ SWEEP_KEYS = ("case", "vary", "cases", "report")
 # the most cases a sweep may have: a [vary] of many long lists is refused at once, not
 # parsed case by case for hours
 MAX_CASES = 10_000
-FIXED_COLUMNS = ("status", "exit_code", "steps", "wall_time_s", "message")
+FIXED_COLUMNS = ("status", "exit_code", "steps", "load_factor", "wall_time_s", "message")
 # one math library thread per worker: the workers already fill the cores
 WORKER_ENV = {v: "1" for v in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")}
 
 
 def toml_value(value: Any) -> str:
     """A value (as tomllib reads it) as one line of TOML, for KEY=VALUE overrides and labels:
-    tomli-w's text of it, its arrays joined on one line (a string of tomli-w's has no line
-    break: it writes one as the escape \\n)."""
+    tables inline ({ along = "r", table = [[0.0, 150.0], ...] }), arrays on one line, every
+    scalar as tomli-w writes it (a string of tomli-w's has no line break: it writes one as
+    the escape \\n)."""
     import tomli_w
 
-    text = tomli_w.dumps({"v": [value]}, indent=0)  # in an array: a table is written inline
-    text = text.removeprefix("v = [\n").removesuffix(",\n]\n")
-    return text.replace("[\n", "[").replace(",\n]", "]").replace(",\n", ", ")
+    if isinstance(value, dict):
+        items = [f"{_toml_key(str(k))} = {toml_value(v)}" for k, v in value.items()]
+        return "{ " + ", ".join(items) + " }" if items else "{}"
+    if isinstance(value, list):
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
+    return tomli_w.dumps({"v": value}).removeprefix("v = ").removesuffix("\n")
+
+
+def _toml_key(key: str) -> str:
+    """A key of an inline table: bare where TOML allows, else quoted."""
+    return key if key and all(c.isascii() and (c.isalnum() or c in "_-") for c in key) else json.dumps(key)
 
 
 class _Report(BaseModel):
@@ -141,7 +152,7 @@ def _has_date(value: Any) -> bool:
 
 def load_sweep(path: str | Path) -> Sweep:
     """Read and check a sweep file; CaseError names the key and the reason.  Every case is
-    read and validated (not built) here, before any work."""
+    read, validated and built here, before any case runs."""
     path = Path(path)
     try:
         data = tomllib.loads(read_text(path, MAX_CASE_BYTES))
@@ -183,8 +194,9 @@ def load_sweep(path: str | Path) -> Sweep:
     where = "vary" if spec.vary is not None else "cases"
     for k, case in enumerate(cases):
         sets = [f"{key}={toml_value(v)}" for key, v in case.items()]
-        try:
+        try:  # built too: what only the model finds (a temperature below the WLF pole) is found now
             parsed = parse(read(case_file, sets))
+            build(parsed, case_file.parent)
         except CaseError as exc:
             text = ", ".join(f"{key} = {toml_value(v)}" for key, v in case.items())
             raise CaseError(f"{where}: case {k + 1} ({text}) is invalid:\n{exc}") from None
@@ -227,7 +239,7 @@ def run_case(case_file: str, overrides: list[str], out: str) -> dict[str, Any]:
 
 
 def summary_row(folder: Path) -> dict[str, Any]:
-    """status, steps, wall_time_s, message, the monitors and the thinnest wall of a results
+    """status, steps, the final load_factor, wall_time_s, message, the monitors and the thinnest wall of a results
     folder's summary.json, and every monitor's (min, max) over the run from its history.csv
     ({} when it has no summary.json)."""
     try:
@@ -237,6 +249,7 @@ def summary_row(folder: Path) -> dict[str, Any]:
     return {
         "status": s.get("status"),
         "steps": s.get("steps"),
+        "load_factor": s.get("load_factor"),
         "wall_time_s": s.get("wall_time_s"),
         "message": s.get("message", ""),
         "monitors": s.get("monitors", {}),
@@ -321,6 +334,7 @@ def write_table(path: Path, sweep: Sweep, rows: list[dict | None]) -> None:
                 row.get("status", ""),
                 row.get("exit_code", ""),
                 row.get("steps", ""),
+                "" if row.get("load_factor") is None else repr(row["load_factor"]),
                 "" if wall is None else f"{wall:.3f}",
                 " ".join(str(row.get("message", "")).split()),
                 *[repr(monitors[m]) if m in monitors else "" for m in sweep.monitors],
