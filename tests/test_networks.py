@@ -7,9 +7,10 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from axiform import MooneyRivlin, NeoHooke, Ogden
+from axiform import ArrudaBoyce, Gent, MooneyRivlin, NeoHooke, Ogden, Yeoh
 from axiform.materials.network import BergstromBoyce, Network
 from axiform.materials.parallel import NetworkLaw
+from axiform.materials.principal import generic_principal, principal_function
 from axiform.materials.temperature import WLF
 
 EQUILIBRIUM = NeoHooke(0.5, 1.0e3)
@@ -235,3 +236,37 @@ def test_flow_parameters_out_of_range_are_refused_naming_the_key(key, values):
 def test_a_stiffness_ratio_must_be_positive():
     with pytest.raises(ValueError, match="^stiffness_ratio:"):
         Network(EQUILIBRIUM, FLOW, 0.0)
+
+
+@pytest.mark.parametrize(
+    "law",
+    [MooneyRivlin(0.8, 0.3, 0.0), Yeoh(0.5, -0.05, 0.01, 0.0), Gent(1.0, 20.0, 0.0), ArrudaBoyce(1.0, 3.0, 0.0)]
+    + [Ogden((1.2, -0.3), (2.5, -2.0), 0.0), Ogden((0.7,), (8.0,), 0.0)],
+    ids=["mooney-rivlin", "yeoh", "gent", "arruda-boyce", "ogden", "ogden alpha 8"],
+)
+def test_the_principal_stresses_agree_with_the_laws_own_stress_and_tangent(law):
+    """principal.py's closed forms on (3, n) against the law's P and A at F = diag(l)."""
+    rng = np.random.default_rng(3)
+    e = rng.uniform(-0.5, 0.6, (3, 20))
+    e[:, 0] = 0.0  # F = I
+    e[1, 1] = e[0, 1]  # equal meridian stretches
+    t, K = principal_function(law, 2.5)(e)
+    t0, K0 = generic_principal(law, e, 2.5)
+    np.testing.assert_allclose(t, t0, rtol=1e-11, atol=1e-11 * np.abs(t0).max())
+    np.testing.assert_allclose(K, K0, rtol=1e-11, atol=1e-11 * np.abs(K0).max())
+
+
+def test_the_update_in_chunks_of_points_is_the_update_at_once(monkeypatch):
+    import axiform.materials.parallel as parallel
+
+    shift = WLF(17.44, 51.6, 150.0)
+    law = law_of(shift=shift)
+    x = np.stack(list(F_CASES.values()))
+    state = law.initial_state((len(x),))
+    T = np.linspace(150.0, 170.0, len(x))
+    whole = law.update(x, state, 0.2, T)
+    monkeypatch.setattr(parallel, "CHUNK", 4)
+    chunked = law.update(x, state, 0.2, T)
+    for a, b in zip(whole[:2], chunked[:2], strict=True):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(whole[2]["network0"], chunked[2]["network0"])

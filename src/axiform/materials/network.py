@@ -34,9 +34,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .base import Hyperelastic
+from .principal import principal_function
 
 Rows = tuple[np.ndarray, np.ndarray]
-PRINCIPAL = (0, 3, 4)  # components of x holding the principal stretches of a diagonal F
 MAX_ITERATIONS = 50
 TOLERANCE = 1e-12  # on the local residual, a logarithmic strain
 DEGENERATE = 1e-8  # relative gap of the meridian eigenvalues below which the limit is used
@@ -89,13 +89,10 @@ class Network:
         if not self.scale > 0:
             raise ValueError(f"stiffness_ratio: must be > 0, got {self.scale}")
 
-    def elastic_rows(self, xt: np.ndarray) -> Rows:
-        """P (5, n) and A (5, 5, n) of the elastic part's isochoric energy at rows xt (5, n)."""
-        P, A = self.law.stress_rows(xt, 0.0, True)
-        assert A is not None, "stress_rows gives A when the tangent is asked for"
-        if self.scale != 1.0:
-            P, A = self.scale * P, self.scale * A
-        return P, A
+    def principal(self, e: np.ndarray) -> Rows:
+        """Principal Kirchhoff stresses t (3, n) of the elastic part at principal log strains
+        e (3, n) and K = dt/de (3, 3, n) (principal.py)."""
+        return principal_function(self.law, self.scale)(e)
 
 
 def inverse3(M: np.ndarray) -> np.ndarray:
@@ -110,20 +107,6 @@ def inverse3(M: np.ndarray) -> np.ndarray:
     return C / det
 
 
-def principal_kirchhoff(elastic: Callable[[np.ndarray], Rows], e: np.ndarray) -> Rows:
-    """Principal Kirchhoff stresses t_i (3, n) at principal log strains e (3, n) and
-    K_ij = dt_i/de_j (3, 3, n): t_i = l_i P_i, K_ij = delta_ij t_i + l_i l_j A_ij (l = exp(e))."""
-    lam = np.exp(e)
-    xe = np.zeros((5, e.shape[1]))
-    xe[0], xe[3], xe[4] = lam
-    P, A = elastic(xe)
-    t = lam * P[PRINCIPAL,]
-    K = (lam[:, None] * lam[None]) * A[np.ix_(PRINCIPAL, PRINCIPAL)]
-    for i in range(3):
-        K[i, i] += t[i]
-    return t, K
-
-
 def local_system(t: np.ndarray, K: np.ndarray, rate: np.ndarray, m: float, dt: float) -> tuple[np.ndarray, np.ndarray]:
     """dt (3/2) g(q) t' (3, n) and its Jacobian in e (3, 3, n), g = rate q^(m-1), from the
     principal stresses t (3, n), K = dt/de (3, 3, n) and rate (n)."""
@@ -133,15 +116,17 @@ def local_system(t: np.ndarray, K: np.ndarray, rate: np.ndarray, m: float, dt: f
     g = rate * safe ** (m - 1.0) * np.where(q > 0, 1.0, 0.0 if m > 1.0 else 1.0)
     flow = (1.5 * dt) * g * dev
     Kdev = K - K.mean(0)
-    dg = (m - 1.0) * rate * safe ** (m - 3.0) * 1.5 * np.einsum("in,ijn->jn", dev, K)  # dg/de (3, n)
+    dg = (m - 1.0) * rate * safe ** (m - 3.0) * 1.5 * (dev[:, None] * K).sum(0)  # dg/de (3, n)
     jac = (1.5 * dt) * (g * Kdev + dev[:, None] * dg[None])
     for i in range(3):
         jac[i, i] += 1.0
     return flow, jac
 
 
-def scalar_guess(e_tr: np.ndarray, t: np.ndarray, rate: np.ndarray, m: float, dt: float) -> np.ndarray:
-    """A first iterate of the local Newton (3, n): the solution for an elastic part linear in
+def scalar_guess(
+    e_tr: np.ndarray, t: np.ndarray, rate: np.ndarray, m: float, dt: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """A first iterate of the local Newton (3, n) and rho (n): the solution for an elastic part linear in
     the deviatoric log strain (2 mu_eff = t':e_tr' / e_tr':e_tr' at the predictor), e =
     mean(e_tr) + rho e_tr', rho (1 + c rho^(m-1)) = 1, c = 3/2 dt rate q_tr^(m-1) 2 mu_eff,
     solved for u = ln(rho) (u + ln(1 + c e^((m-1) u)) = 0: convex, slope in [1, m]) by Newton
@@ -160,18 +145,26 @@ def scalar_guess(e_tr: np.ndarray, t: np.ndarray, rate: np.ndarray, m: float, dt
         u += du
         if not (np.abs(du) > 1e-3).any():  # the Newton of solve_local finishes the work
             break
-    return mean + np.exp(u) * dev
+    rho = np.exp(u)
+    return mean + rho * dev, rho
 
 
 def solve_local(
-    elastic: Callable[[np.ndarray], Rows], e_tr: np.ndarray, rate: np.ndarray, m: float, dt: float
+    principal: Callable[[np.ndarray], Rows], e_tr: np.ndarray, rate: np.ndarray, m: float, dt: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The principal log strains e (3, n) solving r(e) = 0, and at the solution t (3, n),
-    K (3, 3, n) and the local Jacobian dr/de (3, 3, n).  Newton from scalar_guess, on the points
-    not yet converged only; a step that does not lower |r| is halved (up to 8 times)."""
-    t, K = principal_kirchhoff(elastic, e_tr)
-    e = scalar_guess(e_tr, t, rate, m, dt) if dt > 0 else e_tr.copy()
-    t, K = principal_kirchhoff(elastic, e)
+    K (3, 3, n) and the local Jacobian dr/de (3, 3, n).  Newton from the elastic predictor, or
+    from scalar_guess where that one flows far (rho < 0.9), on the points not yet converged
+    only; a step that does not lower |r| is halved (up to 8 times)."""
+    n = e_tr.shape[1]
+    t, K = principal(e_tr)
+    e = e_tr.copy()
+    if dt > 0:
+        guess, rho = scalar_guess(e_tr, t, rate, m, dt)
+        far = np.flatnonzero(rho < 0.9)
+        if far.size:
+            e[:, far] = guess[:, far]
+            t[:, far], K[:, :, far] = principal(guess[:, far])
     flow, jac = local_system(t, K, rate, m, dt)
     r = e - e_tr + flow
     norm = np.abs(r).max(0)
@@ -179,12 +172,13 @@ def solve_local(
         idx = np.flatnonzero(norm > TOLERANCE)
         if not idx.size:
             return e, t, K, jac
-        e_a, e_tr_a, rate_a, norm_a = e[:, idx], e_tr[:, idx], rate[idx], norm[idx]
-        step = -np.einsum("ijn,jn->in", inverse3(jac[:, :, idx]), r[:, idx])
+        at: slice | np.ndarray = slice(None) if idx.size == n else idx
+        e_a, e_tr_a, rate_a, norm_a = e[:, at], e_tr[:, at], rate[at], norm[at]
+        step = -(inverse3(jac[:, :, at]) * r[None, :, at]).sum(1)
         factor = np.ones_like(norm_a)
         for _halving in range(9):
             trial = e_a + factor * step
-            t_a, K_a = principal_kirchhoff(elastic, trial)
+            t_a, K_a = principal(trial)
             flow_a, jac_a = local_system(t_a, K_a, rate_a, m, dt)
             r_a = trial - e_tr_a + flow_a
             new = np.abs(r_a).max(0)
@@ -192,7 +186,7 @@ def solve_local(
             if not worse.any():
                 break
             factor = np.where(worse, 0.5 * factor, factor)
-        e[:, idx], t[:, idx], K[:, :, idx], jac[:, :, idx], r[:, idx], norm[idx] = trial, t_a, K_a, jac_a, r_a, new
+        e[:, at], t[:, at], K[:, :, at], jac[:, :, at], r[:, at], norm[at] = trial, t_a, K_a, jac_a, r_a, new
     raise LocalUpdateError(np.flatnonzero(norm > TOLERANCE))
 
 
@@ -223,12 +217,12 @@ def network_rows(network: Network, xt: np.ndarray, Cvi: np.ndarray, dt: float, a
     det_m = RR * ZZ - RZ * RZ
     rate = network.flow.rate_factor((RR + ZZ) / det_m + 1.0 / TT, a_T if network.flow.shift else 1.0)
     rate = np.broadcast_to(rate, a.shape)
-    e, t, K, jac = solve_local(network.elastic_rows, 0.5 * np.log(mu), rate, network.flow.m, dt)
+    e, t, K, jac = solve_local(network.principal, 0.5 * np.log(mu), rate, network.flow.m, dt)
     j2 = a * d - b * c
     Gi = (d / j2, -c / j2, -b / j2, a / j2)  # F^-T of the meridian block, rows r, z; columns R, Z
     trial = elastic_state(np.exp(2.0 * e), c2, s2, Gi, f)
     # the isotropic function tau(Be_tr): dt_i/dmu_j and the weight of the axes' rotation
-    G = np.einsum("ikn,kjn->ijn", K, inverse3(jac)) / (2.0 * mu[None])
+    G = (K[:, :, None] * inverse3(jac)[None]).sum(1) / (2.0 * mu[None])
     gap = rad > DEGENERATE * mu1
     ratio = np.where(gap, (t[0] - t[1]) / np.where(gap, mu1 - mu2, 1.0), 0.5 * (G[0, 0] - G[0, 1] + G[1, 1] - G[1, 0]))
     tau = meridian_tensor(t[0], t[1], c2, s2) + (t[2],)
