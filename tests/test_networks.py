@@ -270,3 +270,13 @@ def test_the_update_in_chunks_of_points_is_the_update_at_once(monkeypatch):
     for a, b in zip(whole[:2], chunked[:2], strict=True):
         np.testing.assert_array_equal(a, b)
     np.testing.assert_array_equal(whole[2]["network0"], chunked[2]["network0"])
+
+
+def test_the_moduli_of_a_law_of_networks():
+    """kappa: the equilibrium law's; the instantaneous shear modulus: all networks' summed,
+    the slope of the elastic response at F = I (dt = 0) in simple shear."""
+    law = NetworkLaw(EQUILIBRIUM, [Network(NeoHooke(1.0, 0.0), FLOW), Network(EQUILIBRIUM, FLOW, 3.0)])
+    assert law.kappa == EQUILIBRIUM.kappa
+    assert law.shear_modulus == pytest.approx(1.0 + 2.0 + 3.0)
+    _, A, _ = law.update(I5, law.initial_state(()), 0.0, None)
+    assert A[1, 1] == pytest.approx(law.shear_modulus, rel=1e-12)  # dP_rZ / dF_rZ

@@ -113,10 +113,11 @@ def local_system(t: np.ndarray, K: np.ndarray, rate: np.ndarray, m: float, dt: f
     dev = t - t.mean(0)
     q = np.sqrt(1.5 * (dev * dev).sum(0))
     safe = np.where(q > 0, q, 1.0)  # q = 0: dev = 0, the terms with q^(m-3) vanish
-    g = rate * safe ** (m - 1.0) * np.where(q > 0, 1.0, 0.0 if m > 1.0 else 1.0)
+    power = rate * safe ** (m - 1.0)
+    g = power * np.where(q > 0, 1.0, 0.0 if m > 1.0 else 1.0)
     flow = (1.5 * dt) * g * dev
     Kdev = K - K.mean(0)
-    dg = (m - 1.0) * rate * safe ** (m - 3.0) * 1.5 * (dev[:, None] * K).sum(0)  # dg/de (3, n)
+    dg = (1.5 * (m - 1.0)) * power / (safe * safe) * (dev[:, None] * K).sum(0)  # dg/de (3, n)
     jac = (1.5 * dt) * (g * Kdev + dev[:, None] * dg[None])
     for i in range(3):
         jac[i, i] += 1.0
@@ -126,8 +127,8 @@ def local_system(t: np.ndarray, K: np.ndarray, rate: np.ndarray, m: float, dt: f
 def scalar_guess(
     e_tr: np.ndarray, t: np.ndarray, rate: np.ndarray, m: float, dt: float
 ) -> tuple[np.ndarray, np.ndarray]:
-    """A first iterate of the local Newton (3, n) and rho (n): the solution for an elastic part linear in
-    the deviatoric log strain (2 mu_eff = t':e_tr' / e_tr':e_tr' at the predictor), e =
+    """A first iterate of the local Newton (3, n) and rho (n): the solution for an elastic part
+    linear in the deviatoric log strain (2 mu_eff = t':e_tr' / e_tr':e_tr' at the predictor), e =
     mean(e_tr) + rho e_tr', rho (1 + c rho^(m-1)) = 1, c = 3/2 dt rate q_tr^(m-1) 2 mu_eff,
     solved for u = ln(rho) (u + ln(1 + c e^((m-1) u)) = 0: convex, slope in [1, m]) by Newton
     from u = 0.  For a steep flow and a long step the plain Newton from the predictor creeps."""

@@ -44,6 +44,17 @@ class NetworkLaw:
         self.freeze = freeze
         self.shift = shift
 
+    @property
+    def kappa(self) -> float:
+        """The bulk modulus: the equilibrium law's (the networks are isochoric)."""
+        return self.equilibrium.kappa
+
+    @property
+    def shear_modulus(self) -> float:
+        """The instantaneous small-strain shear modulus: the equilibrium law's and every
+        network's (the frozen network's is 0 before any cooling)."""
+        return self.equilibrium.shear_modulus + sum(n.scale * n.law.shear_modulus for n in self.networks)
+
     def initial_state(self, shape: tuple[int, ...], T: np.ndarray | None = None) -> State:
         """Every network at rest (Cv^-1 = I) and no frozen network, arrays (*shape, 4); T (shape)
         the initial temperatures (the frozen network's reference; see Freeze.initial_state)."""
