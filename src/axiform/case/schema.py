@@ -14,6 +14,7 @@ import itertools
 import json
 import math
 import tomllib
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -234,7 +235,7 @@ def parse(data: dict[str, Any]) -> Case:
             msg = err["msg"].removeprefix("Value error, ")
             if err["type"] == "extra_forbidden":
                 msg = "unknown key"
-            lines.append(f"{_loc(err['loc'])}: {msg}{did_you_mean(Case, err, law_keys(data))}")
+            lines.append(f"{_loc(err['loc'])}: {msg}{did_you_mean(Case, dict(err), law_keys(data))}")
         raise CaseError("\n".join(dict.fromkeys(lines))) from None
 
 
@@ -248,7 +249,7 @@ def override(data: dict[str, Any], assignment: str) -> None:
         value = tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:
         value = text
-    parts = []
+    parts: list[str | int] = []
     for part in key.strip().split("."):
         name, _, index = part.partition("[")
         parts.append(name)
@@ -272,7 +273,7 @@ def override(data: dict[str, Any], assignment: str) -> None:
     node[last] = value
 
 
-def load(path: str | Path, overrides: list[str] = ()) -> Case:
+def load(path: str | Path, overrides: Sequence[str] = ()) -> Case:
     """Read and validate a TOML case file, with optional KEY=VALUE overrides."""
     return parse(read(path, overrides))
 
@@ -283,7 +284,7 @@ def fingerprint(data: dict[str, Any]) -> str:
     return hashlib.sha256(json.dumps(data, sort_keys=True, default=str).encode()).hexdigest()
 
 
-def read(path: str | Path, overrides: list[str] = ()) -> dict[str, Any]:
+def read(path: str | Path, overrides: Sequence[str] = ()) -> dict[str, Any]:
     """The tree of a TOML case file with KEY=VALUE overrides applied, not yet validated."""
     path = Path(path)
     try:
@@ -365,7 +366,7 @@ def build(case: Case, base: str | Path = ".") -> Built:
         control = build_control(model, mesh, case.solver)
         moving = any(c.motion.ur or c.motion.uz for c in case.contact)
         gas = any(c.control != "pressure" or c.pressure for c in case.cavity)
-        loads = [*case.pressure, *case.point_load, *case.fix]
+        loads: list[PressureSpec | PointLoadSpec | FixSpec] = [*case.pressure, *case.point_load, *case.fix]
         heated = case.thermal is not None and (case.convection or any(c.conductance for c in case.contact))
         if not any(item.value for item in loads) and not moving and not gas and not heated:
             raise CaseError(
