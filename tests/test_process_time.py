@@ -18,7 +18,7 @@ from conftest import RELAXING_BAR
 
 import axiform.solve.solver as solver
 from axiform.app.console import COLUMNS
-from axiform.app.sweep import monitor_extremes
+from axiform.app.sweep_rows import monitor_extremes
 from axiform.case.labels import case_labels
 from axiform.case.schema import HISTORY_COLUMNS, load, parse
 from axiform.cli import main

@@ -20,6 +20,7 @@ import signal
 import sys
 import threading
 import time
+from collections.abc import Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -168,8 +169,8 @@ class Job:
             out = resume
             state = resume_state(Path(resume), data)
         built = build(case, case_file.parent)
-        if state is not None:
-            check_fit(state, built.model, Path(resume))
+        if state is not None and out is not None:
+            check_fit(state, built.model, Path(out))
             check_resumed_target(case.solver, float(state["path"].get("lam", 0.0)))
         return cls(case_file, overrides, data, case, built, state, out)
 
@@ -223,7 +224,7 @@ def run(
     case_path: str,
     out: str | None,
     quiet: bool = False,
-    overrides: list[str] = (),
+    overrides: Sequence[str] = (),
     resume: str | None = None,
     stream=None,
 ) -> int:
@@ -404,7 +405,7 @@ def _solve(job: Job, out_dir: Path, note: str, writer, quiet: bool, stops: Stops
         status_line(status, message, job.warnings, writer.steps, writer.newton_iterations, wall, out_dir), stream=stream
     )
     if status == "interrupted":
-        return 128 + stops.signum
+        return 128 + (stops.signum or signal.SIGINT)
     return EXIT.get(status, 1)
 
 

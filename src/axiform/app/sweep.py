@@ -34,7 +34,6 @@ import csv
 import datetime
 import io
 import itertools
-import json
 import math
 import os
 import sys
@@ -47,10 +46,12 @@ from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, Field, StrictStr, ValidationError, field_validator, model_validator
 
-from ..case.schema import HISTORY_COLUMNS, CaseError, build, fingerprint, parse, read
+from ..case.schema import CaseError, build, fingerprint, parse, read
 from ..io.text import MAX_CASE_BYTES, FileTooLarge, read_text
 from ..post.sweep_plots import plot_sweep
+from ..post.sweep_plots import value_text as toml_value
 from .console import ProgressLine
+from .sweep_rows import summary_row
 
 SWEEP_KEYS = ("case", "vary", "cases", "report")
 # the most cases a sweep may have: a [vary] of many long lists is refused at once, not
@@ -59,26 +60,6 @@ MAX_CASES = 10_000
 FIXED_COLUMNS = ("status", "exit_code", "steps", "load_factor", "wall_time_s", "message")
 # one math library thread per worker: the workers already fill the cores
 WORKER_ENV = {v: "1" for v in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")}
-
-
-def toml_value(value: Any) -> str:
-    """A value (as tomllib reads it) as one line of TOML, for KEY=VALUE overrides and labels:
-    tables inline ({ along = "r", table = [[0.0, 150.0], ...] }), arrays on one line, every
-    scalar as tomli-w writes it (a string of tomli-w's has no line break: it writes one as
-    the escape \\n)."""
-    import tomli_w
-
-    if isinstance(value, dict):
-        items = [f"{_toml_key(str(k))} = {toml_value(v)}" for k, v in value.items()]
-        return "{ " + ", ".join(items) + " }" if items else "{}"
-    if isinstance(value, list):
-        return "[" + ", ".join(toml_value(v) for v in value) + "]"
-    return tomli_w.dumps({"v": value}).removeprefix("v = ").removesuffix("\n")
-
-
-def _toml_key(key: str) -> str:
-    """A key of an inline table: bare where TOML allows, else quoted."""
-    return key if key and all(c.isascii() and (c.isalnum() or c in "_-") for c in key) else json.dumps(key)
 
 
 class _Report(BaseModel):
@@ -171,6 +152,21 @@ def load_sweep(path: str | Path) -> Sweep:
     case_file = (path.parent / spec.case).resolve()
     if not case_file.is_file():
         raise CaseError(f"case: no such file {case_file}")
+    keys, cases = _cases(spec)
+    monitors = _check_cases(case_file, cases, "vary" if spec.vary is not None else "cases")
+    monitor = spec.report.monitor
+    if monitor is not None and monitor not in monitors:
+        raise CaseError(
+            f"report.monitor: the case has no monitor {monitor!r} (it has: {', '.join(monitors) or 'none'})"
+        )
+    return Sweep(
+        case_file, keys, cases, monitor if monitor is not None else (monitors[0] if monitors else None), monitors
+    )
+
+
+def _cases(spec: SweepFile) -> tuple[list[str], list[dict[str, Any]]]:
+    """The varied keys and the overrides of every case of a sweep file (a full factorial of
+    [vary], or the [[cases]]); CaseError for a date as a value or too many cases."""
     if spec.vary is not None:
         for key, values in spec.vary.items():
             if any(_has_date(v) for v in values):
@@ -179,35 +175,33 @@ def load_sweep(path: str | Path) -> Sweep:
         if n > MAX_CASES:
             raise CaseError(f"vary: {n:,} cases (the product of the list lengths); at most {MAX_CASES:,}")
         keys = list(spec.vary)
-        cases = [dict(zip(keys, combo, strict=False)) for combo in itertools.product(*spec.vary.values())]
-    else:
-        for i, case in enumerate(spec.cases):
-            for key, value in case.items():
-                if _has_date(value):
-                    raise CaseError(f"cases[{i}].{key}: a date or time is not a case value")
-        if len(spec.cases) > MAX_CASES:
-            raise CaseError(f"cases: {len(spec.cases):,} cases; at most {MAX_CASES:,}")
-        cases = [dict(c) for c in spec.cases]
-        keys = list(dict.fromkeys(k for c in cases for k in c))
-    monitor = spec.report.monitor
-    monitors = None
-    where = "vary" if spec.vary is not None else "cases"
+        return keys, [dict(zip(keys, combo, strict=True)) for combo in itertools.product(*spec.vary.values())]
+    listed = spec.cases or []
+    for i, case in enumerate(listed):
+        for key, value in case.items():
+            if _has_date(value):
+                raise CaseError(f"cases[{i}].{key}: a date or time is not a case value")
+    if len(listed) > MAX_CASES:
+        raise CaseError(f"cases: {len(listed):,} cases; at most {MAX_CASES:,}")
+    cases = [dict(c) for c in listed]
+    return list(dict.fromkeys(k for c in cases for k in c)), cases
+
+
+def _check_cases(case_file: Path, cases: list[dict[str, Any]], where: str) -> list[str]:
+    """Read, validate and build every case (what only the model finds, a temperature below
+    the WLF pole, is found before any case runs); CaseError naming the first invalid one.
+    Returns the monitors of the case."""
+    monitors: list[str] | None = None
     for k, case in enumerate(cases):
         sets = [f"{key}={toml_value(v)}" for key, v in case.items()]
-        try:  # built too: what only the model finds (a temperature below the WLF pole) is found now
+        try:
             parsed = parse(read(case_file, sets))
             build(parsed, case_file.parent)
         except CaseError as exc:
             text = ", ".join(f"{key} = {toml_value(v)}" for key, v in case.items())
             raise CaseError(f"{where}: case {k + 1} ({text}) is invalid:\n{exc}") from None
         monitors = monitors if monitors is not None else [m.name for m in parsed.monitor]
-    if monitor is not None and monitor not in monitors:
-        raise CaseError(
-            f"report.monitor: the case has no monitor {monitor!r} (it has: {', '.join(monitors) or 'none'})"
-        )
-    return Sweep(
-        case_file, keys, cases, monitor if monitor is not None else (monitors[0] if monitors else None), monitors
-    )
+    return monitors or []
 
 
 def run_case(case_file: str, overrides: list[str], out: str) -> dict[str, Any]:
@@ -236,47 +230,6 @@ def run_case(case_file: str, overrides: list[str], out: str) -> dict[str, Any]:
         row["message"] = " ".join(said.getvalue().split())
     row.setdefault("wall_time_s", time.perf_counter() - t0)
     return row
-
-
-def summary_row(folder: Path) -> dict[str, Any]:
-    """status, steps, the final load_factor, wall_time_s, message, the monitors and the thinnest wall of a results
-    folder's summary.json, and every monitor's (min, max) over the run from its history.csv
-    ({} when it has no summary.json)."""
-    try:
-        s = json.loads((folder / "summary.json").read_text())
-    except (OSError, ValueError):
-        return {}
-    return {
-        "status": s.get("status"),
-        "steps": s.get("steps"),
-        "load_factor": s.get("load_factor"),
-        "wall_time_s": s.get("wall_time_s"),
-        "message": s.get("message", ""),
-        "monitors": s.get("monitors", {}),
-        "sha256": s.get("case", {}).get("sha256"),
-        "thickness_min": (s.get("thickness") or {}).get("min"),
-        "extremes": monitor_extremes(folder / "history.csv"),
-    }
-
-
-def monitor_extremes(history: Path) -> dict[str, tuple[float, float]]:
-    """(min, max) of every monitor column (not one of HISTORY_COLUMNS) of a history.csv over
-    its rows; {} without one."""
-    try:
-        with open(history, newline="") as fh:
-            rows = list(csv.reader(fh))
-    except OSError:
-        return {}
-    if len(rows) < 2:
-        return {}
-    extremes = {}
-    for k, name in enumerate(rows[0]):
-        if name in HISTORY_COLUMNS:
-            continue
-        values = [float(r[k]) for r in rows[1:] if len(r) > k and r[k]]
-        if values:
-            extremes[name] = (min(values), max(values))
-    return extremes
 
 
 class SweepProgress:
@@ -393,8 +346,8 @@ def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: 
         if done.get("status") == "finished" and done.get("sha256") == fingerprint(
             read(sweep.case_file, sweep.overrides(k))
         ):
-            rows[k] = done | {"exit_code": 0}
-            progress(folders[k].name, rows[k], skipped=True)
+            row = rows[k] = done | {"exit_code": 0}
+            progress(folders[k].name, row, skipped=True)
         else:
             todo.append(k)
     print(f"axiform sweep: {n} cases of {sweep.case_file.name}, {len(todo)} to run -> {root}", file=say)
@@ -418,10 +371,11 @@ def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: 
             for future in as_completed(futures):
                 k = futures[future]
                 try:
-                    rows[k] = future.result()
+                    row = future.result()
                 except Exception as exc:  # noqa: BLE001 - a worker died or was lost: the row says so
-                    rows[k] = {"status": "failed", "exit_code": 3, "message": f"{type(exc).__name__}: {exc}"}
-                progress(folders[k].name, rows[k])
+                    row = {"status": "failed", "exit_code": 3, "message": f"{type(exc).__name__}: {exc}"}
+                rows[k] = row
+                progress(folders[k].name, row)
                 write_table(root / "sweep.csv", sweep, rows)
         finally:
             client.close()
@@ -432,7 +386,7 @@ def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: 
         plot_sweep(root / "sweep.png", sweep, rows)
     except Exception as exc:  # noqa: BLE001 - the cases and sweep.csv stand; say why the picture does not
         print(f"axiform sweep: sweep.png not written ({type(exc).__name__}: {exc})", file=say)
-    bad = [f"{k + 1:04d}" for k, r in enumerate(rows) if r.get("status") != "finished"]
+    bad = [f"{k + 1:04d}" for k, r in enumerate(rows) if (r or {}).get("status") != "finished"]
     print(
         f"axiform sweep: {n - len(bad)} of {n} cases finished"
         + (f"; not finished: {', '.join(bad)}" if bad else "")

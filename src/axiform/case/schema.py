@@ -14,6 +14,7 @@ import itertools
 import json
 import math
 import tomllib
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -238,7 +239,7 @@ def parse(data: dict[str, Any]) -> Case:
             msg = err["msg"].removeprefix("Value error, ")
             if err["type"] == "extra_forbidden":
                 msg = "unknown key"
-            lines.append(f"{_loc(err['loc'])}: {msg}{did_you_mean(Case, err, law_keys(data))}")
+            lines.append(f"{_loc(err['loc'])}: {msg}{did_you_mean(Case, dict(err), law_keys(data))}")
         raise CaseError("\n".join(dict.fromkeys(lines))) from None
 
 
@@ -252,7 +253,7 @@ def override(data: dict[str, Any], assignment: str) -> None:
         value = tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:
         value = text
-    parts = []
+    parts: list[str | int] = []
     for part in key.strip().split("."):
         name, _, index = part.partition("[")
         parts.append(name)
@@ -276,7 +277,7 @@ def override(data: dict[str, Any], assignment: str) -> None:
     node[last] = value
 
 
-def load(path: str | Path, overrides: list[str] = ()) -> Case:
+def load(path: str | Path, overrides: Sequence[str] = ()) -> Case:
     """Read and validate a TOML case file, with optional KEY=VALUE overrides."""
     return parse(read(path, overrides))
 
@@ -287,7 +288,7 @@ def fingerprint(data: dict[str, Any]) -> str:
     return hashlib.sha256(json.dumps(data, sort_keys=True, default=str).encode()).hexdigest()
 
 
-def read(path: str | Path, overrides: list[str] = ()) -> dict[str, Any]:
+def read(path: str | Path, overrides: Sequence[str] = ()) -> dict[str, Any]:
     """The tree of a TOML case file with KEY=VALUE overrides applied, not yet validated."""
     path = Path(path)
     try:
@@ -328,7 +329,7 @@ def _loaded(case: Case) -> bool:
     a moving mould, a loaded cavity, heat flowing in or out, the body's weight."""
     moving = any(c.motion.ur or c.motion.uz for c in case.contact)
     gas = any(c.control != "pressure" or c.pressure for c in case.cavity)
-    loads = [*case.pressure, *case.point_load, *case.fix]
+    loads: list[PressureSpec | PointLoadSpec | FixSpec] = [*case.pressure, *case.point_load, *case.fix]
     heated = case.thermal is not None and bool(case.convection or any(c.conductance for c in case.contact))
     weight = case.gravity is not None and case.gravity.g != 0.0
     return any(item.value for item in loads) or moving or gas or heated or weight

@@ -80,13 +80,16 @@ def build_control(model: Model, mesh: Mesh, spec: SolverSpec) -> LoadControl | D
             "cavity under volume or gas control, or a prescribed motion with its curve"
         )
     if spec.control == "displacement":
-        if spec.dof.dof == "rot":
+        driven, target = spec.dof, spec.target
+        if driven is None or target is None:  # SolverSpec refuses it: for the type checker
+            raise CaseError("solver: displacement control needs 'dof' and 'target'")
+        if driven.dof == "rot":
             raise CaseError("solver.dof.dof: drive a displacement (ur or uz), not a fibre rotation")
-        node = one_node(mesh, spec.dof.at, "solver.dof.at")
-        dof = int(model.dof(node, spec.dof.dof))
+        node = one_node(mesh, driven.at, "solver.dof.at")
+        dof = int(model.dof(node, driven.dof))
         if dof in model.fixed:
             raise CaseError("solver.dof: the driven dof is also fixed by a [[fix]] table")
-        return DisplacementControl(dof, spec.target, spec.steps)
+        return DisplacementControl(dof, target, spec.steps)
     if spec.control == "arc-length":
         stop_dof = stop_value = None
         if spec.stop is not None:

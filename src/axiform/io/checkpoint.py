@@ -88,7 +88,7 @@ def save(folder: str | Path, checkpoint: dict, meta: dict) -> Path:
     target = folder / FILE
     tmp = folder / f".{FILE}.tmp"
     with open(tmp, "wb") as fh:
-        np.savez(fh, __layout__=np.array(text), **arrays)
+        np.savez(fh, __layout__=np.array(text), **arrays)  # type: ignore[arg-type]  # numpy's stub: allow_pickle
         fh.flush()
         os.fsync(fh.fileno())
     tmp.replace(target)

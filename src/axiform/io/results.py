@@ -28,99 +28,15 @@ import numpy as np
 
 from ..post.fields import point_fields, with_components
 from ..post.thickness import thickness_table, write_thickness_csv
-from ..solve.controls import Step
 from . import gid
 from .columns import HISTORY_COLUMNS
 from .files import atomic, contact_table, mould_outlines, write_atomic, write_pvd, write_vtu
-from .run_report import RunRecord, column_units, thickness_summary
-
-
-def initial_step(model) -> Step:
-    """The state a run starts from (step 0, t = 0), as a step for the monitors: the
-    displacements prescribed at t = 0, no reactions, the model's initial history (its
-    temperatures, untouched contact pairs, cavities at their initial volume)."""
-    u_f = np.zeros(model.n_free)
-    u = model.expand(u_f, 0.0)
-    return Step(0, 0.0, 0, [], u_f, u, np.zeros_like(u), None, model.initial_state())
+from .folder_start import clear_folder, initial_step, initial_summary, read_summary
+from .run_report import RunRecord, thickness_summary
 
 
 class NonFiniteResult(ArithmeticError):
     """A converged step holds NaN or inf: it is not written; the message names the place."""
-
-
-def initial_summary(model, title: str, labels: dict | None, case: dict | None, warnings: Sequence[str]) -> dict:
-    """summary.json before the first step: the model's size, the labels (units, load,
-    monitor_quantities), the case's origin and fingerprint, the pre-run warnings."""
-    summary = {
-        "title": title,
-        "status": "running",
-        "steps": 0,
-        "newton_iterations": 0,
-        "wall_time_s": 0.0,
-        "dofs": int(model.dofmap.n_eq),
-        "free_dofs": int(model.n_free),
-        "elements": int(model.mesh.n_cells),
-        "nodes": int(model.mesh.n_nodes),
-        "element": model.mesh.element.name,
-        "load_factor": 0.0,
-        "monitors": {},
-        "units": {},
-        "load": None,
-        "monitor_quantities": {},
-        "warnings": list(dict.fromkeys(" ".join(str(w).split()) for w in warnings)),
-    }
-    summary.update(labels or {})
-    if case is not None:  # where the case came from and its fingerprint (the folder rule)
-        summary["case"] = case
-    summary["column_units"] = column_units(summary)
-    return summary
-
-
-def _read_summary(out: Path) -> dict:
-    try:
-        return json.loads((out / "summary.json").read_text())
-    except (OSError, ValueError):
-        return {}
-
-
-STALE = (
-    "thickness.csv",
-    "contact.csv",
-    "surfaces.csv",
-    "fields.pvd",
-    "revolved.vtu",
-    "load_curve.png",
-    "thickness.png",
-    "deformed.png",
-    "forming.gif",
-)
-
-
-def clear_folder(out: Path, times: dict[int, float], vtu: bool, thickness_steps: bool) -> list[tuple[int, float, str]]:
-    """Make the folders; remove the temporary files, the per-step files after the last step
-    kept (times: the time t of each step kept, {} for a new run) and the files written at the
-    end of a run (STALE).  Returns the fields.pvd entries (step, t, file) of the VTU files
-    kept (a resumed run)."""
-    kept = max(times, default=0)
-    for tmp in out.glob(".*.tmp"):
-        tmp.unlink()
-    if vtu:
-        (out / "fields").mkdir(exist_ok=True)
-    for old in [
-        *(out / "fields").glob("step_*.vtu"),
-        *(out / "fields").glob("surfaces_*.csv"),
-        *(out / "thickness").glob("step_*.csv"),
-    ]:
-        if int(old.stem.split("_")[-1]) > kept:
-            old.unlink()
-    if thickness_steps:
-        (out / "thickness").mkdir(exist_ok=True)
-    for stale in STALE:
-        (out / stale).unlink(missing_ok=True)
-    if not (kept and vtu):
-        return []
-    steps = sorted(int(f.stem.split("_")[-1]) for f in (out / "fields").glob("step_*.vtu"))
-    return [(n, times[n], f"fields/step_{n:04d}.vtu") for n in steps]
 
 
 class ResultsWriter:
@@ -194,7 +110,7 @@ class ResultsWriter:
         self._history = io.StringIO()
         self._csv = csv.writer(self._history, lineterminator="\n")
         self._csv.writerow(header)
-        earlier = _read_summary(self.out).get("contact") if resume is not None else None  # the run's maxima so far
+        earlier = read_summary(self.out).get("contact") if resume is not None else None  # the run's maxima so far
         times = self._resume(resume, header) if resume is not None else {}
         if resume is None:
             self._csv.writerow(self._row(initial_step(self.model), self._values(initial_step(self.model))))

@@ -243,7 +243,7 @@ def _draw_pressures(ax, case, model, size: float, units: dict[str, str]) -> None
     arrow = ARROW * size
     for i, (spec, p) in enumerate(zip(case.pressure, model.pressures, strict=False)):
         a, b = X[p.nodes[:, 0]], X[p.nodes[:, 1]]
-        ax.add_collection(LineCollection(_face(X, p.nodes), colors=COLOURS["pressure"], lw=2.0))
+        ax.add_collection(LineCollection(list(_face(X, p.nodes)), colors=COLOURS["pressure"], lw=2.0))
         mid = X[p.nodes[:, 2]] if p.nodes.shape[1] == 3 else 0.5 * (a + b)
         t = b - a
         out = np.column_stack([t[:, 1], -t[:, 0]]) / np.linalg.norm(t, axis=1)[:, None]
@@ -298,7 +298,7 @@ def _draw_cavities(ax, case, model) -> None:
     for spec, cav in zip(case.cavity, model.cavities, strict=False):
         ax.add_collection(
             LineCollection(
-                _face(X, cav.nodes),
+                list(_face(X, cav.nodes)),
                 colors=COLOURS["cavity"],
                 lw=3.5,
                 alpha=0.8,
@@ -318,7 +318,7 @@ def _draw_moulds(ax, model, moulds, size: float, t_end: float) -> None:
         ax.plot(pts[:, 0], pts[:, 1], "-", color=colour, lw=1.8, label=f"{name}, ticks towards its body")
         p, n = _mould_normals(pair.surface, TICK_SPACING * size)
         p = p + pair.surface.offset(0.0)
-        ax.add_collection(LineCollection(np.stack([p, p + TICK * size * n], axis=1), colors=colour, lw=0.8))
+        ax.add_collection(LineCollection(list(np.stack([p, p + TICK * size * n], axis=1)), colors=colour, lw=0.8))
         if end is not None:
             ax.plot(end[:, 0], end[:, 1], ":", color=colour, lw=1.2, label=f"{name} at t = {t_end:g}")
 

@@ -98,7 +98,7 @@ class FolderInfo:
         """'step 40, p = 33.4 psi': the step and its load, rounded; with the time t where the
         case is timed ('step 40, t = 1.2 s, p = ...'), first where it is a physical time
         ('t = 0.35 s, step 40, ...')."""
-        rows = np.flatnonzero(history.get("step", np.array([])) == step) if history else []
+        rows = np.flatnonzero(history.get("step", np.array([])) == step) if history else np.array([], int)
         if len(rows) == 0:
             return f"step {step}"
         value = self.load_of(history)[rows[0]]
@@ -125,7 +125,9 @@ def read_history(path: Path) -> dict[str, np.ndarray]:
     with open(path, newline="") as fh:
         reader = csv.reader(fh)
         header = next(reader, None)
-        rows = []
+        if header is None:  # an empty file
+            return {}
+        rows: list[list[float]] = []
         for row in reader:
             if not row:  # a blank line
                 continue
@@ -149,7 +151,7 @@ def written_steps(folder: Path) -> list[Path]:
     pvd = Path(folder) / "fields.pvd"
     if not pvd.exists():
         return []
-    return [Path(folder) / d.get("file") for d in ET.parse(pvd).getroot().iter("DataSet")]
+    return [Path(folder) / d.get("file", "") for d in ET.parse(pvd).getroot().iter("DataSet")]
 
 
 def last_vtu(folder: Path) -> Path | None:

@@ -6,6 +6,7 @@ as a flat line."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -32,13 +33,24 @@ class Sweep(Protocol):
 
 
 def value_text(value: Any) -> str:
-    """A value (as tomllib reads it) as one line of TOML: tomli-w's text of it, its arrays
-    joined on one line (the same text as axiform.app.sweep.toml_value, which the overrides use)."""
+    """A value (as tomllib reads it) as one line of TOML, for the KEY=VALUE overrides of a sweep
+    (app.sweep.toml_value) and its labels:
+    tables inline ({ along = "r", table = [[0.0, 150.0], ...] }), arrays on one line, every
+    scalar as tomli-w writes it (a string of tomli-w's has no line break: it writes one as
+    the escape \\n)."""
     import tomli_w
 
-    text = tomli_w.dumps({"v": [value]}, indent=0)  # in an array: a table is written inline
-    text = text.removeprefix("v = [\n").removesuffix(",\n]\n")
-    return text.replace("[\n", "[").replace(",\n]", "]").replace(",\n", ", ")
+    if isinstance(value, dict):
+        items = [f"{_toml_key(str(k))} = {value_text(v)}" for k, v in value.items()]
+        return "{ " + ", ".join(items) + " }" if items else "{}"
+    if isinstance(value, list):
+        return "[" + ", ".join(value_text(v) for v in value) + "]"
+    return tomli_w.dumps({"v": value}).removeprefix("v = ").removesuffix("\n")
+
+
+def _toml_key(key: str) -> str:
+    """A key of an inline table: bare where TOML allows, else quoted."""
+    return key if key and all(c.isascii() and (c.isalnum() or c in "_-") for c in key) else json.dumps(key)
 
 
 def _text(value: Any) -> str:
