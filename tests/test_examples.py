@@ -110,7 +110,7 @@ def wall_volume(x, cells):
 
 
 def test_parison_bottle_keeps_its_wall_and_balances_the_mould(tmp_path):
-    """Blown to 84600 mm^3 (the cavity's constraint), what the constraint does not impose:
+    """Blown to 84500 mm^3 (the cavity's constraint), what the constraint does not impose:
     the wall's volume, measured on its deformed edges, is kept by the near incompressibility
     (kappa = 1000 C1): squeezed by the gas against the mould, it loses less than p / kappa
     (0.48 % measured, p / kappa = 0.68 %; 0.90 % with half the kappa); and along z the mould's
@@ -132,7 +132,7 @@ def test_parison_bottle_keeps_its_wall_and_balances_the_mould(tmp_path):
     change = wall_volume(x, mesh.cells) / wall_volume(mesh.points, mesh.cells) - 1.0
     p, kappa = v["pressure"], data["material"]["kappa"]
     assert 0.2 < p < 5.0 and -p / kappa < change < 0.0, (p, change)
-    assert v["volume"] == pytest.approx(84600.0, rel=1e-8)
+    assert v["volume"] == pytest.approx(84500.0, rel=1e-8)
     assert v["pinch_z"] + v["neck_z"] + v["mould_z"] == pytest.approx(0.0, abs=1e-7 * abs(v["mould_z"]))
     assert abs(v["mould_z"]) > 100.0
 

@@ -3,13 +3,20 @@ law (eqs. 40-41) rounded over a band of gaps, Coulomb friction with a tangential
 a rounded stick/slip corner (eqs. 42-45), sticky ties, and the damping traction of the contact
 stabilization.  Arrays over the slave nodes (n,), vectorized; nothing kept between calls.
 
-Augmented Lagrange: the normal law and the sticky ties carry the traction of the last
-converged step (the multipliers of the history, ContactState.multiplier and .tie) and add the
-penalty of the gap to it: fn = law(g - lambda / kn), ~ lambda - kn g, and t_tie = lambda_tie
-- kn (x - x_stuck).  At the end of every converged step the multipliers take the step's
-traction (`updated_multipliers`, Uzawa's update), so that the penalty carries only the change
-of traction over one step: the penetration left is that change over kn, not the whole
-pressure over kn, and it shrinks again at the next step where the pressure holds."""
+Augmented Lagrange: the normal law carries the normal traction of the last converged step
+(the multiplier of the history, ContactState.multiplier) and adds the penalty of the gap to
+it: fn = law(g - lambda / kn), ~ lambda - kn g.  At the end of every converged step the
+multiplier takes the step's traction (`updated_multipliers`, Uzawa's update), so that the
+penalty carries only the change of traction over one step: the penetration left is that
+change over kn, not the whole pressure over kn, and it shrinks again at the next step where
+the pressure holds.
+
+A sticky node's tie is a spring TIE times the normal penalty, anchored where it pulls as the
+normal law pushed when the node froze (the force does not jump there): a linear spring, whose
+stiffness costs Newton next to nothing, where a tie updated like the multiplier would move a
+frozen wall at every step with no change of load (a path followed by arc length then turns
+back).  A node frozen under a contact pressure p keeps its penetration of that step and adds
+a tenth of the penalty's for the pressure after."""
 
 from __future__ import annotations
 
@@ -18,6 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .state import ContactState
+
+TIE = 10.0  # a sticky node's tie: this many times the normal penalty (see the module)
 
 
 def outer(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -91,29 +100,19 @@ def traction(law: Law, x: np.ndarray, proj, state: ContactState, resting: bool) 
     if law.mu > 0 and not law.sticky:
         slip_state = _friction(law, proj, state, contact, fn, dfn, f, K, status)
     if law.sticky:
-        tie = stuck * kn  # the penalty of the tied nodes, 0 elsewhere (whose stuck point is 0)
+        tie = stuck * (TIE * kn)  # the tied nodes' spring, 0 elsewhere (whose stuck point is 0)
         f -= tie[:, None] * (x - state.stuck_point)
-        f += stuck[:, None] * state.tie
         K[:, 0, 0] -= tie
         K[:, 1, 1] -= tie
         status[stuck] = 3
     return Traction(f, K, status, slip_state, fn)
 
 
-def updated_multipliers(
-    kn: np.ndarray, state: ContactState, law: Traction, proj, x: np.ndarray, new: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
+def updated_multipliers(state: ContactState, law: Traction, new: np.ndarray) -> np.ndarray:
     """Uzawa's update at the end of a converged step: the normal multiplier (n,) takes the
-    step's normal traction fn (zero where a node left the surface), the tie of a tied node
-    (n, 2) its tie's traction at x (n, 2).  A node tied at this step (`new`, its point the
-    contact point x - g n) starts with the part of its normal traction the tie at x does not
-    already give, (fn + kn g) n (the old multiplier, about), so that the force does not jump
-    as it freezes; never a pull."""
-    multiplier = np.where(state.stuck | new, 0.0, law.fn)
-    tie = np.where(state.stuck[:, None], state.tie - kn[:, None] * (x - state.stuck_point), 0.0)
-    carried = np.maximum(law.fn + kn * proj.g, 0.0)
-    tie = np.where(new[:, None], carried[:, None] * proj.n, tie)
-    return multiplier, tie
+    step's normal traction fn (zero where a node left the surface, and for the nodes tied,
+    `state.stuck`, or tied at this step, `new`)."""
+    return np.where(state.stuck | new, 0.0, law.fn)
 
 
 def _friction(law: Law, proj, state: ContactState, contact, fn, dfn, f, K, status) -> tuple:

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..fem.mesh import Mesh
 from .guard import guard_forces
-from .law import Law, Traction, damping, traction, updated_multipliers
+from .law import TIE, Law, Traction, damping, traction, updated_multipliers
 from .report import pair_report
 from .rings import edge_heights, pole_rows, ring_areas, slave_edges
 from .state import ContactSeen, ContactState, ContactTrial
@@ -51,7 +51,7 @@ class ContactPair:
     step over the penalty, and shrinks again where the pressure holds.  tangential_penalty
     defaults to the normal one (and follows the same thinning when that is the default).
     friction: Coulomb coefficient mu (0: frictionless).
-    sticky: a node that touches is tied to the point where it touched.  depth: how deep
+    sticky: a node that touches is tied (contact.law, TIE) to the point where it touched.  depth: how deep
     behind the surface a node is still taken as touching it (nodes deeper were not in
     contact at the last converged step and did not cross the surface since).  smoothing:
     the penalty law is rounded over gaps in [-smoothing, 0] (fn = kn g^2 / 2d there,
@@ -197,7 +197,6 @@ class ContactPair:
             np.zeros((n, 2)),
             np.full(n, np.nan),
             np.zeros(n),
-            np.zeros((n, 2)),
         )
 
     def dofs(self, dpn: int) -> np.ndarray:
@@ -289,7 +288,6 @@ class ContactPair:
             state.stuck_point,
             state.first_contact,
             np.zeros(n),
-            state.tie,
             seen,
             state.damping_work,
         )
@@ -380,11 +378,12 @@ class ContactPair:
         if self.sticky:
             new = status == 1
             stuck_point = stuck_point.copy()
-            stuck_point[new] = x[new] - proj.g[new, None] * proj.n[new]
+            # where the tie pulls as the normal law pushed: the force does not jump as it freezes
+            stuck_point[new] = x[new] + (law.fn[new] / (TIE * self.kn0[new]))[:, None] * proj.n[new]
             stuck = stuck | new
         first = np.where((status > 0) & np.isnan(state.first_contact), lam, state.first_contact)
-        multiplier, tie = updated_multipliers(self.kn0, state, law, proj, x, new)
-        return ContactState(self.nodes, x.copy(), s_stick, stuck, stuck_point, first, multiplier, tie, seen, work)
+        multiplier = updated_multipliers(state, law, new)
+        return ContactState(self.nodes, x.copy(), s_stick, stuck, stuck_point, first, multiplier, seen, work)
 
     def report(self, state: ContactState) -> dict:
         """Per node of the committed `state`'s evaluation: current (r, z) in the global frame, gap, contact

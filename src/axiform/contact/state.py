@@ -32,9 +32,8 @@ class ContactState:
     """The history of a pair, per slave node (n,), as of one converged step: positions for
     the crossing test x_prev (n, 2) (surface frame), friction stick points s_stick (NaN:
     none), sticky nodes and their points, the time of first contact (NaN: never), the
-    augmented Lagrange multipliers (the normal traction `multiplier` (n,) and the sticky
-    ties' traction `tie` (n, 2) of the last converged step, per unit of the pair's weighted
-    area, see contact.law); and what
+    augmented Lagrange multiplier (the normal traction `multiplier` (n,) of the last
+    converged step, per unit of the pair's weighted area, see contact.law); and what
     the step's evaluation found (`seen`, None before the first step and after a restart),
     and the energy the contact stabilization has dissipated.
     Immutable: an evaluation returns a new (trial) state, the solver keeps the committed one."""
@@ -46,12 +45,11 @@ class ContactState:
     stuck_point: np.ndarray
     first_contact: np.ndarray
     multiplier: np.ndarray
-    tie: np.ndarray
     seen: ContactSeen | None = None
     damping_work: float = 0.0  # the energy the contact stabilization dissipated so far
 
-    HISTORY = ("x_prev", "s_stick", "stuck", "stuck_point", "first_contact", "multiplier", "tie", "damping_work")
-    LATER = ("multiplier", "tie")  # history a checkpoint may lack (written before they were kept): zero
+    HISTORY = ("x_prev", "s_stick", "stuck", "stuck_point", "first_contact", "multiplier", "damping_work")
+    LATER = ("multiplier",)  # history a checkpoint may lack (written before they were kept): zero
 
     def to_dict(self) -> dict[str, np.ndarray]:
         """The history arrays (a checkpoint)."""
