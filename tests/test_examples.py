@@ -16,6 +16,7 @@ from scipy import optimize
 from axiform import Ogden
 from axiform.case.schema import build, parse
 from axiform.cli import main
+from axiform.post.fields import point_fields
 from axiform.solve.solver import solve
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -111,11 +112,12 @@ def wall_volume(x, cells):
 
 def test_parison_bottle_keeps_its_wall_and_balances_the_mould(tmp_path):
     """Blown to 84500 mm^3 (the cavity's constraint), what the constraint does not impose:
-    the wall's volume, measured on its deformed edges, is kept by the near incompressibility
-    (kappa = 1000 C1): squeezed by the gas against the mould, it loses less than p / kappa
-    (0.48 % measured, p / kappa = 0.68 %; 0.90 % with half the kappa); and along z the mould's
-    force is carried by the pinch and the neck (whose reaction holds the gas's load on the
-    closing plane, p pi r^2: the wall and the plane together take none)."""
+    the wall's volume, measured on its deformed edges, follows the bulk law of its material:
+    stretched by the gas into a membrane in tension, the wall grows by -p_h / kappa with p_h
+    its mean hydrostatic pressure (tension: p_h < 0; 0.14 % measured against 0.13 % from the
+    stress); and along z the mould's force is carried by the pinch and the neck (whose
+    reaction holds the gas's load on the closing plane, p pi r^2: the wall and the plane
+    together take none)."""
     data = tomllib.loads((EXAMPLES / "parison_bottle.toml").read_text())
     data["monitor"] += [
         {"name": "pinch_z", "reaction": {"set": "start"}, "dof": "uz"},
@@ -131,10 +133,12 @@ def test_parison_bottle_keeps_its_wall_and_balances_the_mould(tmp_path):
     x = mesh.points + res.last.u.reshape(-1, 2)
     change = wall_volume(x, mesh.cells) / wall_volume(mesh.points, mesh.cells) - 1.0
     p, kappa = v["pressure"], data["material"]["kappa"]
-    assert 0.2 < p < 5.0 and -p / kappa < change < 0.0, (p, change)
+    p_h = point_fields(built.model, res.last.u, res.last.state)["hydrostatic_pressure"].mean()
+    assert 0.05 < p < 5.0 and p_h < 0.0, (p, p_h)
+    assert change == pytest.approx(-p_h / kappa, rel=0.3), (change, -p_h / kappa)
     assert v["volume"] == pytest.approx(84500.0, rel=1e-8)
     assert v["pinch_z"] + v["neck_z"] + v["mould_z"] == pytest.approx(0.0, abs=1e-7 * abs(v["mould_z"]))
-    assert abs(v["mould_z"]) > 100.0
+    assert abs(v["mould_z"]) > 10.0  # the mould carries a share (62 N measured)
 
 
 def test_toric_plate_rim_carries_the_pressure_less_the_torus(tmp_path):
