@@ -349,7 +349,7 @@ def main(argv=None) -> int:
     levels = [2, 4, 8] if args.quick else [int(v) for v in args.reference_levels.split(",")]
     repeat = 1 if args.quick else max(1, args.repeat)
     ccx_mesh = "2x20" if args.quick and args.ccx_mesh == "8x80" else args.ccx_mesh
-    ref_solver = "umfpack" if peers.umfpack_available() else "colamd"
+    ref_solver = "shipped"  # axiform's own factorization (PARDISO where MKL is installed): the same curves
     t_start = time.perf_counter()
     print(
         f"element study: meshes {list(base)} + same, {args.steps} steps, {repeat} repeat(s); "
