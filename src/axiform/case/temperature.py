@@ -198,7 +198,7 @@ def boundary_temperatures(case) -> list[tuple[str, float, str]]:
 
 
 def check_boundary_temperatures(case, shift: Shift | None) -> None:
-    """CaseError naming the key of the first mould or film temperature at or below the
+    """CaseError naming the key of the coldest mould or film temperature at or below the
     shift's pole: heat conduction would carry the wall there (the maximum principle bounds
     it by the boundary temperatures, not above them), where a_T is not defined (past the WLF
     pole the coldest material would relax the fastest)."""
@@ -217,7 +217,7 @@ def check_boundary_temperatures(case, shift: Shift | None) -> None:
 
 def give_temperature(model: Model, mesh: Mesh, case) -> None:
     """Give the model the initial temperature field and the shift of [temperature] (case.
-    temperature, not None), after checking every temperature the case can reach against the
+    temperature, not None), and check every other temperature the case can reach against the
     shift's domain; CaseError naming the key."""
     heat = case.temperature
     shift = heat.build_shift(case.units.temperature)
