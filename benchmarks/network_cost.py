@@ -12,7 +12,7 @@ has flowed (Cv^-1 != I, not coaxial with the present F):
   relaxing within the step), P, A and the trial state;
 - the network with freezing too (a cooling step: H grows).
 Process CPU time, single-threaded, the median of interleaved repeats; the ratio to the elastic
-law; the local Newton's law evaluations per point.
+law; the local Newton's evaluations of the network's law per chunk of points.
 
     python benchmarks/network_cost.py            # about a minute
     python benchmarks/network_cost.py --quick    # smoke run (1e4 points, 3 repeats)
@@ -33,7 +33,7 @@ import numpy as np
 from axiform.materials import MooneyRivlin
 from axiform.materials.freeze import Freeze
 from axiform.materials.network import BergstromBoyce, Network
-from axiform.materials.parallel import NetworkLaw
+from axiform.materials.parallel import CHUNK, NetworkLaw
 from axiform.materials.protocol import Elastic
 
 LAW = MooneyRivlin(0.4, 0.1, 1.0e3)
@@ -68,8 +68,9 @@ def cpu(call) -> float:
     return time.process_time() - start
 
 
-def evaluations(call) -> int:
-    """How many times the local Newton evaluates the network's elastic law in `call`."""
+def evaluations(call, n: int) -> float:
+    """How many times the local Newton evaluates the network's elastic law in `call`, per
+    chunk of points (parallel.CHUNK: the networks are updated chunk by chunk)."""
     count = [0]
     original = Network.principal
 
@@ -82,7 +83,7 @@ def evaluations(call) -> int:
         call()
     finally:
         Network.principal = original  # type: ignore[method-assign]
-    return count[0]
+    return count[0] / -(-n // CHUNK)
 
 
 def main() -> None:
@@ -111,12 +112,12 @@ def main() -> None:
             times[name].append(cpu(call))
     base = float(np.median(times["elastic: stress_tangent"]))
     print(f"{n} points, median of {repeats} interleaved repeats, process CPU time, single-threaded\n")
-    print("| update | ms | ratio to elastic | evaluations of the network's law |")
+    print("| update | ms | ratio to elastic | evaluations of the network's law per chunk |")
     print("|---|---:|---:|---:|")
     for name, call in calls.items():
         med = float(np.median(times[name]))
-        count = evaluations(call) if "network" in name else 0
-        print(f"| {name} | {1e3 * med:.1f} | {med / base:.2f} | {count or '-'} |")
+        count = f"{evaluations(call, n):.1f}" if "network" in name else "-"
+        print(f"| {name} | {1e3 * med:.1f} | {med / base:.2f} | {count} |")
 
 
 if __name__ == "__main__":
