@@ -10,8 +10,6 @@ import ast
 from functools import cache
 from pathlib import Path
 
-import pytest
-
 SRC = Path(__file__).resolve().parents[1] / "src"
 PACKAGE = SRC / "axiform"
 
@@ -20,17 +18,6 @@ PACKAGE = SRC / "axiform"
 LAYERS = ("axiform", "materials", "fem", "contact", "model", "solve", "post", "io", "case", "design", "app", "cli")
 MAX_MODULE_LINES = 450
 MAX_FUNCTION_LINES = 80
-
-# Offenders that are being split while this test is written: module paths (relative to src/)
-# over the line limit and "module:function" names over the function limit.  Each entry must
-# still offend (test_being_split_is_current); the set empties as they are split.
-BEING_SPLIT = {
-    "axiform/model/model.py",
-    "axiform/contact/pair.py",
-    "axiform/contact/surfaces.py",
-    "axiform/io/results.py",
-    "axiform/solve/solver.py:solve",
-}
 
 
 def modules() -> dict[str, Path]:
@@ -127,7 +114,7 @@ def test_no_module_over_the_line_limit():
         for path in modules().values()
         if (n := len(path.read_text(encoding="utf-8").splitlines())) > MAX_MODULE_LINES
     }
-    assert set(long) - BEING_SPLIT == set(), f"modules over {MAX_MODULE_LINES} lines: {long}"
+    assert not long, f"modules over {MAX_MODULE_LINES} lines: {long}"
 
 
 def long_functions() -> dict[str, int]:
@@ -143,7 +130,7 @@ def long_functions() -> dict[str, int]:
 
 def test_no_function_over_the_line_limit():
     long = long_functions()
-    assert set(long) - BEING_SPLIT == set(), f"functions over {MAX_FUNCTION_LINES} lines: {long}"
+    assert not long, f"functions over {MAX_FUNCTION_LINES} lines: {long}"
 
 
 def test_no_private_name_is_imported_from_another_module():
@@ -155,16 +142,6 @@ def test_no_private_name_is_imported_from_another_module():
         if n.startswith("_") and not (n.startswith("__") and n.endswith("__")) and target != name
     ]
     assert not private, "private names imported across modules:\n" + "\n".join(private)
-
-
-@pytest.mark.parametrize("entry", sorted(BEING_SPLIT))
-def test_being_split_is_current(entry):
-    """An entry of BEING_SPLIT that no longer offends is taken out of the set."""
-    if ":" in entry:
-        assert entry in long_functions(), f"{entry} is within the limit now: take it out of BEING_SPLIT"
-    else:
-        n = len((SRC / entry).read_text(encoding="utf-8").splitlines())
-        assert n > MAX_MODULE_LINES, f"{entry} has {n} lines now: take it out of BEING_SPLIT"
 
 
 def test_the_checks_see_what_they_look_for(tmp_path):

@@ -95,6 +95,7 @@ def curves_past_target(built: Built) -> list[str]:
     out = []
     for where, knots in _curves(built):
         curve = Curve(knots)
+        assert curve.t is not None and curve.f is not None, "a curve built from knots has them"
         t_last = float(curve.t[-1])
         tol = 1e-9 * max(1.0, abs(end))
         if t_last <= end + tol:
@@ -151,6 +152,7 @@ def mould_checks(built: Built) -> list[str]:
         where = _mould_name(built, i)
         if wrong[on].mean() > WRONG_FACE_FRACTION:
             if isinstance(pair.surface, Circle):
+                assert spec.surface.circle is not None, "a Circle surface comes from a circle table"
                 fix = f"inside = {str(not spec.surface.circle.inside).lower()}"
             else:
                 fix = f"reverse = {str(not spec.surface.reverse).lower()}"
@@ -232,6 +234,7 @@ def _driven_step(built: Built, reference) -> list[str]:
     the loads in proportion along the reference tangent."""
     body, ev, solve = reference
     control = built.control
+    assert isinstance(control, DisplacementControl), "called for displacement control only"
     dm = body.dofmap
     eq = int(dm.eq[control.dof])
     v = solve(-ev.dr_dlam)  # the response to a unit load factor
@@ -264,34 +267,36 @@ def inverting_loads(built: Built) -> list[str]:
     nf, n_eq = dm.nf, body.n_free
     zero = np.zeros(body.n_full)
     units = case.units
-    loads = []  # (key path, value, what, full load vector, full prescribed displacements)
+    # (key path, value, what, full load vector, full prescribed displacements)
+    loads: list[tuple[str, float, str | None, np.ndarray, np.ndarray | None]] = []
     for i, (spec, p) in enumerate(zip(case.pressure, body.pressures, strict=False)):
         step = spec.value * _step_increment(p.curve, t_end, steps)
         if step:
             fe, _ = p.evaluate(zero, tangent=False)
             f = np.bincount(p.dofs.ravel(), fe.ravel(), body.n_full) / p.value * step
             loads.append((f"pressure[{i}].value", spec.value, units.pressure, f, None))
-    for i, spec in enumerate(case.point_load):
-        step = spec.value * _step_increment(spec.build_curve(), t_end, steps)
+    for i, load in enumerate(case.point_load):
+        step = load.value * _step_increment(load.build_curve(), t_end, steps)
         if step:
-            f = _point_load_vector(body, case, i) * step / spec.value
-            loads.append((f"point_load[{i}].value", spec.value, units.force, f, None))
-    for i, (spec, cav) in enumerate(zip(case.cavity, body.cavities, strict=False)):
-        if spec.control != "pressure":
+            f = _point_load_vector(body, case, i) * step / load.value
+            loads.append((f"point_load[{i}].value", load.value, units.force, f, None))
+    for i, (gas, cav) in enumerate(zip(case.cavity, body.cavities, strict=False)):
+        if gas.control != "pressure":
             continue
-        step = spec.pressure * _step_increment(cav.curve, t_end, steps)
+        assert gas.pressure is not None, "a cavity under pressure control has its pressure"
+        step = gas.pressure * _step_increment(cav.curve, t_end, steps)
         if step:
             _, ge, _ = cav.evaluate(zero, tangent=False)
             f = np.bincount(cav.dofs.ravel(), ge.ravel(), body.n_full) * step
-            loads.append((f"cavity[{i}].pressure", spec.pressure, units.pressure, f, None))
-    for i, spec in enumerate(case.fix):
-        if not spec.value:
+            loads.append((f"cavity[{i}].pressure", gas.pressure, units.pressure, f, None))
+    for i, fix in enumerate(case.fix):
+        if not fix.value:
             continue
-        step = spec.value * _step_increment(spec.build_curve(), t_end, steps)
+        step = fix.value * _step_increment(fix.build_curve(), t_end, steps)
         if step:
-            u_p = np.zeros(body.n_full)
-            u_p[_fix_dofs(body, case, i)] = step
-            loads.append((f"fix[{i}].value", spec.value, units.length, -_internal_rate(body, u_p), u_p))
+            u_fix = np.zeros(body.n_full)
+            u_fix[_fix_dofs(body, case, i)] = step
+            loads.append((f"fix[{i}].value", fix.value, units.length, -_internal_rate(body, u_fix), u_fix))
     out = []
     for where, value, unit, f_full, u_p in loads:
         b = np.zeros(n_eq)

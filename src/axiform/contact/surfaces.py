@@ -58,6 +58,10 @@ class RigidSurface:
         surface's frame: each surface kind gives its own."""
         raise NotImplementedError
 
+    def polyline(self) -> np.ndarray:
+        """The surface drawn as a chain of points (k, 2) in its own frame (pictures)."""
+        raise NotImplementedError
+
     def local_sets(self, sets: list, method: str = "buckets") -> list[Projection]:
         """`local` of each set of points (x (n, 2), x_prev (n, 2), depth)."""
         return [self.local(x, x_prev, depth, method) for x, x_prev, depth in sets]
