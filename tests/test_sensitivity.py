@@ -102,7 +102,10 @@ def test_sticky_mould_with_nodes_freezing_at_different_steps_mixed():
     sens = check_against_forward_differences(tube("mixed", contact={"sticky": True}))
     pair, held = sens.model.contacts[0], sens.model.contact_states(sens.solve.last.state)[0]
     assert np.unique(held.first_contact[~np.isnan(held.first_contact)]).size >= 3  # froze over several steps
-    assert (pair.report(held)["status"] == 3).sum() >= 5  # of the 7 outer nodes, 5 frozen (and 1 touching)
+    status = pair.report(held)["status"]
+    # the 7 outer nodes all on the mould, 4 of them frozen (5 while the penalty's tie let the
+    # frozen wall sink, and left room for the volume nearer the pole)
+    assert (status > 0).all() and (status == 3).sum() >= 4
     assert pair.report(held)["penetration"] < 0.05  # the mould holds the tube
 
 
