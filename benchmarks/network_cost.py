@@ -23,6 +23,8 @@ from __future__ import annotations
 import argparse
 import os
 import time
+from collections.abc import Callable
+from functools import partial
 
 if __name__ == "__main__":  # thread counts must be set before NumPy is imported
     for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
@@ -78,11 +80,11 @@ def evaluations(call, n: int) -> float:
         count[0] += 1
         return original(self, e)
 
-    Network.principal = counted  # type: ignore[method-assign]
+    Network.principal = counted
     try:
         call()
     finally:
-        Network.principal = original  # type: ignore[method-assign]
+        Network.principal = original
     return count[0] / -(-n // CHUNK)
 
 
@@ -99,12 +101,12 @@ def main() -> None:
     state = flowed_state(networks, x)
     state_f = flowed_state(frozen, x)
     cold = np.full(n, 120.0)
-    calls = {
+    calls: dict[str, Callable[[], object]] = {
         "elastic: stress_tangent": lambda: LAW.stress_tangent(x),
         "elastic through the protocol": lambda: Elastic(LAW).update(x, {}, 0.1, None),
     }
     for name, dt in STEPS.items():
-        calls[f"one network, {name} (dt {dt:g})"] = lambda dt=dt: networks.update(x, state, dt, None)
+        calls[f"one network, {name} (dt {dt:g})"] = partial(networks.update, x, state, dt, None)
     calls["one network + freezing, short step"] = lambda: frozen.update(x, state_f, STEPS["short step"], cold)
     times: dict[str, list[float]] = {name: [] for name in calls}
     for _ in range(repeats):
