@@ -125,6 +125,7 @@ class Polyline(RigidSurface, Pieces):
     points: np.ndarray = field(default_factory=lambda: np.zeros((2, 2)))
     centers: list | None = None
     ccw: list | None = None
+    polyline = Pieces.polyline  # the pieces' drawing, not the surface's abstract one
 
     def __post_init__(self):
         P = np.asarray(self.points, float)
