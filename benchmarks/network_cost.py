@@ -1,6 +1,6 @@
 #!/usr/bin/env python
 """The cost of a constitutive update with one viscous network against the elastic law's
-(DESIGN § 14.6: at most 3x), side by side in one run.
+(the goal: at most 3x), side by side in one run.
 
 On N material points (default 1e5) with deformation gradients of a stretched, sheared wall
 (stretches up to 2, shear up to 0.3, F differing point to point) and a committed state that

@@ -1,5 +1,5 @@
 #!/usr/bin/env python
-"""The cost of a Newton iteration's evaluation with and without a Prony series (DESIGN § 11.2).
+"""The cost of a Newton iteration's evaluation with and without a Prony series.
 
 1. `Model.evaluate(u, t, state, tangent=True)` (residual and tangent, the part of a Newton
    iteration that the series changes) on the ring of `_perf_common.py` (r 1..2, z 0..1, a

@@ -1,4 +1,4 @@
-"""A results folder is locked while a run writes it (DESIGN § 15): a second run on it exits 2
+"""A results folder is locked while a run writes it: a second run on it exits 2
 naming the first (its pid and start) and leaves its files alone; a lock whose process is
 gone is taken over; the lock goes at every exit (finished, invalid resume, SIGTERM)."""
 

@@ -1,4 +1,4 @@
-"""The discrete maximum principle of the heat scheme (fem.heat, DESIGN § 15): no point warmer
+"""The discrete maximum principle of the heat scheme (fem.heat): no point warmer
 than the warmest initial or boundary temperature, none colder than the coldest, on coarse and
 fine meshes of thin walls (elements far from square), Q4 and Q8, straight and skewed, with
 films and a mould, over steps much shorter than an element's diffusion time (where a

@@ -1,5 +1,5 @@
 """Malformed inputs get exit 2 naming the key, the option or the file, never exit 3 or a
-traceback (DESIGN § 15): tables holding strings, lists or booleans; curves whose times go
+traceback: tables holding strings, lists or booleans; curves whose times go
 back; `check --plot` paths that are not PNG files; devices and huge files read with a bound;
 a WLF reference far from its data; plots into a folder that cannot be written.  And what is
 well formed but was refused or crashed: a UTF-8 byte order mark, the temperature monitors of

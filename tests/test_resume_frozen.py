@@ -1,4 +1,4 @@
-"""`axiform run --resume`: the physics of the steps already made cannot change (DESIGN § 15):
+"""`axiform run --resume`: the physics of the steps already made cannot change:
 [mesh], [material], [temperature], [thermal], [[convection]], the contact's geometry,
 motion and heat, and the loads up to the resume time; each change is refused with exit 2
 naming its table.  A later target, other output, a load curve changed beyond the resume

@@ -1,4 +1,4 @@
-"""Details of a run a user reads at their word (DESIGN § 15): history.csv starts with the
+"""Details of a run a user reads at their word: history.csv starts with the
 state at t = 0; the contact pair's name is printed once; "did you mean" offers the keys of
 the law at hand."""
 

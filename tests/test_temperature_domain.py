@@ -1,4 +1,4 @@
-"""Every temperature a case can reach within the shift's domain (DESIGN § 15): the moulds'
+"""Every temperature a case can reach within the shift's domain: the moulds'
 and films' temperatures x their curves checked before any work (exit 2 naming the key), the
 Arrhenius shift on absolute temperatures ([units] temperature), a run that stops naming the
 pole where a temperature leaves the domain all the same; the heat inputs refused with their

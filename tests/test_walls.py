@@ -1,4 +1,4 @@
-"""Walls a person can take at their word (DESIGN § 15): a station whose wall is held keeps the
+"""Walls a person can take at their word: a station whose wall is held keeps the
 held wall's thickness and the thinnest wall of summary.json is a free one; contact holds a
 wall to within 1 % of its thickness by default; a body that passed through a mould is
 warned about, before the run and after it."""
