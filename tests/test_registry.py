@@ -84,3 +84,17 @@ def test_a_registered_law_is_checked_like_the_others(registered):
 def test_an_unregistered_name_is_refused_with_the_registered_ones():
     with pytest.raises(CaseError, match=r"material\.model: Input should be 'neo-hooke', .* or 'arruda-boyce';"):
         parse(bore({"model": "neo-hooke-mu", "mu": 1.0, "kappa": 200.0}))
+
+
+def test_fit_takes_the_registered_laws_with_a_fit_family(registered, capsys):
+    """`fit --model` lists and takes the laws of the registry that have a fit family: the new
+    law (without one) is neither listed nor taken."""
+    from axiform.cli import build_parser, main
+
+    parser, p_fit = build_parser()
+    text = " ".join(p_fit.format_help().split())
+    fitted = [name for name, entry in registry.LAWS.items() if entry.fit is not None]
+    assert f"the law: {', '.join(fitted)}; or prony, wlf" in text and "neo-hooke-mu" not in text
+    with pytest.raises(SystemExit) as exc:
+        main(["fit", "data.csv", "--model", "neo-hooke-mu"])
+    assert exc.value.code == 2 and "invalid choice: 'neo-hooke-mu'" in capsys.readouterr().err

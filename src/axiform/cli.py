@@ -138,7 +138,7 @@ def _plot_and_fit(sub) -> argparse.ArgumentParser:
     p_fit.add_argument(
         "--model",
         required=True,
-        help=f"the law: {', '.join(_fitted_laws())}; or {', '.join(VISCOELASTIC_FITS)}",
+        action=_LawChoice,
     )
     p_fit.add_argument(
         "--terms",
@@ -267,6 +267,22 @@ def _fitted_laws() -> list[str]:
     from .materials import LAWS
 
     return [name for name, entry in LAWS.items() if entry.fit is not None]
+
+
+class _LawChoice(argparse.Action):
+    """`fit --model`: its help lists the laws of the registry when the help is shown (the
+    registry and numpy are not imported to build the parser)."""
+
+    @property
+    def help(self) -> str:
+        return f"the law: {', '.join(_fitted_laws())}; or {', '.join(VISCOELASTIC_FITS)}"
+
+    @help.setter
+    def help(self, value: str | None) -> None:
+        """The help is the property's (argparse.Action.__init__ sets it)."""
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        setattr(namespace, self.dest, values)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -3,9 +3,9 @@
     model = "neo-hooke" | "mooney-rivlin" | "yeoh" | "ogden" | "gent" | "arruda-boyce" | ...
 
 (a law of the registry, materials/registry.py: LAWS) with the law's keys (its entry's keys),
-and `kappa`, or `E` and `nu` (kappa = E / (3 (1 - 2 nu))).  Where
-one constant sets the initial shear modulus (its entry's shear_key) it may be left out when E and nu are
-given: the law's mu then stands for E / (2 (1 + nu)).  Every number must be finite and in
+and `kappa`, or `E` and `nu` (kappa = E / (3 (1 - 2 nu))).  Where one constant sets the
+initial shear modulus (its entry's shear_key) it may be left out when E and nu are given: the
+law's mu then stands for E / (2 (1 + nu)).  Every number must be finite and in
 range; an error names the key (material.KEY) or, for a missing or cross-key problem, the table.
 A constant other than Ogden's lists may be a table of the temperature [[T, value], ...]
 (T increasing, every value in range; piecewise linear, constant outside), which needs the

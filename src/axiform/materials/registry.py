@@ -62,12 +62,13 @@ class FitFamily:
 class LawEntry:
     """One hyperelastic law.
 
-    name: its `model` in the case file; law: its class (or the function making it); keys: its constants in the case file;
-    from_case(c, kappa, mu0): the law from the constants c (name -> number, or array of one
-    value per point; None where left out) and kappa, where mu0(key) is the initial shear modulus
-    from E and nu for the shear constant `key` left out; shear_key: the constant that may be left
-    out when E and nu are given (None: none may); fit(terms): the description the fitter needs
-    (None: not fitted); terms: whether the law takes a number of terms (--terms)."""
+    name: its `model` in the case file; law: its class (or the function making it); keys: its
+    constants in the case file; from_case(c, kappa, mu0): the law from the constants c (name ->
+    number, or array of one value per point; None where left out) and kappa, where mu0(key) is
+    the initial shear modulus from E and nu for the shear constant `key` left out; shear_key:
+    the constant that may be left out when E and nu are given (None: none may); fit(terms): the
+    description the fitter needs (None: not fitted); terms: whether the law takes a number of
+    terms (--terms)."""
 
     name: str
     law: Callable[..., Hyperelastic]
