@@ -138,7 +138,7 @@ def _plot_and_fit(sub) -> argparse.ArgumentParser:
     p_fit.add_argument(
         "--model",
         required=True,
-        help="the law: neo-hooke, mooney-rivlin, yeoh, ogden, gent, arruda-boyce; or prony, wlf",
+        action=_LawChoice,
     )
     p_fit.add_argument(
         "--terms",
@@ -262,6 +262,29 @@ def dispatch(args: argparse.Namespace) -> int:
     return check(args.case, args.set, args.plot)
 
 
+def _fitted_laws() -> list[str]:
+    """The hyperelastic laws `fit --model` takes: those of the registry with a fit family."""
+    from .materials import LAWS
+
+    return [name for name, entry in LAWS.items() if entry.fit is not None]
+
+
+class _LawChoice(argparse.Action):
+    """`fit --model`: its help lists the laws of the registry when the help is shown (the
+    registry and numpy are not imported to build the parser)."""
+
+    @property
+    def help(self) -> str:
+        return f"the law: {', '.join(_fitted_laws())}; or {', '.join(VISCOELASTIC_FITS)}"
+
+    @help.setter
+    def help(self, value: str | None) -> None:
+        """The help is the property's (argparse.Action.__init__ sets it)."""
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        setattr(namespace, self.dest, values)
+
+
 def main(argv: list[str] | None = None) -> int:
     """The `axiform` command line; returns the exit code.  stdout and stderr are guarded while
     it runs: a reader that closes them early (`| head`) costs the command nothing."""
@@ -271,13 +294,9 @@ def main(argv: list[str] | None = None) -> int:
         parser, p_fit = build_parser()
         args = parser.parse_args(argv)
         if args.command == "fit":
-            from .case.material import KEYS
-
-            if args.model not in (*KEYS, *VISCOELASTIC_FITS):
-                p_fit.error(
-                    f"argument --model: invalid choice: {args.model!r} "
-                    f"(choose from {', '.join((*KEYS, *VISCOELASTIC_FITS))})"
-                )
+            choices = (*_fitted_laws(), *VISCOELASTIC_FITS)
+            if args.model not in choices:
+                p_fit.error(f"argument --model: invalid choice: {args.model!r} (choose from {', '.join(choices)})")
         try:
             return dispatch(args)
         except KeyboardInterrupt:

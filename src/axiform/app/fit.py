@@ -30,23 +30,22 @@ import csv
 import json
 import math
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from scipy.optimize import least_squares, lsq_linear
 
-from ..case.material import KEYS, MAX_OGDEN_TERMS, MaterialSpec
+from ..case.material import MAX_OGDEN_TERMS, MaterialSpec, law_keys
 from ..case.schema import MAX_MAGNITUDE, MIN_MAGNITUDE
-from ..materials import ArrudaBoyce, Gent, Hyperelastic, MooneyRivlin, Ogden, Yeoh
+from ..materials import LAWS, FitFamily, Hyperelastic
 from ..materials.homogeneous import (
     MODES,
     STABILITY_STRETCHES,
     Data,
     FitResult,
     drucker_stable,
-    kinematics,
     nominal,
     stable_range,
 )
@@ -55,15 +54,6 @@ from .run import prepare_folder
 
 # the stretches and stresses a data file may hold: beyond them the fit's powers overflow
 STRETCH_RANGE = (1e-3, 1e3)
-ALPHA_BOUND = 25.0  # |alpha_i| of the Ogden fit, so that lambda^alpha stays finite
-OGDEN_ALPHA_STARTS = (
-    (2.0, -2.0, 4.0, -1.0, 6.0, 1.0),
-    (1.3, 5.0, -2.0, 3.0, -4.0, 8.0),
-    (1.0, 3.0, 6.0, -2.0, -4.0, 9.0),
-    (3.0, -1.0, 8.0, 1.5, -3.0, 5.0),
-    (0.5, 4.0, -3.0, 2.0, 7.0, -1.0),
-    (6.0, -4.0, 1.0, 3.0, -2.0, 10.0),
-)
 
 
 class FitDataError(ValueError):
@@ -145,79 +135,35 @@ def read_data(paths: Sequence[str | Path]) -> Data:
 
 @dataclass(frozen=True)
 class Family:
-    """A law as constants to fit: those it holds linearly (the stress is linear in them at
-    fixed other constants) and the others.  `make(linear, nonlinear)` gives the law with
-    kappa = 1 (W_iso does not depend on kappa)."""
+    """A law as constants to fit (its registry entry's FitFamily) under its case-file name."""
 
     model: str
-    linear: tuple[str, ...]
-    nonlinear: tuple[str, ...]
-    make: Callable[[np.ndarray, np.ndarray], Hyperelastic]
-    linear_sign: tuple[str, ...]  # "positive", "nonnegative" or "free", per linear constant
-    nonlinear_bounds: Callable[[Data], tuple[np.ndarray, np.ndarray]] = lambda data: (np.empty(0), np.empty(0))
-    nonlinear_starts: Callable[[Data], list[np.ndarray]] = lambda data: [np.empty(0)]
+    spec: FitFamily
+
+    @property
+    def linear(self) -> tuple[str, ...]:
+        return self.spec.linear
+
+    @property
+    def nonlinear(self) -> tuple[str, ...]:
+        return self.spec.nonlinear
 
     def law(self, p: np.ndarray) -> Hyperelastic:
         """The law (kappa = 1) of the constants p = (linear, nonlinear)."""
-        return self.make(p[: len(self.linear)], p[len(self.linear) :])
+        return self.spec.make(p[: len(self.linear)], p[len(self.linear) :])
 
     def table(self, p: np.ndarray) -> dict:
-        """The case-file constants (KEYS) of the law of p."""
+        """The case-file constants (the law's keys) of the law of p."""
         law = self.law(p)
-        return {key: (list(v) if isinstance(v := getattr(law, key), tuple) else v) for key in KEYS[self.model]}
-
-
-def _max_I1(data: Data) -> float:
-    """The largest I1 of the data points (incompressible: I1 = sum of squared stretches)."""
-    return max(
-        float(np.sum(kinematics(m, data.stretch[data.mode == i]) ** 2, axis=-1).max(initial=3.0))
-        for i, m in enumerate(MODES)
-    )
+        return {key: (list(v) if isinstance(v := getattr(law, key), tuple) else v) for key in law_keys(self.model)}
 
 
 def family(model: str, terms: int = 3) -> Family:
-    """The fitting description of a case-file model (terms: Ogden only)."""
-    positive = "positive"
-    if model == "neo-hooke":
-        return Family(model, ("C1",), (), lambda a, b: MooneyRivlin(a[0], 0.0, 1.0), (positive,))
-    if model == "mooney-rivlin":
-        return Family(model, ("C1", "C2"), (), lambda a, b: MooneyRivlin(a[0], a[1], 1.0), (positive, "nonnegative"))
-    if model == "yeoh":
-        return Family(
-            model, ("C10", "C20", "C30"), (), lambda a, b: Yeoh(a[0], a[1], a[2], 1.0), (positive, "free", "free")
-        )
-    if model == "ogden":
-        n = terms
-        return Family(
-            model,
-            tuple(f"mu_{i + 1}" for i in range(n)),
-            tuple(f"alpha_{i + 1}" for i in range(n)),
-            lambda a, b: Ogden(tuple(a), tuple(b), 1.0),
-            ("free",) * n,
-            lambda data: (np.full(n, -ALPHA_BOUND), np.full(n, ALPHA_BOUND)),
-            lambda data: [np.array(s[:n]) for s in OGDEN_ALPHA_STARTS],
-        )
-    if model == "gent":
-        return Family(
-            model,
-            ("mu",),
-            ("Jm",),
-            lambda a, b: Gent(a[0], b[0], 1.0),
-            (positive,),
-            lambda data: (np.array([(_max_I1(data) - 3.0) * (1 + 1e-9)]), np.array([np.inf])),
-            lambda data: [np.array([(_max_I1(data) - 3.0) * f]) for f in (1.05, 1.5, 3.0, 10.0, 100.0)],
-        )
-    if model == "arruda-boyce":
-        return Family(
-            model,
-            ("mu",),
-            ("lambda_m",),
-            lambda a, b: ArrudaBoyce(a[0], b[0], 1.0),
-            (positive,),
-            lambda data: (np.array([1.0 + 1e-9]), np.array([np.inf])),
-            lambda data: [np.array([v]) for v in (1.5, 3.0, 6.0, 12.0, 50.0)],
-        )
-    raise ValueError(f"unknown model {model!r}")
+    """The fitting description of a case-file model (terms: laws with terms, as Ogden)."""
+    entry = LAWS.get(model)
+    if entry is None or entry.fit is None:
+        raise ValueError(f"unknown model {model!r}")
+    return Family(model, entry.fit(terms))
 
 
 def _residual(fam: Family, data: Data, p: np.ndarray) -> np.ndarray:
@@ -241,13 +187,13 @@ def fit(data: Data, model: str, terms: int = 3, kappa: float | None = None) -> F
     n = len(fam.linear)
     scale = float(np.median(np.abs(data.stress)))
     lower = {"positive": 1e-9 * scale, "nonnegative": 0.0, "free": -np.inf}
-    lin_lo = np.array([lower[s] for s in fam.linear_sign])
-    nl_lo, nl_hi = fam.nonlinear_bounds(data)
+    lin_lo = np.array([lower[s] for s in fam.spec.linear_sign])
+    nl_lo, nl_hi = fam.spec.nonlinear_bounds(data)
     lo = np.concatenate([lin_lo, nl_lo])
     hi = np.concatenate([np.full(n, np.inf), nl_hi])
     w = 1.0 / np.abs(data.stress)
     best = None
-    for b in fam.nonlinear_starts(data):
+    for b in fam.spec.nonlinear_starts(data):
         b = np.clip(b, nl_lo, nl_hi)
         # the stress is linear in the first n constants: columns = stress of unit constants
         basis = np.stack([nominal(fam.law(np.concatenate([e, b])), data.x) for e in np.eye(n)], axis=1)
@@ -267,10 +213,7 @@ def fit(data: Data, model: str, terms: int = 3, kappa: float | None = None) -> F
             best = sol
     if best is None:
         return None
-    p = best.x
-    if model == "ogden":  # terms in increasing alpha
-        order = np.argsort(p[n:])
-        p = np.concatenate([p[:n][order], p[n:][order]])
+    p = fam.spec.canonical(best.x)
     k = kappa if kappa is not None else 1000.0 * fam.law(p).shear_modulus
     table = fam.table(p)
     law = MaterialSpec.model_validate(table | {"model": model, "kappa": k}).build()
@@ -280,7 +223,7 @@ def fit(data: Data, model: str, terms: int = 3, kappa: float | None = None) -> F
     rms = {m: float(np.sqrt(np.mean(r[data.mode == i] ** 2))) for i, m in enumerate(MODES) if (data.mode == i).any()}
     stable = {m: stable_range(drucker_stable(law, m, STABILITY_STRETCHES)) for m in MODES}
     points = {m: data.count(m) for m in MODES if data.count(m)}
-    return FitResult(model, terms if model == "ogden" else None, law, table, rms, stable, points)
+    return FitResult(model, terms if LAWS[model].terms else None, law, table, rms, stable, points)
 
 
 def _six_digits(v):
@@ -318,8 +261,9 @@ def _range_text(r: tuple[float, float] | None) -> str:
 
 def run(paths: list[str], model: str, terms: int | None, out: str | None, kappa: float | None) -> int:
     """The `axiform fit` command: exit 2 for bad data, 1 if nothing admissible, 0 otherwise."""
-    if terms is not None and model != "ogden":
-        print("axiform fit: --terms is for --model ogden", file=sys.stderr)
+    with_terms = [name for name, entry in LAWS.items() if entry.terms]
+    if terms is not None and model not in with_terms:
+        print(f"axiform fit: --terms is for --model {' or '.join(with_terms)}", file=sys.stderr)
         return 2
     terms = 3 if terms is None else terms
     if not 1 <= terms <= MAX_OGDEN_TERMS:

@@ -1,10 +1,11 @@
 """The `[material]` table of the case file: the law, its constants, the bulk modulus.
 
-    model = "neo-hooke" | "mooney-rivlin" | "yeoh" | "ogden" | "gent" | "arruda-boyce"
+    model = "neo-hooke" | "mooney-rivlin" | "yeoh" | "ogden" | "gent" | "arruda-boyce" | ...
 
-with the law's keys (KEYS), and `kappa`, or `E` and `nu` (kappa = E / (3 (1 - 2 nu))).  Where
-one constant sets the initial shear modulus (SHEAR_KEY) it may be left out when E and nu are
-given: the law's mu then stands for E / (2 (1 + nu)).  Every number must be finite and in
+(a law of the registry, materials/registry.py: LAWS) with the law's keys (its entry's keys),
+and `kappa`, or `E` and `nu` (kappa = E / (3 (1 - 2 nu))).  Where one constant sets the
+initial shear modulus (its entry's shear_key) it may be left out when E and nu are given: the
+law's mu then stands for E / (2 (1 + nu)).  Every number must be finite and in
 range; an error names the key (material.KEY) or, for a missing or cross-key problem, the table.
 A constant other than Ogden's lists may be a table of the temperature [[T, value], ...]
 (T increasing, every value in range; piecewise linear, constant outside), which needs the
@@ -14,40 +15,45 @@ for its weight ([gravity]) and its heat capacity ([thermal] density defaults to 
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
+from pydantic_core import PydanticCustomError
 
-from ..materials import ArrudaBoyce, Gent, Hyperelastic, MooneyRivlin, Ogden, Yeoh
+from ..materials import LAWS, Hyperelastic
+from ..materials.registry import key_spec
 from ..materials.temperature import Table, TemperatureDependent
 from ..materials.viscoelastic import Prony, Viscoelastic
 
-Model = Literal["neo-hooke", "mooney-rivlin", "yeoh", "ogden", "gent", "arruda-boyce"]
-
-KEYS: dict[str, tuple[str, ...]] = {
-    "neo-hooke": ("C1",),
-    "mooney-rivlin": ("C1", "C2"),
-    "yeoh": ("C10", "C20", "C30"),
-    "ogden": ("mu", "alpha"),
-    "gent": ("mu", "Jm"),
-    "arruda-boyce": ("mu", "lambda_m"),
-}
-SHEAR_KEY = {"neo-hooke": "C1", "yeoh": "C10", "gent": "mu", "arruda-boyce": "mu"}
 MAX_OGDEN_TERMS = 6
 
-# key -> (test, what the test asks), for the single numbers
+# key -> (test, what the test asks), for the numbers every law takes (a law's own: its registry entry)
 _RANGE = {
-    "C1": (lambda v: v > 0, "must be > 0"),
-    "C2": (lambda v: v >= 0, "must be >= 0"),
-    "C10": (lambda v: v > 0, "must be > 0"),
-    "C20": (lambda v: True, ""),
-    "C30": (lambda v: True, ""),
-    "Jm": (lambda v: v > 0, "must be > 0"),
-    "lambda_m": (lambda v: v > 1, "must be > 1 (a locking stretch)"),
     "kappa": (lambda v: v > 0, "must be > 0"),
     "E": (lambda v: v > 0, "must be > 0"),
     "nu": (lambda v: -1 < v < 0.5, "must lie in (-1, 0.5)"),
 }
+# the single numbers of the laws (a field each below; a law's keys are among the fields)
+_SCALARS = ("C1", "C2", "C10", "C20", "C30", "Jm", "lambda_m")
+
+
+def law_keys(model: str) -> tuple[str, ...]:
+    """The case-file keys of the law `model` (a registered name)."""
+    return LAWS[model].key_names
+
+
+def _range(name: str, model: str | None) -> tuple:
+    """(test, what the test asks) of the key `name`, for the law `model` where it is known."""
+    if name in _RANGE:
+        return _RANGE[name]
+    spec = key_spec(name, model)
+    return (spec.test, spec.need) if spec is not None else (lambda v: True, "")
+
+
+def _is_list(name: str, model: str | None) -> bool:
+    """Whether the key is a list of numbers (one per term) for the law `model`."""
+    spec = key_spec(name, model)
+    return spec is not None and spec.kind == "list"
 
 
 # a constant as a table of the temperature: [[T, value], ...]
@@ -74,9 +80,9 @@ def _check_number(value: Any, test, need: str) -> Any:
 def _belongs(key: str, info: ValidationInfo) -> str | None:
     """The model, after checking that the key belongs to it (None if the model is invalid)."""
     model = info.data.get("model")
-    if model is not None and key not in KEYS[model] + ("kappa", "E", "nu"):
+    if model is not None and key not in law_keys(model) + ("kappa", "E", "nu"):
         raise ValueError(
-            f'does not belong to model = "{model}" (its keys: {", ".join(KEYS[model])}, and kappa or E and nu)'
+            f'does not belong to model = "{model}" (its keys: {", ".join(law_keys(model))}, and kappa or E and nu)'
         )
     return model
 
@@ -113,7 +119,7 @@ class MaterialSpec(BaseModel):
 
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
-    model: Model
+    model: str
     C1: Tabled = None
     C2: Tabled = None
     C10: Tabled = None
@@ -129,30 +135,39 @@ class MaterialSpec(BaseModel):
     viscoelastic: ViscoelasticSpec | None = None
     density: Annotated[float, Field(gt=0)] | None = None  # mass per unit reference volume ([gravity], [thermal])
 
-    @field_validator(*_RANGE, mode="before")
+    @field_validator("model")
+    @classmethod
+    def _model(cls, value: str) -> str:
+        if value not in LAWS:
+            names = [repr(n) for n in LAWS]
+            expected = " or ".join([", ".join(names[:-1]), names[-1]]) if len(names) > 1 else names[0]
+            raise PydanticCustomError("literal_error", "Input should be {expected}", {"expected": expected})
+        return value
+
+    @field_validator(*_SCALARS, *_RANGE, mode="before")
     @classmethod
     def _not_bool(cls, value: Any) -> Any:
         if isinstance(value, bool):
             raise ValueError(f"must be a number, got {str(value).lower()}")
         return value
 
-    @field_validator(*_RANGE)
+    @field_validator(*_SCALARS, *_RANGE)
     @classmethod
     def _number(cls, value: float, info: ValidationInfo) -> float:
         name = info.field_name
         assert name is not None, "a field validator is called for a field"
-        _belongs(name, info)
-        return _check_number(value, *_RANGE[name])
+        return _check_number(value, *_range(name, _belongs(name, info)))
 
     @field_validator("mu", mode="before")
     @classmethod
     def _mu(cls, value: Any, info: ValidationInfo) -> Any:
         model = _belongs("mu", info)
-        if model == "ogden":
-            return _numbers(value, "ogden mu")
+        if _is_list("mu", model):
+            return _numbers(value, f"{model} mu")
+        test, need = _range("mu", model)
         if isinstance(value, list) and all(isinstance(row, list) and len(row) == 2 for row in value):
             rows = [_numbers(row, "a row [T, value] of the table") for row in value]
-            return _check_number([tuple(r) for r in rows], lambda v: v > 0, "must be > 0")
+            return _check_number([tuple(r) for r in rows], test, need)
         if (
             isinstance(value, bool)
             or not isinstance(value, int | float)
@@ -160,8 +175,8 @@ class MaterialSpec(BaseModel):
             or abs(value) == float("inf")
         ):
             raise ValueError(f"must be a finite number (or a table [[T, value], ...]), got {value!r}")
-        if not value > 0:
-            raise ValueError(f"must be > 0, got {value}")
+        if not test(value):
+            raise ValueError(f"{need}, got {value}")
         return float(value)
 
     @field_validator("alpha", mode="before")
@@ -187,8 +202,8 @@ class MaterialSpec(BaseModel):
             raise ValueError("give kappa or E and nu, not both")
         if self.kappa is None and self.E is None:
             raise ValueError("missing material constant: kappa (or E and nu)")
-        from_E = SHEAR_KEY.get(self.model) if self.E is not None else None
-        missing = [k for k in KEYS[self.model] if getattr(self, k) is None and k != from_E]
+        from_E = LAWS[self.model].shear_key if self.E is not None else None
+        missing = [k for k in law_keys(self.model) if getattr(self, k) is None and k != from_E]
         if missing:
             raise ValueError(f"missing material constant: {', '.join(missing)}")
         return self
@@ -198,7 +213,7 @@ class MaterialSpec(BaseModel):
         out = {}
         for k in CONSTANTS:
             v = getattr(self, k)
-            if isinstance(v, list) and k != "alpha" and not (k == "mu" and self.model == "ogden"):
+            if isinstance(v, list) and not _is_list(k, self.model):
                 out[k] = Table.of(v)
         return out
 
@@ -232,21 +247,8 @@ class MaterialSpec(BaseModel):
             assert E is not None, f"{key} is left out only where E and nu are given (_constants)"
             return E / (2.0 * (1.0 + nu))
 
-        m = self.model
-        if m in ("neo-hooke", "mooney-rivlin"):
-            return MooneyRivlin(
-                c["C1"] if c["C1"] is not None else mu0("C1") / 2.0, c["C2"] if c["C2"] is not None else 0.0, kappa
-            )
-        if m == "yeoh":
-            return Yeoh(c["C10"] if c["C10"] is not None else mu0("C10") / 2.0, c["C20"], c["C30"], kappa)
-        if m == "ogden":
-            return Ogden(tuple(c["mu"]), tuple(c["alpha"]), kappa)
-        if m == "gent":
-            return Gent(c["mu"] if c["mu"] is not None else mu0("mu"), c["Jm"], kappa)
-        # Abaqus' mu from the initial shear modulus: mu0 / mu depends on lambda_m alone
-        mu = c["mu"] if c["mu"] is not None else mu0("mu") / ArrudaBoyce(1.0, c["lambda_m"], kappa).shear_modulus
-        return ArrudaBoyce(mu, c["lambda_m"], kappa)
+        return LAWS[self.model].from_case(c, kappa, mu0)
 
 
-# the law's constants (ogden's mu and alpha are lists, never tables)
+# the laws' constants (a list kind, as Ogden's mu and alpha, is never a table of T)
 CONSTANTS = ("C1", "C2", "C10", "C20", "C30", "mu", "alpha", "Jm", "lambda_m", "kappa", "E", "nu")

@@ -25,6 +25,7 @@ from pydantic import ValidationError
 from ..fem.mesh import MeshError
 from ..fem.selectors import SelectorError
 from ..io.text import MAX_CASE_BYTES, FileTooLarge, read_text
+from ..materials import LAWS
 from ..model.guards import boundary_crossing, free_to_slide
 from ..model.model import Model
 from ..model.system import System
@@ -46,7 +47,6 @@ from .contact import (
 )
 from .gravity import GravitySpec, build_gravity
 from .loads import FixSpec, PointLoadSpec, PressureSpec, apply_loads, prescribe_fixes
-from .material import KEYS as LAW_KEYS
 from .material import MaterialSpec
 from .mesh import ArcPiece, LinePiece, MeshSpec, PieceSpec, build_mesh
 from .monitor import HISTORY_COLUMNS, Monitor, MonitorSpec, build_monitors
@@ -218,9 +218,9 @@ def law_keys(data: dict[str, Any]) -> dict[tuple, list[str]]:
     "did you mean" of an unknown key there: C3 in a Mooney-Rivlin table is not a Yeoh C30."""
     table = data.get("material")
     model = table.get("model") if isinstance(table, dict) else None
-    if not isinstance(model, str) or model not in LAW_KEYS:
+    if not isinstance(model, str) or model not in LAWS:
         return {}
-    return {("material",): ["model", *LAW_KEYS[model], "kappa", "E", "nu", "viscoelastic"]}
+    return {("material",): ["model", *LAWS[model].key_names, "kappa", "E", "nu", "viscoelastic"]}
 
 
 def parse(data: dict[str, Any]) -> Case:

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .invariant import InvariantLaw
+from .registry import FitFamily, Key, LawEntry, positive, register
 
 SERIES = np.array([1.0 / 2.0, 1.0 / 20.0, 11.0 / 1050.0, 19.0 / 7000.0, 519.0 / 673750.0])
 
@@ -40,3 +41,30 @@ class ArrudaBoyce(InvariantLaw):
         W1 = sum(i * ai * I1b ** (i - 1) for i, ai in enumerate(a, 1))
         W11 = sum(i * (i - 1) * ai * I1b ** (i - 2) for i, ai in enumerate(a[1:], 2)) if tangent else None
         return W1, None, W11, None, None
+
+
+def _from_case(c: dict, kappa, mu0) -> ArrudaBoyce:
+    """The law of the case file's constants; Abaqus' mu from the initial shear modulus where
+    mu is left out (mu0 / mu depends on lambda_m alone)."""
+    mu = c["mu"] if c["mu"] is not None else mu0("mu") / ArrudaBoyce(1.0, c["lambda_m"], kappa).shear_modulus
+    return ArrudaBoyce(mu, c["lambda_m"], kappa)
+
+
+def _fit(terms: int) -> FitFamily:
+    """mu linear; lambda_m > 1."""
+    return FitFamily(
+        ("mu",),
+        ("lambda_m",),
+        lambda a, b: ArrudaBoyce(a[0], b[0], 1.0),
+        ("positive",),
+        lambda data: (np.array([1.0 + 1e-9]), np.array([np.inf])),
+        lambda data: [np.array([v]) for v in (1.5, 3.0, 6.0, 12.0, 50.0)],
+    )
+
+
+def _locking(v: float) -> bool:
+    return v > 1
+
+
+KEYS = (Key("mu", positive, "must be > 0"), Key("lambda_m", _locking, "must be > 1 (a locking stretch)"))
+register(LawEntry("arruda-boyce", ArrudaBoyce, KEYS, _from_case, "mu", _fit))

@@ -8,7 +8,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .homogeneous import MODES, Data, kinematics
 from .invariant import InvariantLaw
+from .registry import FitFamily, Key, LawEntry, positive, register
 
 
 @dataclass(frozen=True)
@@ -36,3 +38,35 @@ class Gent(InvariantLaw):
         W1 = 0.5 * self.mu / self._room(I1b)
         W11 = 2.0 / (self.mu * self.Jm) * W1 * W1 if tangent else None
         return W1, None, W11, None, None
+
+
+def _from_case(c: dict, kappa, mu0) -> Gent:
+    """The law of the case file's constants (mu from E and nu where left out)."""
+    return Gent(c["mu"] if c["mu"] is not None else mu0("mu"), c["Jm"], kappa)
+
+
+def _max_I1(data: Data) -> float:
+    """The largest I1 of the data points (incompressible: I1 = sum of squared stretches)."""
+    return max(
+        float(np.sum(kinematics(m, data.stretch[data.mode == i]) ** 2, axis=-1).max(initial=3.0))
+        for i, m in enumerate(MODES)
+    )
+
+
+def _fit(terms: int) -> FitFamily:
+    """mu linear; Jm beyond the largest I1 - 3 of the data (W defined at every point)."""
+    return FitFamily(
+        ("mu",),
+        ("Jm",),
+        lambda a, b: Gent(a[0], b[0], 1.0),
+        ("positive",),
+        lambda data: (np.array([(_max_I1(data) - 3.0) * (1 + 1e-9)]), np.array([np.inf])),
+        lambda data: [np.array([(_max_I1(data) - 3.0) * f]) for f in (1.05, 1.5, 3.0, 10.0, 100.0)],
+    )
+
+
+register(
+    LawEntry(
+        "gent", Gent, (Key("mu", positive, "must be > 0"), Key("Jm", positive, "must be > 0")), _from_case, "mu", _fit
+    )
+)

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .invariant import InvariantLaw
+from .registry import FitFamily, Key, LawEntry, positive, register
 
 
 @dataclass(frozen=True)
@@ -102,3 +103,23 @@ class MooneyRivlin(InvariantLaw):
         A[4, :4] += w
         A[:4, 4] += w
         return P, A
+
+
+def _from_case(c: dict, kappa, mu0) -> MooneyRivlin:
+    """The law of the case file's constants (C2 = 0 where left out)."""
+    return MooneyRivlin(
+        c["C1"] if c["C1"] is not None else mu0("C1") / 2.0, c["C2"] if c["C2"] is not None else 0.0, kappa
+    )
+
+
+def _fit(terms: int) -> FitFamily:
+    """C1 > 0 and C2 >= 0, both linear."""
+    return FitFamily(("C1", "C2"), (), lambda a, b: MooneyRivlin(a[0], a[1], 1.0), ("positive", "nonnegative"))
+
+
+def _nonnegative(v: float) -> bool:
+    return v >= 0
+
+
+KEYS = (Key("C1", positive, "must be > 0"), Key("C2", _nonnegative, "must be >= 0"))
+register(LawEntry("mooney-rivlin", MooneyRivlin, KEYS, _from_case, None, _fit))

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .base import ReducedLaw
+from .registry import FitFamily, Key, LawEntry, register
 
 # Taylor coefficients in theta^2 of R1 = sinh(beta theta) / sinh(theta) / beta and of
 # R2 = (beta cosh(beta theta) sinh(theta) - sinh(beta theta) cosh(theta)) / sinh(theta)^3 / beta,
@@ -149,3 +150,43 @@ class Ogden(ReducedLaw):
             ]
         )
         return g, H
+
+
+ALPHA_BOUND = 25.0  # |alpha_i| of the fit, so that lambda^alpha stays finite
+ALPHA_STARTS = (
+    (2.0, -2.0, 4.0, -1.0, 6.0, 1.0),
+    (1.3, 5.0, -2.0, 3.0, -4.0, 8.0),
+    (1.0, 3.0, 6.0, -2.0, -4.0, 9.0),
+    (3.0, -1.0, 8.0, 1.5, -3.0, 5.0),
+    (0.5, 4.0, -3.0, 2.0, 7.0, -1.0),
+    (6.0, -4.0, 1.0, 3.0, -2.0, 10.0),
+)
+
+
+def _from_case(c: dict, kappa, mu0) -> Ogden:
+    """The law of the case file's lists mu and alpha."""
+    return Ogden(tuple(c["mu"]), tuple(c["alpha"]), kappa)
+
+
+def _increasing_alpha(p: np.ndarray) -> np.ndarray:
+    """The fitted constants (mu_1.., alpha_1..) with the terms in increasing alpha."""
+    n = len(p) // 2
+    order = np.argsort(p[n:])
+    return np.concatenate([p[:n][order], p[n:][order]])
+
+
+def _fit(terms: int) -> FitFamily:
+    """mu_i linear (any sign), |alpha_i| <= ALPHA_BOUND, started from ALPHA_STARTS."""
+    n = terms
+    return FitFamily(
+        tuple(f"mu_{i + 1}" for i in range(n)),
+        tuple(f"alpha_{i + 1}" for i in range(n)),
+        lambda a, b: Ogden(tuple(a), tuple(b), 1.0),
+        ("free",) * n,
+        lambda data: (np.full(n, -ALPHA_BOUND), np.full(n, ALPHA_BOUND)),
+        lambda data: [np.array(s[:n]) for s in ALPHA_STARTS],
+        _increasing_alpha,
+    )
+
+
+register(LawEntry("ogden", Ogden, (Key("mu", kind="list"), Key("alpha", kind="list")), _from_case, None, _fit, True))
