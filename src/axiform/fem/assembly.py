@@ -59,10 +59,24 @@ class SolidAssembly:
             return self.material
         return self.material.at(temperature[sl])
 
-    def stress(self, x: np.ndarray, sl: slice = slice(None), temperature: np.ndarray | None = None) -> np.ndarray:
+    def stress(
+        self,
+        x: np.ndarray,
+        sl: slice = slice(None),
+        temperature: np.ndarray | None = None,
+        memory: Memory | None = None,
+    ) -> np.ndarray:
         """First Piola-Kirchhoff stress P (e, q, 5) at the gradients x of the elements sl
-        (temperature: (e, q) at the points of all elements, or None)."""
-        return self.law(sl, temperature).stress(x)
+        (temperature: (e, q) at the points of all elements, or None; memory: a law's history
+        over a step, applied as `evaluate` applies it)."""
+        law = self.law(sl, temperature)
+        if memory is None:
+            return law.stress(x)
+        xt, shape = to_rows(x)
+        P = law.stress_rows(xt, 0.0, False)[0]
+        memory.add_rows(sl, xt, P, None)
+        add_volumetric(xt, law.kappa, P, None)
+        return from_rows(P, None, shape)[0]
 
     @staticmethod
     def check_inverted(x: np.ndarray, offset: int = 0) -> None:

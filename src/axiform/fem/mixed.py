@@ -113,12 +113,17 @@ class MixedAssembly(SolidAssembly):
         kappa = np.asarray(law.kappa, float)
         return np.broadcast_to(kappa, (m,)) if kappa.ndim == 0 else kappa.reshape(m, -1).mean(1)
 
-    def stress(self, x: np.ndarray, sl: slice = slice(None), temperature: np.ndarray | None = None) -> np.ndarray:
-        """P = P_iso + p dJ/dF (e, q, 5) with the element pressure p."""
+    def stress(
+        self, x: np.ndarray, sl: slice = slice(None), temperature: np.ndarray | None = None, memory=None
+    ) -> np.ndarray:
+        """P = P_iso + p dJ/dF (e, q, 5) with the element pressure p (memory: a law's history
+        over a step on the isochoric part, applied as `evaluate` applies it)."""
         xt, shape = to_rows(x)
         law = self.law(sl, temperature)
         p, dJ = self._pressure(xt, sl, self.bulk_modulus(law, shape[0]))
         P = law.stress_rows(xt, 0.0, False)[0]
+        if memory is not None:
+            memory.add_rows(sl, xt, P, None)
         P += p * dJ
         return from_rows(P, None, shape)[0]
 

@@ -77,21 +77,6 @@ def second_piola_rows(xt: np.ndarray, P: np.ndarray) -> np.ndarray:
     return S
 
 
-def f_times(x: np.ndarray, H: np.ndarray) -> np.ndarray:
-    """F H (..., 5) for a symmetric H (..., 4)."""
-    RR, RZ, ZZ, TT = (H[..., k] for k in range(4))
-    return np.stack(
-        [
-            x[..., 0] * RR + x[..., 1] * RZ,
-            x[..., 0] * RZ + x[..., 1] * ZZ,
-            x[..., 2] * RR + x[..., 3] * RZ,
-            x[..., 2] * RZ + x[..., 3] * ZZ,
-            x[..., 4] * TT,
-        ],
-        axis=-1,
-    )
-
-
 def viscous_rows(
     xt: np.ndarray,
     P: np.ndarray,
@@ -179,3 +164,15 @@ class Memory:
         trial, S = viscous_rows(xt, P, A, h_rows, S_rows, (e, a, b))
         self.trial["h"][sl] = trial.transpose(2, 0, 1).reshape(mc, q, m, 4)
         self.trial["S"][sl] = S.T.reshape(mc, q, 4)
+
+
+def committed_memory(material, state: dict[str, np.ndarray]) -> Memory | None:
+    """The history of a law with memory as it stands at a committed state (None for a law
+    without): a step of no length (every e_i = 1, a_i = b_i = 0), through which the solid's own
+    update gives the stress of the step that committed it, P = P_law - F sum_i h_i, so that
+    the pictures and fields ask the law instead of computing the series again."""
+    prony = getattr(material, "prony", None)
+    history = {k: v for k, v in state.items() if k != "t"}
+    if prony is None or not history:
+        return None
+    return Memory(history, prony.factors(0.0))

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..materials import cauchy_stress
-from ..materials.viscoelastic import f_times
+from ..materials.viscoelastic import committed_memory
 from .thickness import contact_times, nodal_thickness, pieces, thickness_table
 
 
@@ -33,10 +33,9 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
     solid = model.solid
     x = solid.gradient(u_full)
     T = (state or model.initial_state()).temperature  # the nodes' (n,) or None
-    P = solid.stress(x, temperature=None if T is None else solid.point_values(T))  # mixed: with the element pressure
-    history = (model.solid_state(state) if state is not None else {}).get("h")
-    if history is not None:  # a law with memory: S = S_law - sum h_i, P = F S
-        P = P - f_times(x, history.sum(axis=-2))
+    # mixed: with the element pressure; a law with memory: its stress at the committed history
+    memory = committed_memory(solid.material, model.solid_state(state) if state is not None else {})
+    P = solid.stress(x, temperature=None if T is None else solid.point_values(T), memory=memory)
     J = x[..., 4] * (x[..., 0] * x[..., 3] - x[..., 1] * x[..., 2])
     sig = cauchy_stress(x, P)  # (e, q, 4): rr, zz, tt, rz
     s_rr, s_zz, s_tt, s_rz = (sig[..., i] for i in range(4))
