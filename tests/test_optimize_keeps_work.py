@@ -3,6 +3,7 @@ disk as they are found, SIGINT / SIGTERM stop it with 130 / 143 and those files 
 during the final run), a trial design beyond the WLF pole is not solved, and bounds that
 exclude the initial design are refused."""
 
+import copy
 import csv
 import json
 import os
@@ -15,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import test_optimize
 import tomli_w
 
 from axiform.case.schema import parse
@@ -25,23 +27,11 @@ from axiform.design.temperature_design import TemperatureDesign
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 
-# a free-blown tube (tests/test_optimize.py's) in more steps, so that a signal finds it at work
-TUBE = {
-    "title": "free-blown tube",
-    "mesh": {
-        "kind": "layered",
-        "element": "q4",
-        "start": [10.0, 0.0],
-        "profile": [{"line": {"to": [10.0, 20.0], "divisions": 10}}],
-        "thickness": [[0.0, 1.0], [5.0, 1.1], [10.0, 0.9], [15.0, 1.0], [20.0, 1.2]],
-        "layers": 1,
-    },
-    "material": {"model": "neo-hooke", "C1": 0.1, "kappa": 100.0},
-    "fix": [{"at": {"set": "start"}, "dofs": ["uz"]}, {"at": {"set": "end"}, "dofs": ["uz"]}],
-    "cavity": [{"name": "gas", "boundary": {"set": "inner"}, "control": "volume", "volume": 15000.0}],
-    "solver": {"steps": 40},
-    "output": {"vtu": False, "plots": False},
-}
+# the free-blown tube of tests/test_optimize.py in more steps, so that a signal finds it at work
+TUBE = copy.deepcopy(test_optimize.TUBE)
+TUBE["solver"] = {"steps": 40}
+TUBE["output"] = {"vtu": False, "plots": False}
+del TUBE["units"]
 
 # a viscoelastic tube whose initial temperature is the design; its WLF pole is at 150 - 100 = 50
 WARM_TUBE = {
