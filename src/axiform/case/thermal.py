@@ -84,8 +84,7 @@ class ConvectionSpec(CurveMixin):
 
     def ambient_of_time(self):
         """ambient x f(t), f = 1 without a curve."""
-        curve = None if self.curve is None else Curve(self.curve)
-        return (lambda t: self.ambient) if curve is None else (lambda t: self.ambient * curve(t))
+        return _scaled(self.ambient, self.curve)
 
 
 def build_conduction(
