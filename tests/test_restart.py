@@ -89,6 +89,38 @@ def test_resumed_steps_equal_the_uninterrupted_run(case, tmp_path):
         np.testing.assert_allclose(a.u, b.u, rtol=1e-10, atol=1e-12 * np.abs(b.u).max())
 
 
+# the punch in 4 steps of at most 4 iterations: the first step is cut and its interval sub-stepped
+CUT = {**PUNCH, "solver": {"control": "load", "steps": 4, "max_iterations": 4, "growth": 1.0}}
+
+
+def test_a_checkpoint_inside_a_sub_stepped_interval_resumes_as_the_uninterrupted_run(tmp_path):
+    """Resumed from the checkpoint of a step that ended inside the interval of a cut step, the
+    run takes the same sub-steps to that interval's end and then the nominal steps."""
+    full = solve(*_model(CUT))
+    assert full.status == "finished"
+    inside = [s for s in full.steps if s.checkpoint["path"]["goal"] is not None]
+    assert inside, "the first step should have been cut"
+    k = inside[0].number
+    save_checkpoint(tmp_path, inside[0].checkpoint, {})
+    state, _ = load_checkpoint(tmp_path)
+    rest = solve(*_model(CUT), resume=state)
+    assert rest.status == "finished"
+    assert [(s.number, s.lam) for s in rest.steps] == [(s.number, s.lam) for s in full.steps[k:]]
+    for a, b in zip(rest.steps, full.steps[k:], strict=True):
+        assert a.iterations == b.iterations
+        np.testing.assert_allclose(a.u, b.u, rtol=1e-10, atol=1e-12 * np.abs(b.u).max())
+
+
+def test_a_checkpoint_of_before_the_sub_steps_is_resumed():
+    """A checkpoint without the interval being sub-stepped (written before it was kept) resumes
+    from the nominal grid and reaches the end."""
+    full = solve(*_model(CUT))
+    state = full.steps[0].checkpoint
+    del state["path"]["goal"]
+    rest = solve(*_model(CUT), resume=state)
+    assert rest.status == "finished" and rest.last.lam == pytest.approx(1.0, abs=1e-14)
+
+
 def _model(case):
     built = build(parse(case))
     return built.model, built.control, built.options

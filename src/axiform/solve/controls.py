@@ -70,9 +70,14 @@ class ArcLengthControl:
 class NewtonOptions:
     """tolerance: ||R|| <= tolerance * ||reference force||, the reference being the norm of the
     assembled magnitudes of the element forces plus that of the external load; a step is cut back (halved) when
-    Newton needs more than max_iterations, diverges, or an element inverts; it grows by
-    `growth` after a step converged in at most `easy_iterations`; the run stops when a step
-    would be smaller than min_step times the nominal step."""
+    Newton needs more than max_iterations, diverges (its residual beyond 1e10 times that
+    reference and its first residual), or an element inverts.  Under load and displacement
+    control the rest of a cut step's nominal interval is then sub-stepped, the sub-steps
+    growing by `growth` after a step converged in at most `easy_iterations`, the last one
+    landing on the interval's end, where the nominal steps resume (every run passes the same
+    nominal points, however it cut); under arc length the step grows back so, up to the
+    nominal arc.  The run stops when a step would be smaller than min_step times the nominal
+    step."""
 
     tolerance: float = 1e-8
     max_iterations: int = 20

@@ -42,7 +42,10 @@ def converged(ev: Evaluation, lam: float, opts: NewtonOptions, floor: float, res
         raise StepFailed("the residual is not finite")
     residuals.append(norm)
     ref = reference_force(ev, lam, floor)
-    if norm > 1e10 * ref:
+    # diverging: 1e10 times the reference force and the run's first residual; at first contact of
+    # an unloaded body the reference (element forces and loads) is nearly zero while the contact
+    # forces are not: the first residual, the contact's, is no divergence
+    if norm > 1e10 * max(ref, residuals[0]):
         raise StepFailed("Newton diverges")
     # the round-off level (a row sum over K) is computed only where the tolerance is not met
     return (norm <= opts.tolerance * ref or norm <= ev.noise) and ev.constraint_error <= opts.tolerance

@@ -26,9 +26,15 @@ from .newton import (
 
 
 class PathFollowing:
-    """Shared state of a path-following scheme: the last converged (u_f, lambda)."""
+    """Shared state of a path-following scheme: the last converged (u_f, lambda).
+
+    A scheme with a nominal grid (`grid`: load and displacement control) sub-steps a failed
+    step to the end of its own nominal interval: `cut()` keeps that end as `goal`, every
+    step is clipped to it and the last one lands exactly on it; then the grid resumes
+    (`goal` None), so that runs which cut different steps still pass the same nominal points."""
 
     max_steps = 10**9
+    grid = False
 
     def __init__(self, model: System, opts: NewtonOptions):
         self.model = model
@@ -38,11 +44,20 @@ class PathFollowing:
         self.u_f = np.zeros(model.n_free)
         self.lam = 0.0
         self.history = model.initial_state()  # the committed state of the last converged step
+        self.goal: float | None = None  # the end of the nominal interval being sub-stepped (grid schemes)
+        self.aim = 0.0  # where the last attempted step was to end (lambda, or the driven dof's value)
 
     def clip(self, size: float) -> float:
         return size
 
     _state_keys: tuple[str, ...] = ("u_f", "lam")
+    _optional: dict[str, Any] = {}  # state keys a checkpoint of an older version may lack: their defaults
+
+    def cut(self) -> None:
+        """The step just attempted failed: where the scheme has a grid, the rest of that step's
+        nominal interval is sub-stepped (the goal is the end the failed step aimed at)."""
+        if self.grid and self.goal is None:
+            self.goal = self.aim
 
     def state(self) -> dict:
         """What the path needs to go on from its last converged step (restart)."""
@@ -53,6 +68,7 @@ class PathFollowing:
         return out
 
     def restore(self, state: dict) -> None:
+        state = {**self._optional, **state}
         missing = [key for key in self._state_keys if key not in state]
         if missing:
             raise ValueError(
@@ -135,7 +151,9 @@ class PathFollowing:
 class LoadPath(PathFollowing):
     """lambda = t from 0 to the target; every knot of every curve is a step's end."""
 
-    _state_keys = ("u_f", "lam", "rate", "previous")
+    _state_keys = ("u_f", "lam", "rate", "previous", "goal")
+    _optional = {"goal": None}
+    grid = True
 
     def __init__(self, model, control: LoadControl, opts):
         super().__init__(model, opts)
@@ -154,6 +172,9 @@ class LoadPath(PathFollowing):
         return abs(self.target - self.lam) <= 1e-12 * abs(self.target)
 
     def _next_stop(self) -> float:
+        """The end of the interval being sub-stepped, or else the next knot or the end."""
+        if self.goal is not None:
+            return self.goal
         ahead = (self.stops - self.lam) * np.sign(self.target) > 1e-12 * abs(self.target)
         return float(self.stops[np.argmax(ahead)]) if ahead.any() else self.target
 
@@ -164,6 +185,7 @@ class LoadPath(PathFollowing):
     def attempt(self, size):
         stop = self._next_stop()
         lam = stop if abs(stop - self.lam - size) <= 1e-12 * abs(self.target) else self.lam + size
+        self.aim = lam
         if self.rate is None:  # the first step (or a restart): the tangent at the converged state
             self.rate = self._tangent_rate(None)
         # predictor of second order: the parabola through the last two converged states with
@@ -208,6 +230,8 @@ class LoadPath(PathFollowing):
         self.rate = self._tangent_rate(self.converged, u_f, lam)
         self.converged = None
         super().accept(u_f, lam, size)
+        if self.goal is not None and lam == self.goal:  # the sub-stepped interval is done: back on the grid
+            self.goal = None
 
     def diagnosis(self):
         ratio = self._stiffness_ratio() if self.lam != 0 else None
@@ -221,7 +245,9 @@ class LoadPath(PathFollowing):
 
 
 class DisplacementPath(PathFollowing):
-    _state_keys = ("u_f", "lam", "previous", "reached")
+    _state_keys = ("u_f", "lam", "previous", "reached", "goal")
+    _optional = {"goal": None}
+    grid = True
 
     def __init__(self, model, control: DisplacementControl, opts):
         super().__init__(model, opts)
@@ -236,14 +262,18 @@ class DisplacementPath(PathFollowing):
     def done(self):
         return abs(self.target - self.reached) <= 1e-12 * abs(self.target)
 
+    def _end(self) -> float:
+        """The end of the interval being sub-stepped, or else the target."""
+        return self.target if self.goal is None else self.goal
+
     def clip(self, size):
-        remaining = self.target - self.reached
+        remaining = self._end() - self.reached
         return remaining if abs(size) > abs(remaining) else size
 
     def attempt(self, size):
-        goal = (
-            self.target if abs(self.target - self.reached - size) <= 1e-12 * abs(self.target) else self.reached + size
-        )
+        end = self._end()
+        goal = end if abs(end - self.reached - size) <= 1e-12 * abs(self.target) else self.reached + size
+        self.aim = goal
         guess = None
         if self.previous is not None:  # secant predictor, as under load control
             du, dlam, dprev = self.previous
@@ -256,7 +286,9 @@ class DisplacementPath(PathFollowing):
     def accept(self, u_f, lam, size):
         self.previous = (u_f - self.u_f, lam - self.lam, size)
         super().accept(u_f, lam, size)
-        self.reached += size
+        self.reached = self.aim
+        if self.goal is not None and self.reached == self.goal:  # the sub-stepped interval is done
+            self.goal = None
 
 
 def _open_ends(surface) -> np.ndarray:

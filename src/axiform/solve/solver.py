@@ -46,7 +46,8 @@ def solve(
     state after it (path, step size, counts, contact and cavity history).  The result keeps
     all steps, or only the latest `keep` (memory flat in the number of steps: a writer that
     takes each step as it comes needs keep=1).  `resume`: a checkpoint to continue from; the
-    steps then go on with the same numbers and sizes as in an uninterrupted run.
+    steps then go on with the same numbers and sizes as in an uninterrupted run (inside the
+    sub-stepped interval of a cut step too: its end is part of the path's state).
     `model`: a System, or a Model, which is finalized here (Model.finalize)."""
     system = model.finalize()
     opts = options or NewtonOptions()
@@ -70,6 +71,7 @@ def solve(
             result.message = _stop_message(first + result.n_steps, str(exc), path.diagnosis())
             break
         except StepFailed as exc:
+            path.cut()  # the rest of this step's nominal interval is sub-stepped
             size = trial / 2.0
             if abs(size) < opts.min_step * abs(path.nominal):
                 result.status = "stopped"
@@ -80,6 +82,7 @@ def solve(
                 )
                 break
             continue
+        substepping = path.goal is not None
         path.accept(u_new, lam_new, trial)
         u_full = system.expand(u_new, lam_new)
         path.history = system.settle(path.history, ev.trial, u_full)  # the trial of the accepted u only
@@ -87,6 +90,8 @@ def solve(
         if its <= opts.easy_iterations:
             size *= opts.growth
         size = min(size, path.nominal, key=abs)  # the nominal step may change (arc length)
+        if substepping and path.goal is None:  # the end of the cut interval reached: the nominal grid resumes
+            size = path.nominal
         result.n_steps += 1
         number = first + result.n_steps - 1
         checkpoint = {

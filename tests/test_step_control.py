@@ -1,0 +1,59 @@
+"""Step control: a failed step is sub-stepped to the end of its own nominal interval and the
+nominal grid then resumes (a run that cuts early finishes within 1.25 times its nominal steps
+and passes through every nominal point of a run that does not cut); the first contact of an
+unloaded body is no divergence."""
+
+import copy
+
+import pytest
+
+from axiform.case.schema import build, parse
+from axiform.solve.solver import solve
+
+# a sticky punch pressed into a disc it touches at t = 0: the disc is unloaded at the first step
+PUNCH = {
+    "title": "punch on a disc, sticky",
+    "mesh": {"kind": "rectangle", "r": [0.0, 10.0], "z": [0.0, 2.0], "divisions": [10, 2], "element": "q4"},
+    "material": {"model": "neo-hooke", "C1": 0.5, "kappa": 50.0},
+    "fix": [{"at": {"z": 0.0}, "dofs": ["uz"]}, {"at": {"r": 0.0}, "dofs": ["ur"]}],
+    "contact": [
+        {
+            "surface": {"circle": {"center": [0.0, 7.0], "radius": 5.0}},
+            "slaves": {"z": 2.0},
+            "sticky": True,
+            "motion": {"uz": -0.8},
+        }
+    ],
+    "solver": {"control": "load", "steps": 4},
+}
+
+
+def run(**solver):
+    case = copy.deepcopy(PUNCH)
+    case["solver"].update(solver)
+    built = build(parse(case))
+    result = solve(built.model, built.control, built.options)
+    assert result.status == "finished", result.message
+    return result
+
+
+@pytest.mark.parametrize("growth", [1.0, 1.5])
+def test_a_step_cut_early_grows_back_to_the_nominal_grid(growth):
+    """The first step needs more than 4 iterations at its nominal size: it is cut, the rest of
+    its interval sub-stepped, and every later step is nominal again, whatever the growth (with
+    growth = 1.0 the halved size used to stay for the whole run: 8 steps for 4)."""
+    nominal = [s.lam for s in run(max_iterations=20).steps]
+    assert nominal == [0.25, 0.5, 0.75, 1.0]
+    cut = run(max_iterations=4, growth=growth)
+    lams = [s.lam for s in cut.steps]
+    assert min(b - a for a, b in zip([0.0, *lams], lams, strict=False)) < 0.25  # it did cut
+    assert cut.n_steps <= 1.25 * len(nominal)
+    assert set(nominal) <= set(lams)  # the very same nominal points, to the bit
+
+
+def test_the_first_contact_of_an_unloaded_body_is_no_divergence():
+    """At the first step the disc carries no load and no stress, so the reference force is
+    nearly zero while the punch's contact forces are not: the step converges at its nominal
+    size (it was failed as diverging, and cut three times)."""
+    result = run(steps=2)
+    assert [s.lam for s in result.steps] == [0.5, 1.0]
