@@ -109,6 +109,17 @@ def test_sticky_mould_with_nodes_freezing_at_different_steps_mixed():
     assert pair.report(held)["penetration"] < 0.05  # the mould holds the tube
 
 
+def test_steps_cut_and_sub_stepped_within_their_intervals():
+    """The sticky tube with at most 6 Newton iterations a step: steps are cut and their
+    intervals sub-stepped (the nominal points of the run kept); the derivatives follow the
+    path taken, which the designs at +-h take too."""
+    tree = tube("mixed", contact={"sticky": True})
+    tree["solver"].update(max_iterations=6)
+    sens = check_against_forward_differences(tree)
+    lams = [s.lam for s in sens.solve.steps]
+    assert len(lams) > 6 and {round(k / 6, 12) for k in range(1, 7)} <= {round(x, 12) for x in lams}
+
+
 @pytest.mark.parametrize("formulation", ["mixed", "displacement"])
 def test_coulomb_friction_on_the_mould(formulation):
     # 5800 of gas, not 6000: beyond, the last step drives the wall so far into the cone that
