@@ -2,14 +2,15 @@
 """Steps, failed attempts, Newton iterations, model evaluations and solve time of examples,
 with two source trees side by side (interleaved repeats, the minimum time of each).
 
-    python benchmarks/step_control.py --before OLD/src [--after src] [--repeat 1] [EXAMPLE ...]
-        (default: the examples whose runs cut a step on the tree of before this study)
+    python benchmarks/step_control.py --before OLD/src [--after src] [--before-examples OLD/examples]
+        [--repeat 1] [EXAMPLE ...]   (default: the examples whose runs cut a step before this study)
 
 Each run is `solve` on the example's case as `axiform run` builds it, in a process of its own
 with PYTHONPATH set to the tree; the paths' `attempt` is wrapped to count the attempted steps
 (failed = attempted - converged) and System.evaluate to count the model evaluations (Newton
 iterations, line-search halvings, predictors and failed attempts together).  `asked`: the
-case's solver.steps.  Prints a markdown table.
+case's solver.steps.  --before-examples: a folder of examples the old tree runs instead (those
+whose settings changed with the study; the others from examples/).  Prints a markdown table.
 """
 
 from __future__ import annotations
@@ -26,11 +27,11 @@ EXAMPLES = (
     "cup_heater_programming",
     "cup_thermoforming",
     "cup_cold_mould",
+    "dxf_cup_mould",
     "bottle_blow_moulding",
     "stretch_blow_moulding",
+    "parison_bottle",
     "die_drawing",
-    "toric_plate",
-    "plate_arc_length",
 )
 
 WORKER = r"""
@@ -66,9 +67,11 @@ print(json.dumps({
 """
 
 
-def measure(src: Path, example: str) -> dict:
+def measure(src: Path, folder: Path, example: str) -> dict:
     env = dict(os.environ, PYTHONPATH=str(src), OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1")
-    case = ROOT / "examples" / f"{example}.toml"
+    case = folder / f"{example}.toml"
+    if not case.exists():  # the example did not change
+        case = ROOT / "examples" / f"{example}.toml"
     out = subprocess.run(
         [sys.executable, "-c", WORKER, str(case)], env=env, cwd=ROOT, check=True, capture_output=True, text=True
     )
@@ -79,6 +82,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--before", type=Path, required=True)
     ap.add_argument("--after", type=Path, default=ROOT / "src")
+    ap.add_argument("--before-examples", type=Path, default=ROOT / "examples")
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("examples", nargs="*", default=list(EXAMPLES))
     args = ap.parse_args()
@@ -89,8 +93,11 @@ def main() -> None:
     for ex in args.examples:
         runs: dict[str, list[dict]] = {"before": [], "after": []}
         for _ in range(args.repeat):
-            for name, src in (("before", args.before), ("after", args.after)):
-                runs[name].append(measure(src.resolve(), ex))
+            for name, src, folder in (
+                ("before", args.before, args.before_examples),
+                ("after", args.after, ROOT / "examples"),
+            ):
+                runs[name].append(measure(src.resolve(), folder.resolve(), ex))
         b, a = runs["before"][0], runs["after"][0]
         tb = min(r["seconds"] for r in runs["before"])
         ta = min(r["seconds"] for r in runs["after"])
