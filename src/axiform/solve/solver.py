@@ -94,13 +94,7 @@ def solve(
             size = path.nominal
         result.n_steps += 1
         number = first + result.n_steps - 1
-        checkpoint = {
-            "path": path.state(),
-            "model": path.history.to_dict(),
-            "size": size,
-            "step": number,
-            "newton_iterations": result.newton_iterations,
-        }
+        checkpoint = _checkpoint(path, size, number, result.newton_iterations)
         step = Step(number, lam_new, its, res, u_new, u_full, ev.r_full, checkpoint, path.history)
         del ev  # the tangent goes now, not at the next step
         result.steps.append(step)
@@ -114,6 +108,18 @@ def solve(
             break
     result.wall_time_s = time.perf_counter() - t0
     return result
+
+
+def _checkpoint(path, size: float, number: int, newton_iterations: int) -> dict:
+    """The whole state after step `number`: the path's (with the end of an interval being
+    sub-stepped), the committed history, the step size to try next, the counts."""
+    return {
+        "path": path.state(),
+        "model": path.history.to_dict(),
+        "size": size,
+        "step": number,
+        "newton_iterations": newton_iterations,
+    }
 
 
 def _path(system: System, control, opts: NewtonOptions) -> LoadPath | DisplacementPath | ArcLengthPath:
