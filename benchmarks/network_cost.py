@@ -74,17 +74,17 @@ def evaluations(call, n: int) -> float:
     """How many times the local Newton evaluates the network's elastic law in `call`, per
     chunk of points (parallel.CHUNK: the networks are updated chunk by chunk)."""
     count = [0]
-    original = Network.principal
+    original = Network.plane
 
-    def counted(self, e):
+    def counted(self, y, z):
         count[0] += 1
-        return original(self, e)
+        return original(self, y, z)
 
-    Network.principal = counted
+    Network.plane = counted
     try:
         call()
     finally:
-        Network.principal = original
+        Network.plane = original
     return count[0] / -(-n // CHUNK)
 
 
