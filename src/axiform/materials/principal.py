@@ -103,16 +103,17 @@ def invariant_plane(law: InvariantLaw, y: np.ndarray, z: np.ndarray, scale: floa
         P1, P2, P11, P12, P22 = (None if v is None else scale * v for v in (P1, P2, P11, P12, P22))
     sd = SQRT2 * d
     s2 = s - 2.0 * b3
-    ty, tz = P1 * sd, (2.0 / SQRT6) * P1 * s2
-    kyy, kyz, kzz = (2.0 * P1) * s, (2.0 / SQRT3) * P1 * d, (2.0 / 3.0) * P1 * (s + 4.0 * b3)
-    if P2 is not None:
+    if P2 is None:
+        ty, tz = P1 * sd, (2.0 / SQRT6) * P1 * s2
+        kyy, kyz, kzz = (2.0 * P1) * s, (2.0 / SQRT3) * P1 * d, (2.0 / 3.0) * P1 * (s + 4.0 * b3)
+    else:  # Psi_1 d1 + Psi_2 d2 and its moduli, gathered
+        P2b3 = P2 * b3
+        up, down = P1 + P2b3, P1 - P2b3
         sb = s * b3
         c = 2.0 * p12
-        ty = ty + P2 * (sd * b3)
-        tz = tz + (2.0 / SQRT6) * P2 * (c - sb)
-        kyy = kyy + (2.0 * P2) * sb
-        kyz = kyz - (2.0 / SQRT3) * P2 * (d * b3)
-        kzz = kzz + (2.0 / 3.0) * P2 * (2.0 * c + sb)
+        ty, kyy, kyz = up * sd, 2.0 * up * s, (2.0 / SQRT3) * down * d
+        tz = (2.0 / SQRT6) * (P1 * s2 + P2 * (c - sb))
+        kzz = (2.0 / 3.0) * (P1 * (s + 4.0 * b3) + P2 * (2.0 * c + sb))
     if P11 is None and P12 is None and P22 is None:
         return ty, tz, kyy, kyz, kzz
     d1y, d1z = sd, (2.0 / SQRT6) * s2
