@@ -253,21 +253,22 @@ def network_rows(network: Network, xt: np.ndarray, Cvi: np.ndarray, dt: float, a
     rate = network.flow.rate_factor((RR + ZZ) / det_m + 1.0 / TT, a_T if network.flow.shift else 1.0)
     rate = np.broadcast_to(rate, a.shape)
     X = solve_local(network.plane, y_tr, z_tr, rate, network.flow.m, dt)
-    Qm = np.stack([cos, sin, -sin, cos]).reshape(2, 2, -1)  # n_j: [j, a]
-    Finv = np.stack([d, -b, -c, a]).reshape(2, 2, -1) * (1.0 / j2)  # F^-1: [B, a]
-    Hm = (Finv[None] * Qm[:, None]).sum(2)  # h_j = F^-1 n_j: [j, B]
+    ij = 1.0 / j2
+    H = np.stack(
+        [(d * cos - b * sin) * ij, (a * sin - c * cos) * ij, (-d * sin - b * cos) * ij, (c * sin + a * cos) * ij]
+    )
     # be_i = mu_i exp(2 (e_i - e_tr,i)), e - e_tr = (dy u_y + dz u_z)
     ez = np.exp((2.0 / SQRT6) * (X[Z] - z_tr))
     ey = np.exp(SQRT2 * (X[Y] - y_tr))
-    trial = elastic_state(mu1 * ez * ey, mu2 * ez / ey, TT / (ez * ez), Hm)
-    P, A = tangent_rows(X, Qm, Hm, mu1, mu2, rad, xt)
+    trial = elastic_state(mu1 * ez * ey, mu2 * ez / ey, TT / (ez * ez), H)
+    P, A = tangent_rows(X, H, (cos, sin), mu1, mu2, rad, xt)
     return P, A, trial
 
 
-def elastic_state(be1: np.ndarray, be2: np.ndarray, TT: np.ndarray, Hm: np.ndarray) -> np.ndarray:
+def elastic_state(be1: np.ndarray, be2: np.ndarray, TT: np.ndarray, H: np.ndarray) -> np.ndarray:
     """Cv^-1 = F^-1 Be F^-T (4, n) (RR, RZ, ZZ, TT) of Be = be1 n_1 n_1 + be2 n_2 n_2 (meridian)
-    from h_j = F^-1 n_j, Hm (2, 2, n) [j, B], and the new TT (n)."""
-    (h1R, h1Z), (h2R, h2Z) = Hm
+    from h_j = F^-1 n_j, H (4, n) = (h_1R, h_1Z, h_2R, h_2Z), and the new TT (n)."""
+    h1R, h1Z, h2R, h2Z = H
     out = np.empty((4, be1.size))
     out[0] = be1 * h1R * h1R + be2 * h2R * h2R
     out[1] = be1 * h1R * h1Z + be2 * h2R * h2Z
@@ -277,49 +278,57 @@ def elastic_state(be1: np.ndarray, be2: np.ndarray, TT: np.ndarray, Hm: np.ndarr
 
 
 def tangent_rows(
-    X: tuple[np.ndarray, ...],
-    Qm: np.ndarray,
-    Hm: np.ndarray,
+    X: tuple[np.ndarray, ...] | np.ndarray,
+    H: np.ndarray,
+    axis: tuple,
     mu1: np.ndarray,
     mu2: np.ndarray,
     rad: np.ndarray,
     xt: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """P (5, n) and A = dP/dx (5, 5, n) from the local state X at the solution (14 rows (n)),
-    the axes n_j (Qm (2, 2, n): [j, a], a = r, z) and h_j = F^-1 n_j (Hm (2, 2, n): [j, B],
-    B = R, Z), the trial eigenvalues and half gap (module docstring).  On stacked arrays, a
-    few broadcasts rather than one operation per entry."""
+    """P (5, n) and A = dP/dx (5, 5, n) from the local state X at the solution (14, n), the
+    axes h_j = F^-1 n_j (H (4, n): h_1R, h_1Z, h_2R, h_2Z), n_1 = axis = (cos, sin) (n each),
+    the trial eigenvalues and half gap (module docstring).  A is symmetric (the update derives
+    from a potential of F at fixed Cv_n^-1): its upper triangle is computed, entry by entry."""
     n = xt.shape[1]
     f = xt[4]
-    O = (Qm[:, :, None] * Hm[:, None]).reshape(2, 4, n)  # O_j = n_j h_j^T, x's components (a, B)
-    Ow = np.empty((2, 5, n))  # O_y, O_z
-    np.subtract(O[0], O[1], out=Ow[0, :4])
-    Ow[0, :4] *= 1.0 / SQRT2
-    np.add(O[0], O[1], out=Ow[1, :4])
-    Ow[1, :4] *= 1.0 / SQRT6
-    Ow[0, 4] = 0.0
-    Ow[1, 4] = (-2.0 / SQRT6) / f
+    cos, sin = axis
+    q1, q2 = (cos, sin), (-sin, cos)  # n_1, n_2 (r, z)
+    h1, h2 = (H[0], H[1]), (H[2], H[3])
+    pairs = [(i // 2, i % 2) for i in range(4)]  # x's meridian components (a, B): F_aB
+    O1 = [q1[a] * h1[B] for a, B in pairs]  # O_j = n_j h_j^T
+    O2 = [q2[a] * h2[B] for a, B in pairs]
+    Oy = [(u - v) * (1.0 / SQRT2) for u, v in zip(O1, O2, strict=True)]
+    Oz = [(u + v) * (1.0 / SQRT6) for u, v in zip(O1, O2, strict=True)] + [(-2.0 / SQRT6) / f]
     ty, tz = X[TY], X[TZ]
-    P = ty * Ow[0] + tz * Ow[1]
+    P = np.empty((5, n))
+    for i in range(4):
+        P[i] = ty * Oy[i] + tz * Oz[i]
+    P[4] = tz * Oz[4]
     # M = k (dr/dw)^-1, symmetric
     kyy, kyz, kzz, jyy, jyz, jzy, jzz = X[KYY], X[KYZ], X[KZZ], X[JYY], X[JYZ], X[JZY], X[JZZ]
     idet = 1.0 / (jyy * jzz - jyz * jzy)
     Myy = (kyy * jzz - kyz * jzy) * idet
     Myz = 0.5 * (kyz * jyy - kyy * jyz + kyz * jzz - kzz * jzy) * idet
     Mzz = (kzz * jyy - kyz * jyz) * idet
-    D = np.stack([Myy, Myz, Myz, Mzz]).reshape(2, 2, 1, n) * Ow[None]  # [a, b, i] M_ab O_b,i
-    A = Ow[0][:, None] * (D[0, 0] + D[0, 1])[None]
-    A += Ow[1][:, None] * (D[1, 0] + D[1, 1])[None]
+    Dy = [Myy * u + Myz * v for u, v in zip(Oy, Oz, strict=False)] + [Myz * Oz[4]]
+    Dz = [Myz * u + Mzz * v for u, v in zip(Oy, Oz, strict=False)] + [Mzz * Oz[4]]
     # the rotation of the axes: dtau_12 = ratio dBe_12, dBe_12 = n_1.dF mu_2 h_2 + n_2.dF mu_1 h_1
     gap = rad > DEGENERATE * mu1
     ratio = np.where(gap, ty / (SQRT2 * np.where(gap, rad, 1.0)), Myy / (mu1 + mu2))
-    O12 = Qm[0][:, None] * Hm[1][None] + Qm[1][:, None] * Hm[0][None]
-    dBe12 = Qm[0][:, None] * (mu2 * Hm[1])[None] + Qm[1][:, None] * (mu1 * Hm[0])[None]
+    rO12 = [ratio * (q1[a] * h2[B] + q2[a] * h1[B]) for a, B in pairs]
+    m2h2, m1h1 = (mu2 * h2[0], mu2 * h2[1]), (mu1 * h1[0], mu1 * h1[1])
+    dBe12 = [q1[a] * m2h2[B] + q2[a] * m1h1[B] for a, B in pairs]
     # the geometric part tau d(F^-T) = -P dF^T F^-T: [(a, B), (alpha, beta)] = -P_a,beta F^-T_alpha,B
-    Gi = np.stack([xt[3], -xt[2], -xt[1], xt[0]]) * (1.0 / (xt[0] * xt[3] - xt[1] * xt[2]))
-    rotation = (ratio * O12).reshape(4, 1, n) * dBe12.reshape(1, 4, n)
-    geometric = P[:4].reshape(2, 1, 1, 2, n) * Gi.reshape(2, 2, n).transpose(1, 0, 2)[None, :, :, None]
-    rotation -= geometric.reshape(4, 4, n)
-    A[:4, :4] += rotation
-    A[4, 4] -= P[4] / f
+    ij = 1.0 / (xt[0] * xt[3] - xt[1] * xt[2])
+    Gi = (xt[3] * ij, -xt[2] * ij, -xt[1] * ij, xt[0] * ij)
+    A = np.empty((5, 5, n))
+    for i, (a, B) in enumerate(pairs):
+        for j in range(i, 4):
+            alpha, beta = pairs[j]
+            A[i, j] = Oy[i] * Dy[j] + Oz[i] * Dz[j] + rO12[i] * dBe12[j] - P[2 * a + beta] * Gi[2 * alpha + B]
+            if j > i:
+                A[j, i] = A[i, j]
+        A[i, 4] = A[4, i] = Oy[i] * Dy[4] + Oz[i] * Dz[4]
+    A[4, 4] = Oz[4] * Dz[4] - P[4] / f
     return P, A
