@@ -24,6 +24,22 @@
 
 The tables go to stdout and to benchmarks/results/network_cost.md (network_cost_quick.md with
 --quick).
+
+Note (issue 28's goal, at most 3x).  Three runs on the 2-core development machine under a load
+average of 10 to 13 (other jobs): short step 3.21x, 3.10x, 2.89x; long step 3.96x, 3.53x,
+3.24x the elastic law; the previous update in the same runs 9.6x to 10.6x and 12.1x to 12.5x,
+so 3.0x to 3.8x less time, but the goal only about met for the short step and not for the
+long one.  Where the time goes, per chunk of 8192 points against the elastic law on the same
+points (section 2): the local Newton 1.3x to 2.0x (4 evaluations of the law on a short step,
+6 on a long one: the predictor, the far-flow guess, 3 Newton steps and a few points a 4th; the
+residuals at the guess are 4e-3, dominated by the angle between tau' and w, which no radial
+guess removes), P and the tangent 0.6x to 0.8x, the trial Be, its axes, logarithms and the
+flow's rate factor about 0.6x, the far-flow guess up to 0.3x; on top, in the update, the
+equilibrium law itself (1.0x) and parallel.py's sums of P and A.  Each of the 700 to 900
+elementwise NumPy operations of a chunk costs 4 to 9 us (about 1.5 us of call, the rest memory
+traffic: some 50 live arrays of 64 KiB exceed the cache), an exp or log some 40 us: the
+NumPy form is near its floor here; what is left is fewer operations per evaluation (a compiled
+kernel, or a law-specific residual) or fewer evaluations (a guess that knows the angle).
 """
 
 from __future__ import annotations
