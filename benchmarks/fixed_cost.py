@@ -8,7 +8,10 @@ Each repeat runs, in turn (and for each source tree when --before is given):
 - floor: `python -c "import numpy, scipy.sparse"`;
 - off: `axiform run CASE -q` with output.vtu and output.plots off;
 - vtu: the same with the VTU series on (plots off);
-- default: the case's default outputs (VTU and the three pictures).
+- default: the case's default outputs (VTU and the three pictures);
+- and, to read the others by: the imports of a run (`axiform.app.run`, the case schema, the
+  results writer, the solver) and matplotlib's (`matplotlib.figure`, its Agg canvas), each
+  beside NumPy and scipy.sparse, less the floor.
 A run is `axiform.cli.main` in a fresh Python whose `solve` is wrapped to record its wall and
 CPU time (the solve as summary.json's wall_time_s counts it: the steps and their per-step
 files).  Wall time is measured from outside, CPU time is user + system of the child process.
@@ -34,6 +37,12 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 OFF = ["--set", "output.plots=false", "--set", "output.vtu=false"]
 KINDS = {"off": OFF, "vtu": ["--set", "output.plots=false"], "default": []}
+IMPORTS = {
+    "floor": "import numpy, scipy.sparse",
+    "imports": "import numpy, scipy.sparse, axiform.app.run, axiform.case.schema, axiform.io.results, "
+    "axiform.solve.solver",
+    "mpl": "import numpy, scipy.sparse, matplotlib.figure, matplotlib.backends.backend_agg",
+}
 
 # the child: axiform's command line, its solve timed (wall, CPU) into the file argv[1]
 CHILD = """
@@ -65,12 +74,12 @@ def timed(args: list[str], env: dict[str, str]) -> tuple[float, float]:
 
 
 def measure(src: Path, case: Path, work: Path, kind: str) -> dict[str, float]:
-    """One process of `kind` (floor, off, vtu, default): its wall and CPU, and for a run its
-    solve's wall and CPU."""
+    """One process of `kind` (floor, imports, mpl, off, vtu, default): its wall and CPU, and
+    for a run its solve's wall and CPU."""
     env = dict(os.environ, PYTHONPATH=str(src))
     env.pop("PYTHONDONTWRITEBYTECODE", None)
-    if kind == "floor":
-        wall, cpu = timed([sys.executable, "-c", "import numpy, scipy.sparse"], env)
+    if kind in IMPORTS:
+        wall, cpu = timed([sys.executable, "-c", IMPORTS[kind]], env)
         return {"wall": wall, "cpu": cpu}
     spans = work / "solve.json"
     out = work / kind
@@ -85,11 +94,13 @@ def least(runs: list[dict[str, float]], key) -> float:
 
 
 def summary(runs: dict[str, list[dict[str, float]]]) -> dict[str, float]:
-    """The least of the repeats: floor, whole processes, solve, fixed cost, pictures, VTU (wall
-    and CPU)."""
+    """The least of the repeats: floor, whole processes, solve, fixed cost, pictures, VTU, the
+    imports above the floor (wall and CPU)."""
     out = {}
     for clock in ("wall", "cpu"):
         floor = least(runs["floor"], lambda r, c=clock: r[c])
+        for kind in ("imports", "mpl"):
+            out[f"{kind}_{clock}"] = least(runs[kind], lambda r, c=clock: r[c]) - floor
         off = least(runs["off"], lambda r, c=clock: r[c])
         vtu = least(runs["vtu"], lambda r, c=clock: r[c])
         default = least(runs["default"], lambda r, c=clock: r[c])
@@ -120,10 +131,12 @@ def table(results: dict[str, dict[str, float]]) -> str:
         "vtu": "the VTU series (vtu minus off)",
         "pictures": "**the three pictures** (default minus vtu)",
         "default": "whole process, default outputs",
+        "imports": "a run's imports (app.run, case schema, writer, solver), less the floor",
+        "mpl": "matplotlib's imports (figure, Agg canvas), less the floor",
     }
     for key, name in names.items():
         lines.append(f"| {name} | " + " | ".join(f"{results[lb][f'{key}_{c}']:.3f}" for lb, c in heads) + " |")
-    for key in ("fixed", "pictures"):
+    for key in ("fixed", "pictures", "imports", "mpl"):
         lines.append(
             f"| {key} / floor | "
             + " | ".join(f"**{results[lb][f'{key}_{c}'] / results[lb][f'floor_{c}']:.2f}**" for lb, c in heads)
@@ -142,7 +155,7 @@ def main() -> None:
     trees = {"after": args.after.resolve()}
     if args.before is not None:
         trees = {"before": args.before.resolve(), **trees}
-    kinds = ("floor", "off", "vtu", "default")
+    kinds = ("floor", "imports", "mpl", "off", "vtu", "default")
     runs = {label: {kind: [] for kind in kinds} for label in trees}
     print(f"load average at start: {os.getloadavg()[0]:.2f}", flush=True)
     with tempfile.TemporaryDirectory(prefix="axiform-fixed-cost-") as tmp:
