@@ -47,6 +47,7 @@ MODES = ("uniaxial", "equibiaxial")
 STEPS = 40  # steps of the coarse grid of a curve (the fine one has twice as many)
 M_MAX = 20.0  # the largest stress exponent m tried
 UNIT_NETWORK = NeoHooke(0.5, 0.0)  # shear modulus 1: a network's elastic part, scaled by its mu
+MAX_EVALUATIONS = 100  # of the residuals per start (each Jacobian one more)
 FAILED = 1e3  # the residual of a point whose update did not converge (a relative error)
 
 
@@ -205,7 +206,8 @@ class Layout:
 
 def model_stress(layout: Layout, thetas: np.ndarray, curves: Curves, grids: list[tuple]) -> np.ndarray:
     """The model's nominal stress (s, n) at the data points for each parameter set thetas (s, p);
-    grids: (path (K + 1, c), at (n,), weight) of the step sizes combined (Richardson)."""
+    grids: (path (K + 1, c), at (n,), weight) of the step sizes combined (Richardson).
+    TemperatureDomainError where a set's WLF pole is at or above a curve's temperature."""
     s, c = len(thetas), curves.count
     x = curves.x()
     out = np.array([nominal(layout.equilibrium(th), x) for th in thetas])
@@ -214,13 +216,17 @@ def model_stress(layout: Layout, thetas: np.ndarray, curves: Curves, grids: list
         shift = layout.shift(th)
         if shift is not None and curves.temperature is not None:
             a_T[j] = shift.shift(curves.temperature)
-    mode = np.tile(curves.mode, s)
     for k in range(layout.networks):
-        mu, A, C, m = (np.repeat([layout.network(th, k)[i] for th in thetas], c) for i in range(4))
-        scale = A / (a_T.ravel() * np.tile(curves.rate, s))
+        # the sets that differ only in other constants give this network the same stress: each
+        # distinct (mu, A, C, m, a_T) is integrated once
+        own = np.column_stack([[layout.network(th, k) for th in thetas], a_T])
+        unique, back = np.unique(own, axis=0, return_inverse=True)
+        u = len(unique)
+        mu, A, C, m = (np.repeat(unique[:, i], c) for i in range(4))
+        scale = A / (unique[:, 4:].ravel() * np.tile(curves.rate, u))
         for path, at, weight in grids:
-            S = integrate(np.tile(path, (1, s)), mode, scale, mu, C, m, layout.E)
-            out += weight * S[at[None, :], curves.curve[None, :] + c * np.arange(s)[:, None]]
+            S = integrate(np.tile(path, (1, u)), np.tile(curves.mode, u), scale, mu, C, m, layout.E)
+            out += weight * S[at[None, :], curves.curve[None, :] + c * np.ravel(back)[:, None]]
     return out
 
 
@@ -265,7 +271,9 @@ def fit_networks(
     fun, jac = difference_jacobian(residuals, bounds)
     best = None
     for theta0 in starts:
-        sol = least_squares(fun, np.clip(theta0, *bounds), jac=jac, bounds=bounds, x_scale="jac", max_nfev=200)
+        sol = least_squares(
+            fun, np.clip(theta0, *bounds), jac=jac, bounds=bounds, x_scale="jac", max_nfev=MAX_EVALUATIONS
+        )
         if best is None or sol.cost < best.cost:
             best = sol
     assert best is not None, "at least one start"
