@@ -71,6 +71,8 @@ def build_control(model: Model, mesh: Mesh, spec: SolverSpec) -> LoadControl | D
         if getattr(model.material, "prony", None) is not None
         else "heat conduction ([thermal])"
         if model.conduction is not None
+        else "a prescribed change of temperature ([temperature] change)"
+        if model.change is not None
         else None
     )
     if spec.control != "load" and timed:

@@ -61,6 +61,7 @@ class Model:
     temperature: np.ndarray | None = None
     shift: Any = None
     conduction: Any = None
+    change: Curve | None = None
 
     def __post_init__(self):
         if self.sfr_edges not in SFR_EDGE_RULES:
@@ -105,6 +106,14 @@ class Model:
         if shift is not None:
             shift.check(T)
         self.temperature, self.shift = T, shift
+
+    def program(self, change: Curve | None) -> None:
+        """A prescribed change of the temperature in time (needs a temperature, `heat`):
+        T(x, t) = T(x) + dT(t), dT the Curve `change` (None: none); a step runs at the
+        temperature of its end (System.temperature_at)."""
+        if change is not None and self.temperature is None:
+            raise ValueError("a change of temperature needs the material's initial temperature (heat)")
+        self.change = change
 
     def conduct(self, conduction) -> None:
         """Heat conduction in the body (fem.heat.Conduction; needs a temperature, `heat`):
@@ -218,6 +227,7 @@ class Model:
             unknown_offsets=tuple(int(o) for o in offsets[:-1]),
             noise_floor=float(floor),
             rigid_modes=rigid_translations(self.mesh, self.dpn, dofmap, dofmap.nf + int(offsets[-1])),
+            change=self.change,
         )
 
 
