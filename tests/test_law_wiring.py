@@ -1,0 +1,77 @@
+"""The solid knows a law only through its interface (materials.protocol): a law of viscous
+networks in a model gives, on a homogeneous bar, the numbers of the law at a material point
+(elements, mixed or not, and the pictures' stresses)."""
+
+import numpy as np
+import pytest
+
+from axiform import LoadControl, Model, NeoHooke, NewtonOptions, rectangle, select_nodes, solve
+from axiform.fem.curves import Curve
+from axiform.materials import cauchy_stress
+from axiform.materials.network import BergstromBoyce, Network
+from axiform.materials.parallel import NetworkLaw
+from axiform.post.fields import point_fields
+
+LAW = NetworkLaw(NeoHooke(0.5, 50.0), [Network(NeoHooke(1.0, 0.0), BergstromBoyce(A=0.5, C=-0.7, m=3.0, E=0.01))])
+STRETCH, STEPS, END = 1.8, 16, 1.6  # stretched at 0.5 / s, then held: it relaxes
+
+
+def program(t):
+    return 1.0 + (STRETCH - 1.0) * min(t, END / 2.0) / (END / 2.0)
+
+
+def point(law, times):
+    """The nominal stress P_zZ and x at a material point stretched along z by program(t),
+    its lateral stress free (Newton on the lateral stretch with the update's tangent)."""
+    state, a, t0, out = law.initial_state(()), 1.0, 0.0, []
+    for t in times:
+        lam = program(t)
+        for _ in range(50):
+            x = np.array([a, 0.0, 0.0, lam, a])
+            P, A, trial = law.update(x, state, t - t0, None)
+            da = -P[0] / (A[0, 0] + A[0, 4])
+            a += da
+            if abs(da) < 1e-15:
+                break
+        x = np.array([a, 0.0, 0.0, lam, a])
+        P, _, state = law.update(x, state, t - t0, None)
+        t0 = t
+        out.append((P[3], x, P))
+    return out
+
+
+def bar(law, element, formulation):
+    mesh = rectangle((0.0, 1.0), (0.0, 1.0), (2, 2), element)
+    model = Model(mesh, law, formulation=formulation)
+    model.fix(select_nodes(mesh, {"r": 0.0}), ["ur"])
+    model.fix(select_nodes(mesh, {"z": 0.0}), ["uz"])
+    top = select_nodes(mesh, {"z": 1.0})
+    model.prescribe(top, ["uz"], STRETCH - 1.0, Curve([[0.0, 0.0], [END / 2.0, 1.0], [END, 1.0]]))
+    system = model.finalize()
+    return system, system.dof(top, "uz")
+
+
+@pytest.mark.parametrize(
+    "element, formulation", [("q4", "displacement"), ("q4", "mixed"), ("q8", "mixed"), ("sfr", "mixed")]
+)
+def test_a_homogeneous_bar_of_networks_is_the_law_at_a_point(element, formulation):
+    """Force on the end / pi against the material point's P_zZ at every step (the same steps):
+    to the solver's tolerance; the fields' Cauchy stress at the committed state against the
+    point's."""
+    system, top = bar(LAW, element, formulation)
+    forces, times = [], []
+
+    def record(step):
+        forces.append(step.r_full[top].sum() / np.pi)
+        times.append(step.lam)
+
+    res = solve(system, LoadControl(END, STEPS), NewtonOptions(tolerance=1e-12), on_step=record)
+    assert res.status == "finished", res.message
+    assert len(times) == STEPS
+    expected = point(LAW, np.array(times))
+    P_point = np.array([p for p, _, _ in expected])
+    assert P_point.max() > 1.5 and P_point[-1] < 0.92 * P_point.max()  # loaded, then relaxed
+    np.testing.assert_allclose(forces, P_point, rtol=1e-8, atol=1e-10)
+    sigma = point_fields(system, res.last.u, res.last.state)["cauchy_stress"]
+    _, x, P = expected[-1]
+    np.testing.assert_allclose(sigma[:, :3], np.tile(cauchy_stress(x, P)[:3], (len(sigma), 1)), atol=1e-8)
