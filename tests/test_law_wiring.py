@@ -1,13 +1,13 @@
 """The solid knows a law only through its interface (materials.protocol): a law of viscous
 networks in a model gives, on a homogeneous bar, the numbers of the law at a material point
-(elements, mixed or not, and the pictures' stresses)."""
+(elements, mixed or not, and the pictures' stresses); a local update that fails cuts the step."""
 
 import numpy as np
 import pytest
 
 from axiform import LoadControl, Model, NeoHooke, NewtonOptions, rectangle, select_nodes, solve
 from axiform.fem.curves import Curve
-from axiform.materials import cauchy_stress
+from axiform.materials import LocalUpdateError, cauchy_stress
 from axiform.materials.network import BergstromBoyce, Network
 from axiform.materials.parallel import NetworkLaw
 from axiform.post.fields import point_fields
@@ -75,3 +75,21 @@ def test_a_homogeneous_bar_of_networks_is_the_law_at_a_point(element, formulatio
     sigma = point_fields(system, res.last.u, res.last.state)["cauchy_stress"]
     _, x, P = expected[-1]
     np.testing.assert_allclose(sigma[:, :3], np.tile(cauchy_stress(x, P)[:3], (len(sigma), 1)), atol=1e-8)
+
+
+class Fussy(NetworkLaw):
+    """The law of networks whose local update fails over steps longer than 0.06."""
+
+    def update(self, x, state_n, dt, T, volumetric=True, tangent=True):
+        if dt > 0.06:
+            raise LocalUpdateError(np.arange(3))
+        return super().update(x, state_n, dt, T, volumetric, tangent)
+
+
+def test_a_local_update_that_fails_cuts_the_step():
+    law = Fussy(LAW.equilibrium, LAW.networks)
+    system, top = bar(law, "q4", "mixed")
+    times = []
+    res = solve(system, LoadControl(0.4, 4), NewtonOptions(), on_step=lambda step: times.append(step.lam))
+    assert res.status == "finished", res.message
+    assert times[-1] == pytest.approx(0.4) and np.diff([0.0, *times]).max() <= 0.06
