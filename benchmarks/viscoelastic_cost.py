@@ -153,7 +153,7 @@ def pieces(n_points: int, repeats: int) -> list[list[str]]:
     branch = {  # the displacement assembly's memory branch, call by call
         "`stress_rows(xt, 0.0, True)` (the law's isochoric part)": lambda: law.stress_rows(xt, 0.0, True),
         "`prony_step` (`viscous_rows`, the history to rows and back)": lambda: prony_step(
-            SERIES["3 terms"], xt, P.copy(), A.copy(), history, T_TRIAL - T_COMMITTED
+            xt, P.copy(), A.copy(), history, factors
         ),
         "`add_volumetric` (kappa's part, a second pass over A)": lambda: add_volumetric(
             xt, law.kappa, P.copy(), A.copy()

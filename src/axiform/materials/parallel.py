@@ -28,6 +28,7 @@ from .prony import Prony, prony_step
 from .protocol import State, law_at, quadratic_volumetric
 from .temperature import Shift, TemperatureDependent
 
+MEMO = 64  # chunks of points whose step factors are kept (the step's: the same at each iteration)
 IDENTITY = np.array([1.0, 0.0, 1.0, 1.0])  # Cv^-1 = I: a network at rest (RR, RZ, ZZ, TT)
 # points per call of a network's update: its (3, 3, n) work arrays stay in the cache (at 1e5
 # points on a loaded machine about 20 % faster than one call; benchmarks/network_cost.py)
@@ -51,6 +52,7 @@ class NetworkLaw:
         self.freeze = freeze
         self.shift = shift
         self.prony = prony
+        self._memo: dict = {}  # a memo of step_factors, a pure function of (dt, T)
 
     @property
     def kappa(self) -> float:
@@ -79,6 +81,7 @@ class NetworkLaw:
             return self
         out = copy.copy(self)
         out.shift = shift
+        out._memo = {}
         return out
 
     def bulk_modulus(self, T: np.ndarray | None) -> Any:
@@ -117,16 +120,13 @@ class NetworkLaw:
         (no shift, no freezing)."""
         xt, shape = to_rows(x)
         law = law_at(self.equilibrium, T)
-        # a step of no length (the stress at a committed state) needs no shift: none is taken,
-        # so that a temperature beyond the shift's domain stops only a step that advances
-        a_T = None if self.shift is None or T is None or not dt > 0 else self.shift.shift(T)
+        a_T, factors = self.step_factors(dt, T)
         trial: State = {}
-        if self.prony is None:
+        if factors is None:
             P, A = law.stress_rows(xt, law.kappa if volumetric else 0.0, tangent)
         else:  # the series on the isochoric part, then the volumetric part
             P, A = law.stress_rows(xt, 0.0, tangent)
-            dxi = max(dt, 0.0) if a_T is None else max(dt, 0.0) * (1.0 / a_T)
-            trial |= prony_step(self.prony, xt, P, A, state_n, dxi)
+            trial |= prony_step(xt, P, A, state_n, factors)
             if volumetric:
                 add_volumetric(xt, law.kappa, P, A)
         if self.networks:
@@ -138,6 +138,24 @@ class NetworkLaw:
                 A += Af
             trial |= frozen
         return (*from_rows(P, A, shape), trial)
+
+    def step_factors(self, dt: float, T: np.ndarray | None) -> tuple[np.ndarray | None, tuple | None]:
+        """a_T (T's shape) or None (no shift, no temperature, or a step of no length: the stress
+        at a committed state takes none, so that a temperature beyond the shift's domain stops
+        only a step that advances) and the Prony factors of the step (Prony.factors of each
+        point's reduced time dt / a_T; None without a series).  Kept for the last MEMO chunks
+        of points of the same dt: the iterations of a step ask the same again (read only)."""
+        if self.shift is None or T is None or not dt > 0:
+            return None, None if self.prony is None else self.prony.factors(max(dt, 0.0))
+        T = np.asarray(T, float)
+        key = (dt, T.shape, T.tobytes())
+        hit = self._memo.get(key)
+        if hit is None:
+            if len(self._memo) >= MEMO or any(k[0] != dt for k in self._memo):
+                self._memo.clear()
+            a_T = self.shift.shift(T)
+            hit = self._memo[key] = (a_T, None if self.prony is None else self.prony.factors(dt * (1.0 / a_T)))
+        return hit
 
     def add_networks(
         self,

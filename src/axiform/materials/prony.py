@@ -120,12 +120,13 @@ def viscous_rows(
 
 
 def prony_step(
-    prony: Prony, xt: np.ndarray, P: np.ndarray, A: np.ndarray | None, state_n: dict, dxi: Any
+    xt: np.ndarray, P: np.ndarray, A: np.ndarray | None, state_n: dict, factors: tuple[Any, Any, Any]
 ) -> dict[str, np.ndarray]:
     """Add the series to the law's isochoric P rows (5, n) and A rows (5, 5, n) (or None), in
-    place, over a step of reduced time dxi (a number, or one per point (...)) from the committed
-    history state_n {"h": (..., m, 4), "S": (..., 4)} of the n points of xt (5, n); return the
-    trial history, arrays of the same shapes."""
+    place, over a step of factors `factors` (Prony.factors of the step's reduced time: (m,) for
+    every point or (..., m) one set per point) from the committed history state_n {"h":
+    (..., m, 4), "S": (..., 4)} of the n points of xt (5, n); return the trial history, arrays of
+    the same shapes."""
     h = state_n["h"]
     shape, m = h.shape[:-2], h.shape[-2]
     n = xt.shape[1]
@@ -133,7 +134,6 @@ def prony_step(
     # strided view the sums ran loops of length 4 and cost the law's own stress and tangent)
     h_rows = np.ascontiguousarray(h.reshape(n, m, 4).transpose(1, 2, 0))
     S_rows = np.ascontiguousarray(state_n["S"].reshape(n, 4).T)
-    factors = prony.factors(dxi)
     if factors[0].ndim == 1:
         e, a, b = (f[:, None] for f in factors)
     else:
