@@ -77,6 +77,23 @@ def test_a_homogeneous_bar_of_networks_is_the_law_at_a_point(element, formulatio
     np.testing.assert_allclose(sigma[:, :3], np.tile(cauchy_stress(x, P)[:3], (len(sigma), 1)), atol=1e-8)
 
 
+@pytest.mark.parametrize("element, formulation", [("q4", "displacement"), ("q8", "mixed")])
+def test_the_tangent_of_a_model_of_networks_matches_differences_of_the_residual(element, formulation):
+    """From a committed state whose networks have flowed, at a perturbed state a step later:
+    the model's tangent against central differences of its residual (the state held)."""
+    from conftest import difference_tangent
+
+    system, _ = bar(LAW, element, formulation)
+    res = solve(system, LoadControl(0.4, 4), NewtonOptions())
+    held = res.last.state
+    assert np.abs(system.solid_state(held)["network0"] - [1.0, 0.0, 1.0, 1.0]).max() > 1e-3
+    u_f = res.last.u_f + 1e-3 * np.random.default_rng(5).standard_normal(system.n_free)
+    t = res.last.lam + 0.05
+    K = system.evaluate(u_f, t, held).K.toarray()
+    num, _ = difference_tangent(system, u_f, t, 1e-6, held)
+    assert np.abs(K - num).max() < 1e-6 * np.abs(K).max()
+
+
 class Fussy(NetworkLaw):
     """The law of networks whose local update fails over steps longer than 0.06."""
 
