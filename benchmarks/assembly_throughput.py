@@ -95,7 +95,7 @@ def solid_pieces(solid: SolidAssembly, u: np.ndarray):
         c1 = clock()
         solid.check_inverted(x, start)
         c2 = clock()
-        P, A = solid.material.stress_tangent(x)
+        P, A, _ = solid.law.update(x, {}, 0.0, None)
         c3 = clock()
         GdV_T = solid._GdV[sl].transpose(0, 2, 1)
         AG = np.matmul(A, solid.G[sl]).reshape(m, q * 5, nd)
@@ -267,7 +267,7 @@ def variants(element: str, n_elements: int, min_time: float) -> dict:
     u = model.expand(u_f, lam)
     ue = u[s.dofs]
     x = s.gradient(u)
-    P, A = s.material.stress_tangent(x)
+    P, A, _ = s.law.update(x, {}, 0.0, None)
     P2 = P.reshape(e, q * 5)
     AG = np.matmul(A, s.G).reshape(e, q * 5, nd)
     GdV_T_copy = np.ascontiguousarray(s._GdV.transpose(0, 2, 1))  # (e, nd, 5q), as src did before
@@ -290,7 +290,7 @@ def variants(element: str, n_elements: int, min_time: float) -> dict:
     cases = [
         ("g = G u_e", "matmul G2 (e,5q,nd) · u_e (src)", loop(lambda sl: np.matmul(s._G2[sl], ue[sl, :, None]))),
         ("g = G u_e", "einsum eqik,ek->eqi", loop(lambda sl: np.einsum("eqik,ek->eqi", s.G[sl], ue[sl]))),
-        ("P, A", "MooneyRivlin.stress_tangent (src)", loop(lambda sl: s.material.stress_tangent(x[sl]))),
+        ("P, A", "the law's update, MooneyRivlin (src)", loop(lambda sl: s.law.update(x[sl], {}, 0.0, None))),
         (
             "f_e = GᵀP dV",
             "matmul, transposed view of GdV (e,5q,nd) (src)",

@@ -355,11 +355,11 @@ def idle_temperature(built: Built) -> list[str]:
     heat = case.temperature
     if heat is None:
         return []
-    viscous = case.material.viscoelastic is not None
+    viscous = case.material.memory
     if heat.shift is not None and not viscous:
         return [
-            "temperature.shift: the material has no Prony series ([material] viscoelastic): the shift of its "
-            "relaxation times changes nothing"
+            "temperature.shift: the material has no Prony series ([material] viscoelastic) and no network: "
+            "the shift of its relaxation times changes nothing"
         ]
     if heat.shift is None and not case.material.tables() and case.thermal is None:
         return [

@@ -3,8 +3,9 @@ along the load path (load control).
 
 At each converged step n the residual R_n(u_n; s, h_{n-1}) = 0 holds, h_{n-1} the history
 committed at the step before (contact stick points, sticky nodes and where they froze,
-positions for the crossing test; the h_i of a viscoelastic law's Prony series and the
-isochoric stress they were updated with, per quadrature point; the nodes' temperature where
+positions for the crossing test; the law's state per quadrature point (materials.protocol:
+a Prony series' h_i and the isochoric stress they were updated with, a network's Cv^-1, a
+frozen network's H); the nodes' temperature where
 heat conduction advances it after each step, System.settle), and h_n = H(u_n; s, h_{n-1}).
 Differentiating,
 
@@ -109,7 +110,7 @@ def _dofmap(model: System) -> DofMap:
 
 def has_history(model: System) -> bool:
     """Whether the residual of a step depends on the history committed before it: contact
-    pairs, a law with memory (materials.viscoelastic), or a temperature that heat conduction
+    pairs, a law with state (materials.protocol), or a temperature that heat conduction
     advances step by step (System.settle)."""
     return bool(model.contacts) or bool(model.solid_state(model.initial_state())) or model.conduction is not None
 

@@ -172,15 +172,15 @@ class Model:
         dofmap = DofMap(self.n_full, fixed, ties)
         n = self.n_full
         if self.formulation == "mixed":
-            solid: SolidAssembly = MixedAssembly(self.mesh, self.material, str(self.pressure_space))
+            solid: SolidAssembly = MixedAssembly(self.mesh, self.material, str(self.pressure_space), self.shift)
         else:
-            solid = SolidAssembly(self.mesh, self.material)
+            solid = SolidAssembly(self.mesh, self.material, self.shift)
         if self.temperature is None and tabled(self.material):
             raise ValueError("the law's constants are tables of temperature: give the model a temperature (heat)")
         by_curve: dict[Curve, np.ndarray] = {}  # point loads grouped by curve
         for d, v, c in self.point_loads:
             by_curve.setdefault(c, np.zeros(n))[d] += v
-        solid_term = SolidTerm(solid, n, self.shift)
+        solid_term = SolidTerm(solid, n, self.shift, self.temperature)
         terms: list[Term] = [solid_term, *(PressureTerm(p, n) for p in self.pressures)]
         terms += [PointLoadTerm(by_curve, n)] if by_curve else []
         terms += self.added

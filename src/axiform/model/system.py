@@ -111,10 +111,10 @@ class System:
 
     def timed(self) -> bool:
         """Whether the load factor is the process time: load curves with knots, moving tools,
-        or a law with memory follow it."""
+        or a law with memory (materials.protocol: `timed`) follow it."""
         return (
             bool(self.knots().size)
-            or getattr(self.material, "prony", None) is not None
+            or self.solid.law.timed
             or self.conduction is not None
             or self.change is not None
             or any(np.any(np.asarray(c.surface.motion, float) != 0) for c in self.contacts)
@@ -190,7 +190,7 @@ class System:
         relaxes (its stress moves with t), which Evaluation.dr_dlam (the loads') leaves out;
         a forward difference over h.  Zeros for a law without memory."""
         out = np.zeros(self.n_free)
-        if getattr(self.material, "prony", None) is None or h <= 0:
+        if not self.solid.law.timed or h <= 0:
             return out
         u = self.expand(u_f, t)
         held = self.solid_state(state)
@@ -204,11 +204,11 @@ class System:
     def strain_energy(self, u_full: np.ndarray, state: ModelState | None = None) -> float:
         """The strain energy stored in the body at the displacements u_full (n_full,) (at the
         temperatures of `state`, default the initial ones): the law's W at every quadrature
-        point, integrated over the revolved body."""
+        point (of its elastic part: materials.protocol `energy`), integrated over the revolved body."""
         x = self.solid.gradient(u_full)
         T = (state or self.initial_state()).temperature
-        law = self.solid.law(slice(None), None if T is None else self.solid.point_values(T))
-        W = law.energy(x.reshape(-1, 5)).reshape(x.shape[:-1])
+        W = self.solid.law.energy(x.reshape(-1, 5), None if T is None else self.solid.point_values(T))
+        W = W.reshape(x.shape[:-1])
         return float((W * self.solid.dV).sum())
 
     def external_load(self, u_full: np.ndarray, t: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
