@@ -37,9 +37,9 @@ from scipy.optimize import least_squares
 from .base import Hyperelastic
 from .homogeneous import Data, kinematics, nominal
 from .neo_hooke import NeoHooke
-from .network import BergstromBoyce, LocalUpdateError, Network, solve_local
+from .network import TY, TZ, BergstromBoyce, LocalUpdateError, Network, Y, Z, solve_local
 from .parallel import NetworkLaw
-from .principal import principal_function
+from .principal import BASIS, SQRT2, SQRT6, plane_function, plane_strains
 from .registry import FitFamily
 from .temperature import WLF
 
@@ -137,17 +137,18 @@ def integrate(
     lnv = np.zeros((3, b))  # ln lambda_v
     out = np.zeros_like(path)
     groups = [(float(v), np.flatnonzero(m == v)) for v in np.unique(m)]
-    principal = principal_function(UNIT_NETWORK)
+    plane = plane_function(UNIT_NETWORK)
     scaled = time_scale * mu**m  # tau = mu tau_1(e): the local equation of the unit network, rate x mu^m
     for k in range(1, path.shape[0]):
         L = log_stretches(mode, path[k])
         lam_v = np.sqrt(np.exp(2.0 * lnv).sum(0) / 3.0)
         rate = (path[k] - path[k - 1]) * scaled * (lam_v - 1.0 + E) ** C
-        e_tr = L - lnv
+        w_tr = BASIS.T @ (L - lnv)  # the trial elastic log strains on the deviatoric plane (2, b)
         for v, idx in groups:
-            e, t, _, _ = solve_local(principal, e_tr[:, idx], rate[idx], v, 1.0)
-            lnv[:, idx] = L[:, idx] - e
-            out[k, idx] = mu[idx] * (t[0] - t[2]) / path[k, idx]
+            X = solve_local(plane, w_tr[0, idx], w_tr[1, idx], rate[idx], v, 1.0)
+            lnv[:, idx] = L[:, idx] - plane_strains(X[Y], X[Z])
+            t_diff = X[TY] / SQRT2 + 3.0 * X[TZ] / SQRT6  # t_1 - t_3 of t = t_y u_y + t_z u_z
+            out[k, idx] = mu[idx] * t_diff / path[k, idx]
     return out
 
 
