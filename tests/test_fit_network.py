@@ -4,11 +4,13 @@ constants recovered from curves at three rates (and temperatures), a fourth rate
 bad data and options refused naming the line, the column or the option."""
 
 import json
+import tomllib
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from axiform.case.schema import parse
 from axiform.cli import main
 from axiform.materials import LAWS
 from axiform.materials.homogeneous import kinematics
@@ -163,6 +165,8 @@ def test_networks_from_three_rates_are_recovered_and_predict_a_fourth(tmp_path, 
     assert prediction_error(wrong, layout, fourth, truth) > 0.03
     text = (out / "material.toml").read_text()
     assert "[[material.network]]" in text and 'flow = "bergstrom-boyce"' in text
+    law = parse(BAR | tomllib.loads(text)).material.build()  # the case file takes the tables as written
+    assert len(law.networks) == 1 and law.networks[0].flow.A == pytest.approx(got["A"], rel=1e-5)
     assert {p.name for p in out.glob("*.png")} == {"fit_network_uniaxial.png", "fit_network_equibiaxial.png"}
 
 
@@ -182,6 +186,10 @@ def test_the_wlf_constants_are_recovered_from_curves_at_three_temperatures(tmp_p
     assert "shift = { wlf = {" in (out / "material.toml").read_text()
 
 
+BAR = {
+    "mesh": {"kind": "rectangle", "r": [0.0, 1.0], "z": [0.0, 1.0], "divisions": [1, 1], "element": "q4"},
+    "fix": [{"at": {"z": 0.0}, "dofs": ["ur", "uz"]}, {"at": {"z": 1.0}, "dofs": ["uz"], "value": 0.1}],
+}
 GOOD = "mode,rate,stretch,stress\nuniaxial,0.1,1.5,1.0\nuniaxial,1.0,1.5,2.0\nuniaxial,1.0,2.0,3.0\n"
 
 
