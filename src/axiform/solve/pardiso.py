@@ -157,15 +157,28 @@ class Pardiso:
         )
         return self.error.value
 
-    def analyse(self, indptr: np.ndarray, indices: np.ndarray, data: np.ndarray, symmetric: bool, key) -> None:
+    def analyse(
+        self,
+        indptr: np.ndarray,
+        indices: np.ndarray,
+        data: np.ndarray,
+        symmetric: bool,
+        key,
+        variant: tuple[int, int, int] | None = None,
+    ) -> None:
         """Phase 11: ordering and symbolic factorization of the CSR pattern (indptr, indices:
-        int32, sorted; the upper triangle where symmetric), made for `key`."""
+        int32, sorted; the upper triangle where symmetric), made for `key`.  variant: (matrix
+        type, scaling and matching 0 / 1, ordering 0 minimum degree / 2 METIS) instead of
+        those chosen here (benchmarks/pardiso_types.py compares them)."""
         self.release()
         n = len(indptr) - 1
         self.threads = 1 if n < PARALLEL_MIN else 0
         self.iparm[1] = 0 if n <= MINIMUM_DEGREE_MAX else 2
         self.mtype.value = -2 if symmetric else 11
         self.iparm[10] = self.iparm[12] = 0 if symmetric else 1  # scaling and weighted matching: mtype 11
+        if variant is not None:
+            self.mtype.value, self.iparm[10], self.iparm[1] = variant
+            self.iparm[12] = self.iparm[10]
         self._indptr, self._indices = indptr, indices  # kept alive while PARDISO points to them
         self._p_indptr, self._p_indices = indptr.ctypes.data_as(_I32P), indices.ctypes.data_as(_I32P)
         self.n.value = n
