@@ -7,7 +7,7 @@ The solver is chosen by the size n of K (benchmarks/README.md § 3.2 measured ea
   exceed the whole dense work;
 - larger: MKL PARDISO (pardiso.py), the symmetric indefinite factorization of the upper
   triangle where K is symmetric to round-off (|K - K^T| <= SYMMETRY |K| entry by entry,
-  checked on every K: 0.5 to 0.65 of the time of an LU, benchmarks/README.md § 7), else
+  checked on every K: 0.45 to 0.65 of the time of an LU, benchmarks/README.md § 7), else
   the non-symmetric LU with weighted matching; the ordering (minimum degree below
   pardiso.MINIMUM_DEGREE_MAX unknowns, METIS nested dissection above) and the symbolic
   factorization once for each pattern and matrix type;

@@ -7,7 +7,7 @@ Two matrix types are used (benchmarks/README.md § 7 measured both on the same t
 - real symmetric indefinite (mtype -2, Bunch-Kaufman pivots within the supernodes) on the
   upper triangle, for a tangent that is symmetric to round-off (a hyperelastic solid, mixed
   or not, a frictionless penalty contact, a pressure on a whole face between supports): its
-  factors are half those of an LU, and it factorizes in 0.5 to 0.65 of the time of mtype 11
+  factors are half those of an LU, and it factorizes in 0.45 to 0.65 of the time of mtype 11
   from 1e3 to 2e4 unknowns;
 - real non-symmetric (mtype 11) with scaling and weighted matching, for the others.
   Structurally symmetric (mtype 1) and mtype 11 without matching factorize in the same time
