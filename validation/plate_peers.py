@@ -195,10 +195,11 @@ LINEAR_SOLVERS = {
 def linsolve_identity() -> str:
     """What axiform.solve.linsolve.factorize does in this run, in a few words."""
     import axiform.solve.linsolve as ls
+    from axiform.solve.pardiso import mkl
 
-    mkl = ls._mkl() is not None  # the library it loads for PARDISO, None where there is none
+    found = mkl() is not None  # the library it loads for PARDISO, None where there is none
     return f"dense LAPACK up to {ls.DENSE_MAX} unknowns, then " + (
-        "MKL PARDISO (libmkl_rt found: used in this run)" if mkl else "SuperLU (no libmkl_rt: PARDISO not used)"
+        "MKL PARDISO (libmkl_rt found: used in this run)" if found else "SuperLU (no libmkl_rt: PARDISO not used)"
     )
 
 
