@@ -25,7 +25,9 @@
 The tables go to stdout and to benchmarks/results/network_cost.md (network_cost_quick.md with
 --quick).
 
-Note (issue 28's goal, at most 3x).  Three runs on the 2-core development machine under a load
+Note (issue 28's goal, at most 3x).  On a quiet machine (16-core Xeon, load 0.4, one thread;
+results/network_cost_quiet.md): short step 2.69x, long step 2.92x, the previous update 7.7x and
+8.3x, one network with freezing 3.8x.  Three runs on the 2-core development machine under a load
 average of 10 to 13 (other jobs): short step 3.21x, 3.10x, 2.89x; long step 3.96x, 3.53x,
 3.24x the elastic law; the previous update in the same runs 9.6x to 10.6x and 12.1x to 12.5x,
 so 3.0x to 3.8x less time, but the goal only about met for the short step and not for the
