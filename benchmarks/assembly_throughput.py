@@ -143,8 +143,8 @@ def timed_once(fn):
     return r, time.process_time() - c
 
 
-def timed_finalize(model) -> dict:
-    """CPU s of model.finalize() and of its main parts, timed inside that one call: the
+def timed_finalize(model) -> tuple:
+    """The System of model.finalize() and the CPU s of that call and of its main parts, timed inside it: the
     SolidAssembly and SparsePattern constructors and SparsePattern.positions (subclasses with
     timers, put in axiform.model.model's namespace for the call)."""
     import axiform.model.model as am
@@ -172,10 +172,10 @@ def timed_finalize(model) -> dict:
 
     am.SolidAssembly, am.SparsePattern = Solid, Pattern
     try:
-        _, t["finalize"] = timed_once(model.finalize)
+        system, t["finalize"] = timed_once(model.finalize)
     finally:
         am.SolidAssembly, am.SparsePattern = SolidAssembly, SparsePattern
-    return t
+    return system, t
 
 
 # --------------------------------------------------------------------------------------------
@@ -184,8 +184,9 @@ def timed_finalize(model) -> dict:
 
 
 def measure_case(element: str, n_elements: int, min_time: float, unique_limit: int) -> dict:
-    model, t_setup = timed_once(lambda: build_model(element, divisions_for_elements(n_elements), finalize=False))
-    build = timed_finalize(model) | dict(setup=t_setup, unique=None)
+    builder, t_setup = timed_once(lambda: build_model(element, divisions_for_elements(n_elements), finalize=False))
+    model, build = timed_finalize(builder)
+    build |= dict(setup=t_setup, unique=None)
     keys = np.concatenate(
         [model.pattern._keys(b).ravel() for b in [model.solid.dofs] + [p.dofs for p in model.pressures]]
     )
