@@ -25,7 +25,8 @@ test: $(STAMP)
 
 # each script asserts its agreements (exit 1 on a failure) and writes validation/results/
 VALIDATE = "heat_ccx.py" "toric_ccx.py" "die_drawing_ccx.py" "plate_peers.py" \
-	"toric_plate.py --repeat 1 --no-symmetric" "plate_elements.py --repeat 1 --no-committed --ccx-mesh 4x40"
+	"toric_plate.py --repeat 1 --no-symmetric" "plate_elements.py --repeat 1 --no-committed --ccx-mesh 4x40" \
+	"cold_mould_freezing.py" "pet_networks.py"
 
 validate: $(STAMP)
 	$(BIN)/pip install -q -e ".[test,bench]"

@@ -95,7 +95,7 @@ def solid_pieces(solid: SolidAssembly, u: np.ndarray):
         c1 = clock()
         solid.check_inverted(x, start)
         c2 = clock()
-        P, A = solid.material.stress_tangent(x)
+        P, A, _ = solid.law.update(x, {}, 0.0, None)
         c3 = clock()
         GdV_T = solid._GdV[sl].transpose(0, 2, 1)
         AG = np.matmul(A, solid.G[sl]).reshape(m, q * 5, nd)
@@ -143,8 +143,8 @@ def timed_once(fn):
     return r, time.process_time() - c
 
 
-def timed_finalize(model) -> dict:
-    """CPU s of model.finalize() and of its main parts, timed inside that one call: the
+def timed_finalize(model) -> tuple:
+    """The System of model.finalize() and the CPU s of that call and of its main parts, timed inside it: the
     SolidAssembly and SparsePattern constructors and SparsePattern.positions (subclasses with
     timers, put in axiform.model.model's namespace for the call)."""
     import axiform.model.model as am
@@ -172,10 +172,10 @@ def timed_finalize(model) -> dict:
 
     am.SolidAssembly, am.SparsePattern = Solid, Pattern
     try:
-        _, t["finalize"] = timed_once(model.finalize)
+        system, t["finalize"] = timed_once(model.finalize)
     finally:
         am.SolidAssembly, am.SparsePattern = SolidAssembly, SparsePattern
-    return t
+    return system, t
 
 
 # --------------------------------------------------------------------------------------------
@@ -184,8 +184,9 @@ def timed_finalize(model) -> dict:
 
 
 def measure_case(element: str, n_elements: int, min_time: float, unique_limit: int) -> dict:
-    model, t_setup = timed_once(lambda: build_model(element, divisions_for_elements(n_elements), finalize=False))
-    build = timed_finalize(model) | dict(setup=t_setup, unique=None)
+    builder, t_setup = timed_once(lambda: build_model(element, divisions_for_elements(n_elements), finalize=False))
+    model, build = timed_finalize(builder)
+    build |= dict(setup=t_setup, unique=None)
     keys = np.concatenate(
         [model.pattern._keys(b).ravel() for b in [model.solid.dofs] + [p.dofs for p in model.pressures]]
     )
@@ -267,7 +268,7 @@ def variants(element: str, n_elements: int, min_time: float) -> dict:
     u = model.expand(u_f, lam)
     ue = u[s.dofs]
     x = s.gradient(u)
-    P, A = s.material.stress_tangent(x)
+    P, A, _ = s.law.update(x, {}, 0.0, None)
     P2 = P.reshape(e, q * 5)
     AG = np.matmul(A, s.G).reshape(e, q * 5, nd)
     GdV_T_copy = np.ascontiguousarray(s._GdV.transpose(0, 2, 1))  # (e, nd, 5q), as src did before
@@ -290,7 +291,7 @@ def variants(element: str, n_elements: int, min_time: float) -> dict:
     cases = [
         ("g = G u_e", "matmul G2 (e,5q,nd) · u_e (src)", loop(lambda sl: np.matmul(s._G2[sl], ue[sl, :, None]))),
         ("g = G u_e", "einsum eqik,ek->eqi", loop(lambda sl: np.einsum("eqik,ek->eqi", s.G[sl], ue[sl]))),
-        ("P, A", "MooneyRivlin.stress_tangent (src)", loop(lambda sl: s.material.stress_tangent(x[sl]))),
+        ("P, A", "the law's update, MooneyRivlin (src)", loop(lambda sl: s.law.update(x[sl], {}, 0.0, None))),
         (
             "f_e = GᵀP dV",
             "matmul, transposed view of GdV (e,5q,nd) (src)",

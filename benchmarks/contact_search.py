@@ -37,7 +37,8 @@ runs on one thread; the wall/CPU ratio is reported too).
 
 Run:   python benchmarks/contact_search.py           (N up to 1e6, M up to 1e4; ~3.5 min)
        python benchmarks/contact_search.py --quick   (N up to 1e5, M up to 1e3; ~1 min)
-Writes benchmarks/results/contact_search.md and contact_search.png.
+Writes benchmarks/results/contact_search.md and contact_search.png (with --quick,
+contact_search_quick.md and .png, so that a quick look never overwrites the full table).
 """
 
 from __future__ import annotations
@@ -401,10 +402,11 @@ def write_report(rows, Ns, Ms, repeat, total, args):
                 + [f"{r['time'][k] / tb:.2f}" if k in r["time"] else "—" for k in methods]
             )
     lines.append(table(["layout", "N", "M"] + methods, body))
-    lines += ["`contact_search.png` plots time against N for every M and method.", ""]
-    (out / "contact_search.md").write_text("\n".join(lines) + "\n")
-    plot(rows, Ns, Ms, out / "contact_search.png")
-    print("wrote", out / "contact_search.md")
+    stem = "contact_search_quick" if args.quick else "contact_search"  # --quick keeps the full table
+    lines += [f"`{stem}.png` plots time against N for every M and method.", ""]
+    (out / f"{stem}.md").write_text("\n".join(lines) + "\n")
+    plot(rows, Ns, Ms, out / f"{stem}.png")
+    print("wrote", out / f"{stem}.md")
 
 
 def plot(rows, Ns, Ms, path):

@@ -11,7 +11,7 @@
    evaluation starts from a committed state with history (h_i != 0), a step dt later.  The
    same for `tangent=False` (a residual alone, as a line search or a sensitivity's shadow).
 2. Where the time of the series goes: the pieces of the displacement assembly's memory
-   branch (fem.assembly; the mixed one calls the same Memory.add_rows) on one chunk of
+   branch (fem.assembly; the mixed one calls the same prony_step) on one chunk of
    elements, timed apart (same points, same calls as the assembly makes).
 
     python benchmarks/viscoelastic_cost.py            # about a minute
@@ -44,14 +44,9 @@ from axiform import Model, rectangle  # noqa: E402
 from axiform.fem.mesh import edges_on_nodes  # noqa: E402
 from axiform.materials.base import add_volumetric  # noqa: E402
 from axiform.materials.kinematics import from_rows, to_rows  # noqa: E402
+from axiform.materials.prony import Prony, prony_step, second_piola_rows, viscous_rows  # noqa: E402
 from axiform.materials.temperature import WLF  # noqa: E402
-from axiform.materials.viscoelastic import (
-    Memory,
-    Prony,
-    Viscoelastic,
-    second_piola_rows,  # noqa: E402
-    viscous_rows,
-)
+from axiform.materials.viscoelastic import Viscoelastic  # noqa: E402
 
 SERIES = {"1 term": Prony((0.5,), (0.1,)), "3 terms": Prony((0.3, 0.2, 0.1), (0.01, 0.1, 1.0))}
 # the 3 terms again with their relaxation times shifted per point: 150 on the inner face to
@@ -146,11 +141,10 @@ def pieces(n_points: int, repeats: int) -> list[list[str]]:
     law = MATERIAL
     history = {"h": rng.standard_normal(x.shape[:2] + (3, 4)), "S": rng.standard_normal(x.shape[:2] + (4,))}
     factors = SERIES["3 terms"].factors(T_TRIAL - T_COMMITTED)
-    memory = Memory(history, factors)
     xt, shape = to_rows(x)
     P, A = law.stress_rows(xt, 0.0, True)
     n, m = xt.shape[1], len(factors[0])
-    h_rows = history["h"].reshape(n, m, 4).transpose(1, 2, 0)  # (m, 4, n), as Memory.add_rows views it
+    h_rows = history["h"].reshape(n, m, 4).transpose(1, 2, 0)  # (m, 4, n), as prony_step views it
     S_rows = history["S"].reshape(n, 4).T
     column = tuple(f[:, None] for f in factors)
     e, a, b = column
@@ -158,15 +152,15 @@ def pieces(n_points: int, repeats: int) -> list[list[str]]:
     trial, _ = viscous_rows(xt, P.copy(), A.copy(), h_rows, S_rows, column)
     branch = {  # the displacement assembly's memory branch, call by call
         "`stress_rows(xt, 0.0, True)` (the law's isochoric part)": lambda: law.stress_rows(xt, 0.0, True),
-        "`Memory.add_rows` (`viscous_rows`, the history to rows and back)": lambda: memory.add_rows(
-            slice(None), xt, P.copy(), A.copy()
+        "`prony_step` (`viscous_rows`, the history to rows and back)": lambda: prony_step(
+            xt, P.copy(), A.copy(), history, factors
         ),
         "`add_volumetric` (kappa's part, a second pass over A)": lambda: add_volumetric(
             xt, law.kappa, P.copy(), A.copy()
         ),
         "`from_rows` of P, A": lambda: from_rows(P, A, shape),
     }
-    inside = {  # what Memory.add_rows spends it on (the copies of P and A it is handed, apart)
+    inside = {  # what prony_step spends it on (the copies of P and A it is handed, apart)
         "· copies of P, A (this benchmark's, to keep them unchanged)": lambda: (P.copy(), A.copy()),
         "· `second_piola_rows` (S_iso)": lambda: second_piola_rows(xt, P),
         "· H0 = sum(e h) + sum(a) S_n, h a (m, 4, n) view of (n, m, 4)": lambda: (
@@ -179,8 +173,8 @@ def pieces(n_points: int, repeats: int) -> list[list[str]]:
             (e[:, None] * h_contiguous).sum(0) + a.sum(0) * S_rows,
             e[:, None] * h_contiguous + a[:, None] * S_rows + b[:, None] * S,
         ),
-        "· the trial written back to (e, q, m, 4)": lambda: memory.trial["h"].__setitem__(
-            slice(None), trial.transpose(2, 0, 1).reshape(history["h"].shape)
+        "· the trial brought back to (e, q, m, 4)": lambda: np.ascontiguousarray(
+            trial.transpose(2, 0, 1).reshape(history["h"].shape)
         ),
         "· `viscous_rows` as a whole": lambda: viscous_rows(xt, P.copy(), A.copy(), h_rows, S_rows, column),
     }
@@ -189,7 +183,7 @@ def pieces(n_points: int, repeats: int) -> list[list[str]]:
     times = {name: best(f, repeats) for name, f in (branch | inside).items()}
     copies = times["· copies of P, A (this benchmark's, to keep them unchanged)"]
     for name in (
-        "`Memory.add_rows` (`viscous_rows`, the history to rows and back)",
+        "`prony_step` (`viscous_rows`, the history to rows and back)",
         "`add_volumetric` (kappa's part, a second pass over A)",
         "· `viscous_rows` as a whole",
     ):

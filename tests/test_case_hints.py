@@ -261,3 +261,11 @@ def test_pressure_arrows_point_where_the_pressure_pushes():
     (quiver,) = [c for c in fig.axes[0].collections if type(c).__name__ == "Quiver"]
     assert len(quiver.U) >= 10 and np.all(quiver.V > 0) and np.allclose(quiver.U, 0.0)
     assert np.allclose(quiver.Y + quiver.V, 0.0)  # the heads on the face
+
+
+def test_a_temperature_monitor_has_a_marker_of_its_own():
+    fig = check_figure(built(EXAMPLES / "cup_cold_mould.toml"))
+    markers = {line.get_label(): line.get_marker() for line in fig.axes[0].get_lines()}
+    (temperature,) = [m for label, m in markers.items() if label.startswith("temperature monitor")]
+    (displacement,) = [m for label, m in markers.items() if label.startswith("monitor ")]
+    assert temperature != displacement

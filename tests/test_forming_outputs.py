@@ -394,7 +394,7 @@ def test_cavity_pressure_monitor_is_the_load_axis(tmp_path):
         fix=[],
         contact=[],
         cavity=[],
-        material=SimpleNamespace(viscoelastic=None),
+        material=SimpleNamespace(viscoelastic=None, memory=False),
         thermal=None,
         units=SimpleNamespace(model_dump=lambda: {"length": "mm", "pressure": "MPa"}),
     )

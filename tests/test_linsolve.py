@@ -10,6 +10,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
 import axiform.solve.linsolve as ls
+import axiform.solve.pardiso as pd
 from axiform import Model, MooneyRivlin, rectangle
 from axiform.fem.mesh import edges_on_nodes
 
@@ -31,8 +32,8 @@ def _tangent(element: str, divisions, seed: int = 0):
 def _backend(monkeypatch, name: str):
     monkeypatch.setattr(ls, "DENSE_MAX", 10**9 if name == "dense" else 0)
     if name == "superlu":
-        monkeypatch.setattr(ls, "_mkl", lambda: None)
-    elif name == "pardiso" and ls._mkl() is None:
+        monkeypatch.setattr(ls, "mkl", lambda: None)
+    elif name == "pardiso" and pd.mkl() is None:
         pytest.skip("MKL is not installed")
 
 
@@ -68,8 +69,8 @@ def test_pardiso_analysis_once_per_pattern(monkeypatch):
     K1, B = _tangent("q4", (7, 6), seed=1)
     K2, _ = _tangent("q4", (7, 6), seed=2)
     calls = []
-    original = ls._Pardiso.analyse
-    monkeypatch.setattr(ls._Pardiso, "analyse", lambda self, K: calls.append(K.shape) or original(self, K))
+    original = pd.Pardiso.analyse
+    monkeypatch.setattr(pd.Pardiso, "analyse", lambda self, *args: calls.append(args[3]) or original(self, *args))
     solver = ls.LinearSolver()
     for K in (K1, K2, K1, sp.csr_matrix(K2.toarray())):  # the last: a copy, equal pattern
         solver.factorize(K)(B)
@@ -133,10 +134,10 @@ def test_pardiso_typed_and_guarded(monkeypatch):
     K, B = _tangent("q4", (7, 6), seed=6)
     ls.factorize(K)(B)
     assert dict(os.environ) == environ
-    argtypes = ls._mkl().pardiso.argtypes
+    argtypes = pd.mkl().pardiso.argtypes
     assert len(argtypes) == 16 and ctypes.c_void_p not in argtypes
-    assert ls._mkl().MKL_Set_Num_Threads_Local.argtypes == [ctypes.c_int]
-    monkeypatch.setattr(ls, "_INT32_MAX", K.nnz - 1)
+    assert pd.mkl().MKL_Set_Num_Threads_Local.argtypes == [ctypes.c_int]
+    monkeypatch.setattr(pd, "INT32_MAX", K.nnz - 1)
     with pytest.raises(ValueError, match="32-bit"):
         ls.factorize(K)
 
@@ -148,7 +149,7 @@ def test_pardiso_one_and_several_rhs(monkeypatch):
     K, B = _tangent("q4", (7, 6), seed=4)
     ref = spsolve(K.tocsc(), B)
     for parallel_min in (10**9, 0):
-        monkeypatch.setattr(ls, "PARALLEL_MIN", parallel_min)
+        monkeypatch.setattr(pd, "PARALLEL_MIN", parallel_min)
         solve = ls.factorize(K)
         assert np.abs(solve(B) - ref).max() <= 1e-10 * np.abs(ref).max()
         assert np.abs(solve(B[:, 1]) - ref[:, 1]).max() <= 1e-10 * np.abs(ref).max()
@@ -180,15 +181,15 @@ def test_threads_by_size(monkeypatch):
     _backend(monkeypatch, "pardiso")
     K, B = _tangent("q4", (7, 6))
     threads = []
-    original = ls._Pardiso.analyse
+    original = pd.Pardiso.analyse
 
-    def analyse(self, K):
-        original(self, K)
+    def analyse(self, *args):
+        original(self, *args)
         threads.append(self.threads)
 
-    monkeypatch.setattr(ls._Pardiso, "analyse", analyse)
+    monkeypatch.setattr(pd.Pardiso, "analyse", analyse)
     x1 = ls.factorize(K)(B)
-    monkeypatch.setattr(ls, "PARALLEL_MIN", 0)
+    monkeypatch.setattr(pd, "PARALLEL_MIN", 0)
     x0 = ls.factorize(K)(B)
     assert threads == [1, 0]
     assert np.abs(x1 - x0).max() <= 1e-12 * np.abs(x0).max()
@@ -208,3 +209,81 @@ def test_signed_factorization_against_dense_determinant(n):
         assert A @ solve(b) == pytest.approx(b, abs=1e-8 * np.abs(b).max() * np.linalg.cond(A.toarray()))
         signs.append(sign)
     assert n == 1 or set(signs) == {-1, 1}
+
+
+def _symmetric_tangent(divisions=(7, 6), seed: int = 0):
+    """K (symmetric to round-off: no pressure) and two right-hand sides of a deformed ring."""
+    mesh = rectangle((1.0, 2.0), (0.0, 1.0), divisions, "q4")
+    model = Model(mesh, MooneyRivlin(80.0, 20.0, 1e4), formulation="displacement")
+    model.fix(mesh.node_sets["bottom"], ["uz"])
+    model.prescribe(mesh.node_sets["top"], ["uz"], -0.05)
+    model = model.finalize()
+    u_f = 0.002 * np.random.default_rng(seed).standard_normal(model.n_free)
+    ev = model.evaluate(u_f, 0.5)
+    return ev.K.tocsr(), np.column_stack([-ev.r, -ev.dr_dlam])
+
+
+def _types(monkeypatch) -> list[bool]:
+    """The matrix types (symmetric or not) of PARDISO's analyses from now on."""
+    kinds: list[bool] = []
+    original = pd.Pardiso.analyse
+
+    def analyse(self, *args):
+        kinds.append(args[3])
+        original(self, *args)
+
+    monkeypatch.setattr(pd.Pardiso, "analyse", analyse)
+    return kinds
+
+
+def test_symmetric_tangent_factorized_as_symmetric(monkeypatch):
+    """A K symmetric to round-off goes to PARDISO's symmetric indefinite type (one analysis
+    of its upper triangle), a K of the same pattern with a real asymmetry to the LU; both
+    solved as spsolve solves them."""
+    _backend(monkeypatch, "pardiso")
+    K, B = _symmetric_tangent()
+    asymmetry = abs(K - K.T).max() / abs(K).max()
+    assert 0 < asymmetry <= 1e-2 * ls.SYMMETRY  # round-off only
+    kinds = _types(monkeypatch)
+    solver = ls.LinearSolver()
+    Ka = K.copy()
+    Ka.data[np.flatnonzero(Ka.indices > np.repeat(np.arange(K.shape[0]), np.diff(K.indptr)))[::7]] *= 1.0 + 1e-6
+    for M in (K, K, Ka, K):
+        x = solver.factorize(M)(B)
+        ref = spsolve(M.tocsc(), B)
+        assert np.abs(x - ref).max() <= 1e-10 * np.abs(ref).max()
+    assert kinds == [True, False]  # each pattern and type analysed once
+
+
+def test_symmetric_pattern_needs_its_diagonal(monkeypatch):
+    """A symmetric K with a diagonal entry not stored (the symmetric types need them all)
+    and a K whose pattern is not symmetric go to the LU."""
+    _backend(monkeypatch, "pardiso")
+    K, B = _symmetric_tangent()
+    kinds = _types(monkeypatch)
+    A = K.tolil()
+    A[5, 5] = 0.0  # removed from the pattern by lil
+    A = A.tocsr()
+    A.eliminate_zeros()
+    assert A[5].nnz > 0 and not ls.Pattern(A).symmetric
+    C = K.tolil()
+    C[0, K.shape[0] - 1] = 1e-3  # one entry without its mirror
+    C = C.tocsr()
+    assert not ls.Pattern(C).symmetric
+    for M in (A, C):
+        x = ls.factorize(M)(B)
+        assert np.abs(M @ x - B).max() <= 1e-9 * np.abs(B).max()
+    assert kinds == [False, False]
+
+
+def test_symmetric_singular_goes_on_to_lu_and_superlu(monkeypatch):
+    """A symmetric K with a zero row and column (stored zeros: the pattern is kept) has a
+    perturbed pivot in the symmetric factorization, then in the LU, and SuperLU raises."""
+    _backend(monkeypatch, "pardiso")
+    K, B = _symmetric_tangent(seed=3)
+    rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
+    K.data[(rows == 7) | (K.indices == 7)] = 0.0
+    kinds = _types(monkeypatch)
+    with pytest.raises(ls.SingularTangentError):
+        ls.factorize(K)(B)
+    assert kinds == [True, False]

@@ -3,14 +3,15 @@ the update's tangent against differences, the elastic limit, relaxation, rate de
 against an independent integration of the homogeneous uniaxial flow, incompressible flow,
 objectivity in the meridian plane, parameter checks."""
 
+import network_reference as ref
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
 from axiform import ArrudaBoyce, Gent, MooneyRivlin, NeoHooke, Ogden, Yeoh
-from axiform.materials.network import BergstromBoyce, Network
+from axiform.materials.network import BergstromBoyce, Network, network_rows
 from axiform.materials.parallel import NetworkLaw
-from axiform.materials.principal import generic_principal, principal_function
+from axiform.materials.principal import BASIS, generic_plane, generic_principal, plane_function
 from axiform.materials.temperature import WLF
 
 EQUILIBRIUM = NeoHooke(0.5, 1.0e3)
@@ -250,10 +251,75 @@ def test_the_principal_stresses_agree_with_the_laws_own_stress_and_tangent(law):
     e = rng.uniform(-0.5, 0.6, (3, 20))
     e[:, 0] = 0.0  # F = I
     e[1, 1] = e[0, 1]  # equal meridian stretches
-    t, K = principal_function(law, 2.5)(e)
+    t, K = ref.principal_function(law, 2.5)(e)
     t0, K0 = generic_principal(law, e, 2.5)
     np.testing.assert_allclose(t, t0, rtol=1e-11, atol=1e-11 * np.abs(t0).max())
     np.testing.assert_allclose(K, K0, rtol=1e-11, atol=1e-11 * np.abs(K0).max())
+
+
+@pytest.mark.parametrize(
+    "law",
+    [MooneyRivlin(0.8, 0.3, 0.0), Yeoh(0.5, -0.05, 0.01, 0.0), Gent(1.0, 20.0, 0.0), ArrudaBoyce(1.0, 3.0, 0.0)]
+    + [Ogden((1.2, -0.3), (2.5, -2.0), 0.0), Ogden((0.7,), (8.0,), 0.0)],
+    ids=["mooney-rivlin", "yeoh", "gent", "arruda-boyce", "ogden", "ogden alpha 8"],
+)
+def test_the_stresses_on_the_deviatoric_plane_agree_with_the_laws_own_stress_and_tangent(law):
+    """principal.py's closed forms on the plane sum(e) = 0 against the law's P and A at
+    F = diag(exp(e)) projected on the plane (generic_plane), and the basis orthonormal."""
+    np.testing.assert_allclose(BASIS.T @ BASIS, np.eye(2), atol=1e-15)
+    np.testing.assert_allclose(BASIS.sum(0), 0.0, atol=1e-15)
+    rng = np.random.default_rng(5)
+    y, z = rng.uniform(-0.7, 0.7, (2, 20))
+    y[0] = z[0] = 0.0  # F = I
+    y[1] = 0.0  # equal meridian stretches
+    closed = plane_function(law, 2.5)(y, z)
+    projected = generic_plane(law, y, z, 2.5)
+    for got, expected in zip(closed, projected, strict=True):
+        np.testing.assert_allclose(got, expected, rtol=1e-11, atol=1e-11 * np.abs(projected).max())
+
+
+def random_points(n, seed):
+    """x rows (5, n) of random F (meridian stretches 0.6..1.8, shear, hoop 0.7..1.5) and a random
+    flowed Cv^-1 rows (4, n) (RR, RZ, ZZ, TT) of a random isochoric Fv (det Fv = 1)."""
+    rng = np.random.default_rng(seed)
+    xt = np.stack(
+        [rng.uniform(0.6, 1.8, n), rng.uniform(-0.4, 0.4, n), rng.uniform(-0.4, 0.4, n)]
+        + [rng.uniform(0.6, 1.8, n), rng.uniform(0.7, 1.5, n)]
+    )
+    a, b, c, d = (
+        rng.uniform(0.7, 1.4, n),
+        rng.uniform(-0.3, 0.3, n),
+        rng.uniform(-0.3, 0.3, n),
+        rng.uniform(0.7, 1.4, n),
+    )
+    det = a * d - b * c  # Fv = [[a, b], [c, d]] (meridian), hoop 1/det; Cv = Fv^T Fv
+    RR, RZ, ZZ = a * a + c * c, a * b + c * d, b * b + d * d
+    return xt, np.stack([ZZ / det**2, -RZ / det**2, RR / det**2, det**2])
+
+
+@pytest.mark.parametrize(
+    "elastic, scale, flow",
+    [
+        (MooneyRivlin(1.0, 0.2, 0.0), 1.0, FLOW),
+        (Ogden((1.2, -0.3), (2.5, -2.0), 0.0), 1.0, BergstromBoyce(A=2.0, C=-0.5, m=1.5, E=0.05)),
+        (Yeoh(0.5, -0.05, 0.01, 0.0), 3.0, BergstromBoyce(A=5.0, C=-1.0, m=4.0, E=0.01)),
+    ],
+    ids=["mooney-rivlin", "ogden", "yeoh, stiffness ratio"],
+)
+@pytest.mark.parametrize("dt", [0.0, 1e-3, 0.3, 30.0])
+def test_the_update_on_the_deviatoric_plane_is_the_update_in_three_principal_strains(elastic, scale, flow, dt):
+    """The update (a 2 x 2 local Newton on the plane sum(e) = 0, the tangent from principal
+    quantities) gives the numbers of the update with three principal log strains, a 3 x 3
+    local Newton and the tangent built direction by direction (network_reference.py), to 1e-10
+    of each point's largest entry: P, A and the trial Cv^-1, on random points and flowed states."""
+    network = Network(elastic, flow, scale)
+    xt, Cvi = random_points(400, seed=int(1e3 * dt) + 7)
+    a_T = np.linspace(0.5, 2.0, 400)
+    for new, old in zip(
+        network_rows(network, xt, Cvi, dt, a_T), ref.network_rows(network, xt, Cvi, dt, a_T), strict=True
+    ):
+        size = np.abs(old).reshape(-1, old.shape[-1]).max(0)
+        assert (np.abs(new - old).reshape(-1, old.shape[-1]).max(0) <= 1e-10 * size).all()
 
 
 def test_the_update_in_chunks_of_points_is_the_update_at_once(monkeypatch):

@@ -180,7 +180,7 @@ def test_the_cold_mould_cools_the_skin_it_touches_and_stays_between_its_temperat
     the sheet cools where it touches the 60 C mould (to 72 C at the rim's flange, touched
     from t = 0.1 s), never below the mould nor above the oven's 150 C (the heat scheme keeps
     the maximum principle); the thinnest wall is the bottom corner, which the vacuum reaches
-    last, still hot."""
+    last, as thin as on the sticky mould (0.26 mm): the sheet freezes where it touches."""
     out = tmp_path / "out"
     assert (
         main(
@@ -203,4 +203,26 @@ def test_the_cold_mould_cools_the_skin_it_touches_and_stays_between_its_temperat
     summary = json.loads((out / "summary.json").read_text())
     T = summary["temperature"]
     assert 60.0 <= T["min"] < 80.0 and T["max"] <= 150.0 + 1e-9
-    assert 9.0 <= summary["thickness"]["s_min"] <= 13.0 and summary["thickness"]["min"] < 0.25
+    assert 9.0 <= summary["thickness"]["s_min"] <= 13.0 and 0.24 < summary["thickness"]["min"] < 0.29
+
+
+@pytest.mark.slow
+def test_the_pet_preform_with_networks_blows_a_more_even_body(tmp_path):
+    """examples/pet_stretch_blow.toml (networks in parallel: Arruda-Boyce and a Bergström-Boyce
+    network) beside stretch_blow_moulding.toml (a Prony series), both coarse (1 layer, 4 + 15
+    Q8 along): the network preform finishes its whole process, and its body (current z from
+    40 to 150) comes out more even (a smaller coefficient of variation of the thickness)."""
+    spread = {}
+    for name in ("stretch_blow_moulding", "pet_stretch_blow"):
+        out = tmp_path / name
+        sets = [
+            "--set",
+            "mesh.layers=1",
+            "--set",
+            "mesh.profile=[{arc={center=[0.0,115.0],to=[9.0,115.0],divisions=4}},{line={to=[9.0,200.0],divisions=15}}]",
+        ]
+        assert main(["run", str(EXAMPLES / f"{name}.toml"), "--out", str(out), *sets, *QUIET]) == 0
+        wall = rows(out / "thickness.csv")
+        t = np.array([float(r["thickness"]) for r in wall if 40.0 < float(r["z"]) < 150.0])
+        spread[name] = t.std() / t.mean()
+    assert spread["pet_stretch_blow"] < spread["stretch_blow_moulding"], spread

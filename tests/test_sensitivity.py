@@ -156,3 +156,14 @@ def test_design_changing_the_supports_is_refused():
         sensitivity(make, np.array([1.0, 1.2, 0.9]), built.control, built.options)
     with pytest.raises(ValueError, match="load control"):
         sensitivity(plain, np.array([1.0, 1.2, 0.9]), ArcLengthControl(), NewtonOptions())
+
+
+def test_a_clamped_end_differentiates_the_held_wall():
+    """A tube clamped at its top (every node of the end fibre held): the station there reports
+    the held wall's reference thickness, so its derivative is that of the design's own table
+    there, not of a wall measured across the bulging element next to it."""
+    tree = tube()
+    tree["fix"][1]["dofs"] = ["ur", "uz"]
+    sens = check_against_forward_differences(tree)
+    assert sens.thickness["held"][-1] and not sens.thickness["held"][:-1].any()
+    assert sens.dthickness_ds[-1] == pytest.approx([0.0, 0.0, 1.0], abs=1e-9)  # t0 at s = 12 is the third knot

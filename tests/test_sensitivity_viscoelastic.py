@@ -101,8 +101,8 @@ def history_held(tree, sens) -> np.ndarray:
     du_f = -np.asarray(factorize(K)(dR)).reshape(model.n_free, s.size)
     dm = model.dofmap
     du = np.concatenate([du_f[: dm.nf], np.zeros((dm.np, s.size))])[dm.eq]
-    dx = sens.dx_ds + du.reshape(model.mesh.n_nodes, model.dpn, -1)[:, :2]
-    return thickness_derivative(model, last.u.reshape(-1, model.dpn)[:, :2], dx)
+    du2 = du.reshape(model.mesh.n_nodes, model.dpn, -1)[:, :2]
+    return thickness_derivative(model, last.u.reshape(-1, model.dpn)[:, :2], sens.dx_ds, du2)
 
 
 def agree_with_differences(tree: dict, sens, built, pressure: bool = False) -> None:

@@ -67,8 +67,7 @@ import scipy.sparse.linalg as sla  # noqa: E402
 from scipy.interpolate import CubicSpline  # noqa: E402
 
 import axiform as af  # noqa: E402
-import axiform.solve.newton as _solver  # noqa: E402
-from axiform.solve.linsolve import SingularTangentError  # noqa: E402
+from axiform.solve.linsolve import LinearSolver, SingularTangentError  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
@@ -195,26 +194,27 @@ LINEAR_SOLVERS = {
 def linsolve_identity() -> str:
     """What axiform.solve.linsolve.factorize does in this run, in a few words."""
     import axiform.solve.linsolve as ls
+    from axiform.solve.pardiso import mkl
 
-    mkl = ls._mkl() is not None  # the library it loads for PARDISO, None where there is none
+    found = mkl() is not None  # the library it loads for PARDISO, None where there is none
     return f"dense LAPACK up to {ls.DENSE_MAX} unknowns, then " + (
-        "MKL PARDISO (libmkl_rt found: used in this run)" if mkl else "SuperLU (no libmkl_rt: PARDISO not used)"
+        "MKL PARDISO (libmkl_rt found: used in this run)" if found else "SuperLU (no libmkl_rt: PARDISO not used)"
     )
 
 
 @contextlib.contextmanager
 def linear_solver(name: str):
-    """Run axiform with another sparse factorization (benchmark-local; the package is not
-    changed): 'shipped' keeps axiform.solve.linsolve.factorize."""
-    if not hasattr(_solver, "factorize"):
-        raise RuntimeError("axiform.solve.newton no longer calls a module-level 'factorize': update linear_solver()")
-    original = _solver.factorize
-    if LINEAR_SOLVERS[name] is not None:
-        _solver.factorize = LINEAR_SOLVERS[name]
+    """Run axiform with another sparse factorization (script-local; the package is not
+    changed): every path's LinearSolver.factorize answers with it; 'shipped' keeps the
+    LinearSolver as found in the tree."""
+    original = LinearSolver.factorize
+    other = LINEAR_SOLVERS[name]
+    if other is not None:
+        LinearSolver.factorize = lambda self, K: other(K)  # type: ignore[method-assign]
     try:
         yield
     finally:
-        _solver.factorize = original
+        LinearSolver.factorize = original  # type: ignore[method-assign]
 
 
 def run_axiform(

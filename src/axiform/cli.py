@@ -24,6 +24,7 @@ import sys
 from . import __version__
 
 VISCOELASTIC_FITS = ("prony", "wlf")  # `fit --model` beyond the hyperelastic laws (app/fit_viscoelastic.py)
+NETWORK_FIT = "network"  # `fit --model network` (app/fit_network.py)
 DESCRIPTION = (
     "Large-strain axisymmetric hyperelastic solids by finite elements: blow moulding, "
     "thermoforming and rubber parts, described in TOML case files."
@@ -118,14 +119,15 @@ def _plot_and_fit(sub) -> argparse.ArgumentParser:
     p_fit = sub.add_parser(
         "fit",
         help="fit a hyperelastic law to test data, a Prony series to relaxation or "
-        "DMA data, WLF constants to shift factors",
+        "DMA data, WLF constants to shift factors, viscous networks to curves at several rates",
         description="Fit the constants of a hyperelastic law to uniaxial, equibiaxial and "
         "planar (pure shear) test data by least squares on the relative errors, "
         "and check the law's Drucker stability at stretches 0.1 to 10; or a "
         "Prony series (--model prony) to a relaxation modulus or DMA data; or "
-        "the WLF constants (--model wlf) to shift factors. Writes material.toml "
-        "(the case-file table), fit.json and the plots fit_<mode>.png, "
-        "fit_prony.png or fit_wlf.png.",
+        "the WLF constants (--model wlf) to shift factors; or an equilibrium law and "
+        "viscous networks (--model network) to stress-stretch curves at constant stretch rates. "
+        "Writes material.toml (the case-file table), fit.json and the plots fit_<mode>.png, "
+        "fit_prony.png, fit_wlf.png or fit_network_<mode>.png.",
         epilog="exit codes: 0 fitted, 1 no admissible constants, 2 a bad data file or argument",
     )
     p_fit.add_argument(
@@ -133,7 +135,7 @@ def _plot_and_fit(sub) -> argparse.ArgumentParser:
         nargs="+",
         help="CSV files with the header mode,stretch,stress (one file with "
         "time,modulus or frequency,storage,loss for prony, "
-        "temperature,log10_shift for wlf)",
+        "temperature,log10_shift for wlf, mode,rate,stretch,stress[,temperature] for network)",
     )
     p_fit.add_argument(
         "--model",
@@ -150,7 +152,15 @@ def _plot_and_fit(sub) -> argparse.ArgumentParser:
     p_fit.add_argument(
         "--reference",
         type=float,
-        help="wlf: the reference temperature T_ref (default: where the data's log10_shift is 0)",
+        help="wlf: the reference temperature T_ref (default: where the data's log10_shift is 0); "
+        "network: T_ref of the fitted shift (default: the middle temperature of the data)",
+    )
+    p_fit.add_argument(
+        "--law", help="network: the equilibrium network's law (default neo-hooke; any law --model takes)"
+    )
+    p_fit.add_argument("--networks", type=int, help="network: the number of viscous networks, 1 to 4 (default 1)")
+    p_fit.add_argument(
+        "--E", dest="flow_E", type=float, help="network: the flow's stretch offset E, fixed (default 0.01)"
     )
     return p_fit
 
@@ -219,6 +229,16 @@ def _optimize_and_sweep(sub) -> None:
 
 def dispatch(args: argparse.Namespace) -> int:
     """Run the parsed command; returns its exit code."""
+    if args.command == "fit" and args.model == NETWORK_FIT:
+        if args.terms is not None:
+            print("axiform fit: --terms is for --model ogden or prony, not network", file=sys.stderr)
+            return 2
+        from .app.fit_network import run as fit_network
+
+        return fit_network(args.data, args.law, args.networks, args.flow_E, args.out, args.kappa, args.reference)
+    if args.command == "fit" and (args.law, args.networks, args.flow_E) != (None, None, None):
+        print("axiform fit: --law, --networks and --E are for --model network", file=sys.stderr)
+        return 2
     if args.command == "fit" and args.model in VISCOELASTIC_FITS:
         from .app.fit_viscoelastic import run as fit_viscoelastic
 
@@ -275,7 +295,7 @@ class _LawChoice(argparse.Action):
 
     @property
     def help(self) -> str:
-        return f"the law: {', '.join(_fitted_laws())}; or {', '.join(VISCOELASTIC_FITS)}"
+        return f"the law: {', '.join(_fitted_laws())}; or {', '.join(VISCOELASTIC_FITS)}, {NETWORK_FIT}"
 
     @help.setter
     def help(self, value: str | None) -> None:
@@ -294,7 +314,7 @@ def main(argv: list[str] | None = None) -> int:
         parser, p_fit = build_parser()
         args = parser.parse_args(argv)
         if args.command == "fit":
-            choices = (*_fitted_laws(), *VISCOELASTIC_FITS)
+            choices = (*_fitted_laws(), *VISCOELASTIC_FITS, NETWORK_FIT)
             if args.model not in choices:
                 p_fit.error(f"argument --model: invalid choice: {args.model!r} (choose from {', '.join(choices)})")
         try:

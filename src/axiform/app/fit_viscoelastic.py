@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from ..case.schema import MAX_MAGNITUDE, MIN_MAGNITUDE
-from ..materials.viscoelastic import MAX_TERMS
+from ..materials.prony import MAX_TERMS
 from ..materials.viscoelastic_fit import PronyFit, WLFFit, decades, fit_dynamic, fit_relaxation, fit_wlf, zero_crossing
 from ..post.fit_viscoelastic_plots import plot_dynamic, plot_relaxation, plot_wlf
 from .fit import FitDataError, read_text

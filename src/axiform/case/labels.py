@@ -47,9 +47,9 @@ def case_labels(case: Case) -> dict[str, Any]:
 
 def time_is_real(case: Case) -> bool:
     """Whether the load factor of a validated case is a physical time (its result depends on
-    how fast the loads come): a material with a Prony series (`[material] viscoelastic`), or
+    how fast the loads come): a material with memory (`[material] viscoelastic`, a network), or
     heat conduction (`[thermal]`)."""
-    return case.material.viscoelastic is not None or case.thermal is not None
+    return case.material.memory or case.thermal is not None
 
 
 def monitor_quantity(m: MonitorSpec) -> str:

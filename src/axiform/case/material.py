@@ -11,16 +11,27 @@ A constant other than Ogden's lists may be a table of the temperature [[T, value
 (T increasing, every value in range; piecewise linear, constant outside), which needs the
 case's [temperature].  `density` (> 0, mass per unit reference volume) is the material's own,
 for its weight ([gravity]) and its heat capacity ([thermal] density defaults to it).
+
+Networks in parallel with the law (materials.parallel): any number of `[[material.network]]`
+tables, each a viscous network with its elastic law (`model` and its constants, or
+`stiffness_ratio`: the [material] law's isochoric part times it) and Bergström-Boyce flow (A,
+C, m, E as Abaqus' parallel rheological framework; `shift = false`: the network ignores the
+[temperature] shift); `[material.freeze] modulus = [[T, G_f], ...]`: a network born free of
+stress as the material cools (materials.freeze).  A Prony series (`viscoelastic`) and networks
+combine.
 """
 
 from __future__ import annotations
 
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 from pydantic_core import PydanticCustomError
 
 from ..materials import LAWS, Hyperelastic
+from ..materials.freeze import Freeze
+from ..materials.network import BergstromBoyce, Network
+from ..materials.parallel import NetworkLaw
 from ..materials.registry import key_spec
 from ..materials.temperature import Table, TemperatureDependent
 from ..materials.viscoelastic import Prony, Viscoelastic
@@ -114,6 +125,135 @@ class ViscoelasticSpec(BaseModel):
         return self
 
 
+def _known_model(value: str) -> str:
+    """A registered law's name, else pydantic's literal error listing them."""
+    if value not in LAWS:
+        names = [repr(n) for n in LAWS]
+        expected = " or ".join([", ".join(names[:-1]), names[-1]]) if len(names) > 1 else names[0]
+        raise PydanticCustomError("literal_error", "Input should be {expected}", {"expected": expected})
+    return value
+
+
+# the flow's constants: (test, what the test asks), as Abaqus' parallel rheological framework
+_FLOW = {
+    "A": (lambda v: v > 0, "must be > 0"),
+    "C": (lambda v: -1.0 <= v <= 0.0, "must lie in [-1, 0]"),
+    "m": (lambda v: v >= 1.0, "must be >= 1"),
+    "E": (lambda v: v > 0, "must be > 0"),
+}
+
+
+class NetworkSpec(BaseModel):
+    """A `[[material.network]]` table: a viscous network in parallel with the law, its elastic
+    part a law (`model` and its constants, numbers) or `stiffness_ratio` (the [material] law's
+    isochoric part times it), its flow Bergström-Boyce's: eps_dot = A (lambda_v - 1 + E)^C q^m /
+    a_T (A > 0, -1 <= C <= 0, m >= 1, E > 0, default 0.01); `shift = false`: no a_T."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+    model: str | None = None
+    C1: float | None = None
+    C2: float | None = None
+    C10: float | None = None
+    C20: float | None = None
+    C30: float | None = None
+    mu: Any = None  # a number (gent, arruda-boyce) or a list (ogden)
+    alpha: Any = None
+    Jm: float | None = None
+    lambda_m: float | None = None
+    stiffness_ratio: float | None = None
+    flow: Literal["bergstrom-boyce"] = "bergstrom-boyce"
+    A: float
+    C: float
+    m: float
+    E: float = 0.01
+    shift: bool = True
+
+    @field_validator("model")
+    @classmethod
+    def _model(cls, value: str) -> str:
+        return _known_model(value)
+
+    @field_validator(*_FLOW)
+    @classmethod
+    def _flow(cls, value: float, info: ValidationInfo) -> float:
+        assert info.field_name is not None, "a field validator is called for a field"
+        test, need = _FLOW[info.field_name]
+        if not test(value):
+            raise ValueError(f"{need}, got {value}")
+        return value
+
+    @field_validator("stiffness_ratio")
+    @classmethod
+    def _ratio(cls, value: float) -> float:
+        if not value > 0:
+            raise ValueError(f"must be > 0, got {value}")
+        return value
+
+    @field_validator(*_SCALARS, "mu", "alpha", mode="before")
+    @classmethod
+    def _constant(cls, value: Any, info: ValidationInfo) -> Any:
+        name = info.field_name
+        assert name is not None, "a field validator is called for a field"
+        model = info.data.get("model")
+        if model is None:
+            raise ValueError("a constant of the network's law needs its model (or give stiffness_ratio alone)")
+        if name not in law_keys(model):
+            raise ValueError(f'does not belong to model = "{model}" (its keys: {", ".join(law_keys(model))})')
+        if _is_list(name, model):
+            return _numbers(value, f"{model} {name}")
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ValueError(f"must be a number, got {value!r}")
+        return _check_number(value, *_range(name, model))
+
+    @model_validator(mode="after")
+    def _law(self):
+        if (self.model is None) == (self.stiffness_ratio is None):
+            raise ValueError("give the network's elastic part as a model (with its constants) or stiffness_ratio")
+        if self.model is not None:
+            missing = [k for k in law_keys(self.model) if getattr(self, k) is None]
+            if missing:
+                raise ValueError(f"missing constant of the network's law: {', '.join(missing)}")
+        return self
+
+    def build(self, k: int, equilibrium: Any) -> Network:
+        """Network k of the law `equilibrium` (its isochoric part times stiffness_ratio, where
+        given; ValueError naming the key where that law's constants are tables of T)."""
+        flow = BergstromBoyce(self.A, self.C, self.m, self.E, self.shift)
+        if self.model is None:
+            assert self.stiffness_ratio is not None, "a network has a model or a stiffness ratio (_law)"
+            if isinstance(equilibrium, TemperatureDependent):
+                raise ValueError(
+                    f"network[{k}].stiffness_ratio: the [material] law's constants are tables of T; give the "
+                    "network its own model and constants"
+                )
+            return Network(equilibrium, flow, self.stiffness_ratio)
+        c = {name: getattr(self, name, None) for name in CONSTANTS} | {"kappa": 0.0, "E": None, "nu": None}
+
+        def no_default(key: str) -> Any:
+            raise AssertionError(f"{key}: every constant of a network's law is given (_law)")
+
+        return Network(LAWS[self.model].from_case(c, 0.0, no_default), flow)
+
+
+class FreezeSpec(BaseModel):
+    """`[material.freeze] modulus = [[T, G_f], ...]`: the shear modulus G_f(T) of the network
+    frozen in as the material cools (T increasing, G_f >= 0 and non-increasing in T)."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+    modulus: list[Annotated[list[float], Field(min_length=2, max_length=2)]]
+
+    @field_validator("modulus")
+    @classmethod
+    def _modulus(cls, rows: list[list[float]]) -> list[list[float]]:
+        try:
+            Freeze(rows)  # its checks say what is wrong
+        except ValueError as exc:
+            raise ValueError(str(exc).removeprefix("modulus: ")) from None
+        return rows
+
+
 class MaterialSpec(BaseModel):
     """The [material] table (see the module docstring)."""
 
@@ -133,16 +273,14 @@ class MaterialSpec(BaseModel):
     E: Tabled = None
     nu: Tabled = None
     viscoelastic: ViscoelasticSpec | None = None
+    network: list[NetworkSpec] = []
+    freeze: FreezeSpec | None = None
     density: Annotated[float, Field(gt=0)] | None = None  # mass per unit reference volume ([gravity], [thermal])
 
     @field_validator("model")
     @classmethod
     def _model(cls, value: str) -> str:
-        if value not in LAWS:
-            names = [repr(n) for n in LAWS]
-            expected = " or ".join([", ".join(names[:-1]), names[-1]]) if len(names) > 1 else names[0]
-            raise PydanticCustomError("literal_error", "Input should be {expected}", {"expected": expected})
-        return value
+        return _known_model(value)
 
     @field_validator(*_SCALARS, *_RANGE, mode="before")
     @classmethod
@@ -217,10 +355,24 @@ class MaterialSpec(BaseModel):
                 out[k] = Table.of(v)
         return out
 
-    def build(self, temperature: float | None = None) -> Hyperelastic | Viscoelastic | TemperatureDependent:
-        """The law (with its Prony series where `viscoelastic` is given); where constants are
-        tables of T, a TemperatureDependent law whose scales are taken at `temperature`
-        (ValueError naming the key when it is None)."""
+    @property
+    def memory(self) -> bool:
+        """Whether the law remembers its past: a Prony series or a viscous network."""
+        return self.viscoelastic is not None or bool(self.network)
+
+    def error(self, exc: ValueError) -> str:
+        """The message of an error of `build`, under the key it names (material.KEY) or the
+        table's (material: ...)."""
+        key = str(exc).split(":")[0]
+        named = key in self.tables() or key == "freeze" or key.startswith("network[")
+        return f"material.{exc}" if named else f"material: {exc}"
+
+    def build(
+        self, temperature: float | None = None
+    ) -> Hyperelastic | Viscoelastic | TemperatureDependent | NetworkLaw:
+        """The law (with its Prony series where `viscoelastic` is given, its networks and its
+        frozen network: a NetworkLaw); where constants are tables of T, a TemperatureDependent
+        law whose scales are taken at `temperature` (ValueError naming the key when it is None)."""
         tables = self.tables()
         law: Hyperelastic | TemperatureDependent
         if not tables:
@@ -230,9 +382,14 @@ class MaterialSpec(BaseModel):
         else:
             fixed = {k: getattr(self, k) for k in CONSTANTS if k not in tables}
             law = TemperatureDependent(self.elastic_law, tables, fixed, temperature)
-        if self.viscoelastic is None:
-            return law
-        return Viscoelastic(law, Prony(tuple(self.viscoelastic.g), tuple(self.viscoelastic.tau)))
+        prony = None if self.viscoelastic is None else Prony(tuple(self.viscoelastic.g), tuple(self.viscoelastic.tau))
+        if not self.network and self.freeze is None:
+            return law if prony is None else Viscoelastic(law, prony)
+        if self.freeze is not None and temperature is None:
+            raise ValueError("freeze: a network frozen in as the material cools needs the case's [temperature]")
+        networks = [spec.build(k, law) for k, spec in enumerate(self.network)]
+        freeze = None if self.freeze is None else Freeze(self.freeze.modulus)
+        return NetworkLaw(law, networks, freeze, prony=prony)
 
     def elastic_law(self, constants: dict[str, Any] | None = None) -> Hyperelastic:
         """The law from its constants (the spec's, or `constants`: name -> number, or array of

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .temperature import boundary_temperatures
+from .temperature import boundary_temperatures, change_values
 
 # the stiffest shear modulus a hyperelastic law of axiform's stands for in MPa: a glassy polymer's
 # is about 1e3, a rubber's 0.1 to 10, a polymer melt's below 1
@@ -24,14 +24,17 @@ MPA = ("MPa", "N/mm^2", "N/mm2", "N/mm²")
 
 
 def reachable_range(built) -> tuple[float, float] | None:
-    """The lowest and highest temperature the case can reach (the initial field, and with
-    [thermal] the moulds' and films' temperatures x their curves), None without [temperature]."""
+    """The lowest and highest temperature the case can reach (the initial field plus its
+    prescribed change, and with [thermal] the moulds' and films' temperatures x their curves),
+    None without [temperature]."""
     T = built.model.temperature
     if T is None:
         return None
     values = [float(T.min()), float(T.max())]
     if built.case.thermal is not None:
         values += [v for _, v, _ in boundary_temperatures(built.case)]
+    for dT, _ in change_values(built.case):
+        values += [float(T.min()) + dT, float(T.max()) + dT]
     return min(values), max(values)
 
 

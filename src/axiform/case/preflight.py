@@ -189,10 +189,13 @@ def _step_increment(curve, t_end: float, steps: int) -> float:
     return float(np.abs(np.diff(f)).max())
 
 
-def _contact_free(builder):
+def _contact_free(built: Built):
     """The system of the model without its contact pairs (the reference tangent of the body
-    and its loads), from the model as built (model.model.Model)."""
-    return dataclasses.replace(builder, contacts=[]).finalize()
+    and its loads): the built system itself where it has none (its evaluation keeps nothing),
+    else finalized again from the model as built (model.model.Model) without them."""
+    if not built.builder.contacts:
+        return built.model
+    return dataclasses.replace(built.builder, contacts=[]).finalize()
 
 
 def _gradients(model, u_full: np.ndarray) -> tuple[float, float]:
@@ -206,11 +209,11 @@ def _gradients(model, u_full: np.ndarray) -> tuple[float, float]:
     return float(np.abs(g).max()), float(det.min())
 
 
-def _reference_tangent(builder):
+def _reference_tangent(built: Built):
     """The contact-free copy of the model, its evaluation at rest (u = 0, t = 0) and the
     factorization of its tangent; None where there is none (held by its moulds alone)."""
     try:
-        body = _contact_free(builder)
+        body = _contact_free(built)
         ev = body.evaluate(np.zeros(body.n_free), 0.0)
         if not np.all(np.isfinite(ev.K.data)):
             return None
@@ -255,7 +258,7 @@ def _driven_step(built: Built, reference) -> list[str]:
 def inverting_loads(built: Built) -> list[str]:
     """Loads that invert elements within one nominal step, by a linear estimate (under
     displacement control: the driven dof's step)."""
-    reference = _reference_tangent(built.builder)
+    reference = _reference_tangent(built)
     if reference is None:
         return []  # held by its moulds alone: no reference tangent without them
     if isinstance(built.control, DisplacementControl):
@@ -352,11 +355,11 @@ def idle_temperature(built: Built) -> list[str]:
     heat = case.temperature
     if heat is None:
         return []
-    viscous = case.material.viscoelastic is not None
+    viscous = case.material.memory
     if heat.shift is not None and not viscous:
         return [
-            "temperature.shift: the material has no Prony series ([material] viscoelastic): the shift of its "
-            "relaxation times changes nothing"
+            "temperature.shift: the material has no Prony series ([material] viscoelastic) and no network: "
+            "the shift of its relaxation times changes nothing"
         ]
     if heat.shift is None and not case.material.tables() and case.thermal is None:
         return [

@@ -220,7 +220,7 @@ def law_keys(data: dict[str, Any]) -> dict[tuple, list[str]]:
     model = table.get("model") if isinstance(table, dict) else None
     if not isinstance(model, str) or model not in LAWS:
         return {}
-    return {("material",): ["model", *LAWS[model].key_names, "kappa", "E", "nu", "viscoelastic"]}
+    return {("material",): ["model", *LAWS[model].key_names, "kappa", "E", "nu", "viscoelastic", "network", "freeze"]}
 
 
 def parse(data: dict[str, Any]) -> Case:
@@ -352,9 +352,7 @@ def build(case: Case, base: str | Path = ".") -> Built:
     try:
         material = case.material.build(None if heat is None else heat.representative())
     except ValueError as exc:
-        raise CaseError(
-            f"material.{exc}" if str(exc).split(":")[0] in case.material.tables() else f"material: {exc}"
-        ) from None
+        raise CaseError(case.material.error(exc)) from None
     try:
         model = Model(mesh, material, formulation=case.mesh.formulation, sfr_edges=case.mesh.sfr_edges)
     except MeshError as exc:
@@ -400,6 +398,8 @@ def build(case: Case, base: str | Path = ".") -> Built:
         system = model.finalize()
     except ValueError as exc:  # a tied fibre rotation prescribed twice
         raise CaseError(f"fix: {exc}") from None
+    if system.n_free == 0:
+        raise CaseError("fix: every dof of the mesh is held: nothing is left to solve")
     try:
         monitors = build_monitors(system, mesh, case.monitor, cavities, case.mesh.element)
     except SelectorError as exc:

@@ -8,6 +8,7 @@ from typing import Annotated, Literal
 from pydantic import Field, model_validator
 
 from ..fem.mesh import Mesh
+from ..materials.protocol import as_law
 from ..model.model import Model
 from ..solve.solver import ArcLengthControl, DisplacementControl, LoadControl
 from .base import CaseError, DofName, PositiveFloat, Selector, Strict, one_node
@@ -67,10 +68,12 @@ def build_control(model: Model, mesh: Mesh, spec: SolverSpec) -> LoadControl | D
     prescribed (a driven or stop dof that is also fixed is refused).  A law with memory makes
     the load factor the process time: only load control advances it."""
     timed = (
-        "a viscoelastic material"
-        if getattr(model.material, "prony", None) is not None
+        "a viscoelastic material (a Prony series or viscous networks)"
+        if as_law(model.material).timed
         else "heat conduction ([thermal])"
         if model.conduction is not None
+        else "a prescribed change of temperature ([temperature] change)"
+        if model.change is not None
         else None
     )
     if spec.control != "load" and timed:

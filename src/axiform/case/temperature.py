@@ -7,9 +7,12 @@ of its relaxation times.
     # initial = { along = "r", table = [[0.0, 150.0], [7.5, 140.0]] }   # or "z": by reference coordinate
     reference = 150.0                                    # T_ref of the shift
     shift = { wlf = { C1 = 17.44, C2 = 51.6 } }          # or { arrhenius = { activation = 8.0e3 } } (E/R, K)
+    change = [[0.0, 0.0], [5.0, -30.0]]                  # optional: dT(t) added everywhere (an oven program)
 
 Without a heat equation the temperature of a material point stays its initial value (piecewise
-linear in the table, constant outside).  The law's constants may be tables [[T, value], ...]
+linear in the table, constant outside), plus the prescribed `change` dT(t) (linear between its
+knots, times increasing, held after the last; refused with [thermal], where conduction computes
+the temperature).  The law's constants may be tables [[T, value], ...]
 of it ([material]).  Errors name the key (temperature.KEY).
 """
 
@@ -95,6 +98,12 @@ class TemperatureSpec(Strict):
     initial: Any
     reference: float | None = None
     shift: ShiftSpec | None = None
+    change: list[tuple[float, float]] | None = None
+
+    @field_validator("change")
+    @classmethod
+    def _change(cls, rows):
+        return None if rows is None else _increasing_table(rows, "times")
 
     @field_validator("initial", mode="before")
     @classmethod
@@ -167,25 +176,31 @@ class TemperatureSpec(Strict):
         return float(self.initial)
 
 
+def _times(knots, end: float | None) -> list[float]:
+    """The times at which a curve of these knots can take its extremes within the run: t = 0,
+    the end time and the knots between (all knots where the end is not known); the curve is
+    piecewise linear and constant outside its knots."""
+    times = [float(t) for t, _ in knots]
+    if end is None:
+        return times
+    low, high = min(0.0, end), max(0.0, end)
+    return [0.0, *(t for t in times if low <= t <= high), end]
+
+
 def _scaled(value: float, knots, end: float | None) -> list[tuple[float, str]]:
     """(value x f(t), how) at every time a temperature x curve can take its extremes within
-    the run: t = 0, the end time and the knots between (all knots where the end is not
-    known); f is piecewise linear and constant outside its knots."""
+    the run (_times)."""
     if knots is None:
         return [(float(value), "")]
     curve = Curve(knots)
-    times = [float(t) for t, _ in knots]
-    if end is not None:
-        low, high = min(0.0, end), max(0.0, end)
-        times = [0.0, *(t for t in times if low <= t <= high), end]
-    return [(float(value) * curve(t), f" ({float(value):g} x its curve at t = {t:g})") for t in times]
+    return [(float(value) * curve(t), f" ({float(value):g} x its curve at t = {t:g})") for t in _times(knots, end)]
 
 
 def boundary_temperatures(case) -> list[tuple[str, float, str]]:
     """(key, temperature, how) of every temperature besides the initial field that the case
     can bring into the wall: each mould's temperature x its curve, each film's ambient x its
     curve, over the run ([solver] target under load control, else every knot)."""
-    end = float(case.solver.target) if case.solver.control == "load" and case.solver.target is not None else None
+    end = _end_time(case)
     out = []
     for k, c in enumerate(case.contact):
         if c.temperature is not None:
@@ -215,17 +230,59 @@ def check_boundary_temperatures(case, shift: Shift | None) -> None:
             ) from None
 
 
+def _end_time(case) -> float | None:
+    """The run's end time ([solver] target under load control), None where not known."""
+    return float(case.solver.target) if case.solver.control == "load" and case.solver.target is not None else None
+
+
+def change_values(case) -> list[tuple[float, str]]:
+    """(dT, how) at every time the prescribed change can take its extremes within the run
+    (_times); empty without a change."""
+    change = case.temperature.change if case.temperature is not None else None
+    if not change:
+        return []
+    curve = Curve(change)
+    return [(curve(t), f" (its value at t = {t:g})") for t in _times(change, _end_time(case))]
+
+
+def check_change(case, initial: np.ndarray, shift: Shift | None) -> None:
+    """CaseError naming temperature.change where it is given with [thermal], or where it brings
+    the coldest initial temperature to or below the shift's pole within the run."""
+    if case.temperature.change is None:
+        return
+    if case.thermal is not None:
+        raise CaseError(
+            "temperature.change: a prescribed change of temperature cannot be combined with [thermal]: heat "
+            "conduction computes the temperature there; program the films' ambients ([[convection]] ambient "
+            "with a curve) or the moulds' temperatures instead"
+        )
+    if shift is None:
+        return
+    for dT, how in sorted(change_values(case)):
+        try:
+            shift.check(initial + dT)
+        except TemperatureDomainError:
+            raise CaseError(
+                f"temperature.change: {dT:g}{how} brings the coldest initial temperature {initial.min():g} to "
+                f"{initial.min() + dT:g}, at or below {shift.describe()} of temperature.shift, where the shift is "
+                "not defined; give a smaller change, or a shift whose domain holds it"
+            ) from None
+
+
 def give_temperature(model: Model, mesh: Mesh, case) -> None:
-    """Give the model the initial temperature field and the shift of [temperature] (case.
-    temperature, not None), and check every other temperature the case can reach against the
-    shift's domain; CaseError naming the key."""
+    """Give the model the initial temperature field, the shift and the prescribed change of
+    [temperature] (case.temperature, not None), and check every other temperature the case can
+    reach against the shift's domain; CaseError naming the key."""
     heat = case.temperature
     shift = heat.build_shift(case.units.temperature)
     try:
-        model.heat(heat.nodal(mesh), shift)
+        initial = heat.nodal(mesh)
+        model.heat(initial, shift)
     except ValueError as exc:
         if shift is None:
             raise CaseError(f"temperature.initial: {exc}") from None
         key = "wlf.C2" if heat.shift.wlf is not None else "arrhenius"
         raise CaseError(f"temperature.shift.{key}: {exc} (temperature.initial)") from None
+    check_change(case, initial, shift)
+    model.program(None if heat.change is None else Curve(heat.change))
     check_boundary_temperatures(case, shift)

@@ -3,8 +3,9 @@ along the load path (load control).
 
 At each converged step n the residual R_n(u_n; s, h_{n-1}) = 0 holds, h_{n-1} the history
 committed at the step before (contact stick points, sticky nodes and where they froze,
-positions for the crossing test; the h_i of a viscoelastic law's Prony series and the
-isochoric stress they were updated with, per quadrature point; the nodes' temperature where
+positions for the crossing test; the law's state per quadrature point (materials.protocol:
+a Prony series' h_i and the isochoric stress they were updated with, a network's Cv^-1, a
+frozen network's H); the nodes' temperature where
 heat conduction advances it after each step, System.settle), and h_n = H(u_n; s, h_{n-1}).
 Differentiating,
 
@@ -32,6 +33,7 @@ conduction step each with heat conduction), one back-substitution with m right-h
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -78,10 +80,9 @@ class Sensitivity:
     def status(self) -> str:
         return self.solve.status
 
-    def dx_final_ds(self) -> np.ndarray:
-        """Derivative of the current node positions x = X + u at the last step (n_nodes, 2, m)."""
-        du = self.du_ds[-1].reshape(self.model.mesh.n_nodes, self.model.dpn, -1)[:, :2]
-        return self.dx_ds + du
+    def du_final_ds(self) -> np.ndarray:
+        """Derivative of the node displacements u at the last step (n_nodes, 2, m)."""
+        return self.du_ds[-1].reshape(self.model.mesh.n_nodes, self.model.dpn, -1)[:, :2]
 
 
 def _same_numbering(base: System, other: System, k: int) -> None:
@@ -109,7 +110,7 @@ def _dofmap(model: System) -> DofMap:
 
 def has_history(model: System) -> bool:
     """Whether the residual of a step depends on the history committed before it: contact
-    pairs, a law with memory (materials.viscoelastic), or a temperature that heat conduction
+    pairs, a law with state (materials.protocol), or a temperature that heat conduction
     advances step by step (System.settle)."""
     return bool(model.contacts) or bool(model.solid_state(model.initial_state())) or model.conduction is not None
 
@@ -191,29 +192,36 @@ def sensitivity(
         u2 = last.u.reshape(-1, model.dpn)[:, :2]
         out.thickness = thickness_table(model.mesh, u2, model.contact_states(last.state))
         if out.thickness is not None:
-            out.dthickness_ds = thickness_derivative(model, u2, out.dx_final_ds())
+            out.dthickness_ds = thickness_derivative(model, u2, out.dx_ds, out.du_final_ds())
     return out
 
 
-def thickness_derivative(model: System, u: np.ndarray, dx: np.ndarray) -> np.ndarray:
+def thickness_derivative(model: System, u: np.ndarray, dX: np.ndarray, du: np.ndarray) -> np.ndarray:
     """d thickness / ds (stations, m) of the wall at the nodal displacements u (n_nodes, 2),
-    the current positions moving by dx (n_nodes, 2, m) per unit of each design variable:
-    central differences of the measured thickness along each dx (the thickness is a smooth
-    function of the node positions), moving no node by more than 1e-6 of the smallest
-    element edge."""
+    the reference node positions moving by dX (n_nodes, 2, m) and the displacements by du
+    (n_nodes, 2, m) per unit of each design variable: central differences of the measured
+    thickness of the perturbed reference mesh and displacements (the thickness is a smooth
+    function of both; a held station, whose du is exactly zero or one translation, stays held
+    and gives the derivative of its reference thickness), moving no node by more than 1e-6 of
+    the smallest element edge."""
     mesh = model.mesh
-    m = dx.shape[-1]
-    out = np.empty((len(_wall(mesh, u)), m))
+    m = dX.shape[-1]
+    out = np.empty((len(_wall(mesh, mesh.points, u)), m))
     for k in range(m):
-        v = dx[..., k]
-        eps = 1e-6 * mesh.size() / max(float(np.abs(v).max()), 1e-300)
-        out[:, k] = (_wall(mesh, u + eps * v) - _wall(mesh, u - eps * v)) / (2 * eps)
+        v, w = dX[..., k], du[..., k]
+        eps = 1e-6 * mesh.size() / max(float(np.abs(v + w).max()), 1e-300)
+        plus = _wall(mesh, mesh.points + eps * v, u + eps * w)
+        minus = _wall(mesh, mesh.points - eps * v, u - eps * w)
+        out[:, k] = (plus - minus) / (2 * eps)
     return out
 
 
-def _wall(mesh, u: np.ndarray) -> np.ndarray:
-    """The wall's thickness per station at the nodal displacements u (n_nodes, 2)."""
-    table = thickness_table(mesh, u)
+def _wall(mesh, X: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """The wall's thickness per station of the mesh with reference node positions X (n_nodes, 2)
+    at the nodal displacements u (n_nodes, 2)."""
+    moved = copy.copy(mesh)
+    moved.points = X
+    table = thickness_table(moved, u)
     if table is None:
         raise ValueError("the mesh has no through-wall fibres: no thickness to differentiate")
     return table["thickness"]

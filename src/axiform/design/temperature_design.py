@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from ..case.schema import Built, CaseError, build, parse, read
+from ..case.temperature import change_values
 from ..materials.temperature import WLF, Arrhenius
 from .problem import CaseDesign, absolute_paths
 
@@ -91,13 +92,15 @@ class TemperatureDesign(CaseDesign):
 
     def outside(self, values: np.ndarray) -> str | None:
         """Why the temperatures `values` (k,) lie outside the shift's domain (at or below the
-        WLF pole T_ref - C2, or not a positive absolute temperature), or None.  The table's
+        WLF pole T_ref - C2, or not a positive absolute temperature), or None, also once lowered
+        by the most the prescribed change ([temperature] change) lowers them.  The table's
         field lies between its smallest and largest knot value, so the knots tell."""
         shift = self.built.model.shift
         if not isinstance(shift, (WLF, Arrhenius)):  # no shift: every temperature will do
             return None
+        lowest = min([0.0, *(dT for dT, _ in change_values(self.built.case))])
         try:
-            shift.check(np.asarray(values, float))
+            shift.check(np.asarray(values, float) + lowest)
         except ValueError as exc:
             return str(exc)
         return None

@@ -9,9 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..materials import InvertedElementError, deformation_gradient
-from ..materials.base import add_volumetric
-from ..materials.kinematics import from_rows, to_rows
-from ..materials.viscoelastic import Memory
+from ..materials.protocol import State, as_law
 from .elements import gauss_quad, gradient_operator
 from .mesh import Mesh
 
@@ -23,13 +21,14 @@ def element_dofs(cells: np.ndarray, dofs_per_node: int) -> np.ndarray:
 
 class SolidAssembly:
     """The solid's contribution: internal forces and material tangent of every element,
-    evaluated in chunks of elements so that the temporaries stay in cache."""
+    evaluated in chunks of elements so that the temporaries stay in cache.  The material (any
+    law; shift: the shift a_T of its rates, or None) is asked through materials.protocol alone."""
 
     chunk = 2048
 
-    def __init__(self, mesh: Mesh, material):
+    def __init__(self, mesh: Mesh, material, shift=None):
         self.mesh = mesh
-        self.material = material
+        self.law = as_law(material, shift)  # materials.protocol: the one call for P, A and the state
         self.G, self.dV = gradient_operator(mesh.element, mesh.points[mesh.cells])
         self.dofs = element_dofs(mesh.cells, mesh.element.dofs_per_node)
         e, q, _, nd = self.G.shape
@@ -51,32 +50,25 @@ class SolidAssembly:
         N = kind.shape(gauss_quad(kind.gauss)[0])[0]  # (q, k)
         return nodal[self.mesh.cells] @ N.T
 
-    def law(self, sl: slice = slice(None), temperature: np.ndarray | None = None):
-        """The law at the points of the elements sl: the material, or where its constants are
-        tables of T (materials.temperature) the law at the points' temperatures (temperature:
-        (e, q) of all elements), one value per point in the order of x[sl].reshape(-1, 5)."""
-        if temperature is None or not hasattr(self.material, "at"):
-            return self.material
-        return self.material.at(temperature[sl])
-
     def stress(
         self,
         x: np.ndarray,
         sl: slice = slice(None),
         temperature: np.ndarray | None = None,
-        memory: Memory | None = None,
+        state: State | None = None,
     ) -> np.ndarray:
-        """First Piola-Kirchhoff stress P (e, q, 5) at the gradients x of the elements sl
-        (temperature: (e, q) at the points of all elements, or None; memory: a law's history
-        over a step, applied as `evaluate` applies it)."""
-        law = self.law(sl, temperature)
-        if memory is None:
-            return law.stress(x)
-        xt, shape = to_rows(x)
-        P = law.stress_rows(xt, 0.0, False)[0]
-        memory.add_rows(sl, xt, P, None)
-        add_volumetric(xt, law.kappa, P, None)
-        return from_rows(P, None, shape)[0]
+        """First Piola-Kirchhoff stress P (e, q, 5) at the gradients x of the elements sl at the
+        committed state `state` (arrays (e, q, ...) of all elements; None: the initial one): the
+        law's update over a step of no length (temperature: (e, q) at the points of all
+        elements, or None)."""
+        held = self.initial_state(temperature) if state is None else state
+        T = None if temperature is None else temperature[sl]
+        return self.law.update(x, {k: v[sl] for k, v in held.items()}, 0.0, T, tangent=False)[0]
+
+    def initial_state(self, temperature: np.ndarray | None = None) -> State:
+        """The law's state before the first step at every quadrature point, arrays (e, q, ...);
+        temperature: (e, q) the points' initial temperatures, or None."""
+        return self.law.initial_state(self.dV.shape, temperature)
 
     @staticmethod
     def check_inverted(x: np.ndarray, offset: int = 0) -> None:
@@ -110,32 +102,50 @@ class SolidAssembly:
         u_full: np.ndarray,
         tangent: bool = True,
         out: tuple | None = None,
-        memory: Memory | None = None,
+        state: State | None = None,
+        dt: float = 0.0,
         temperature: np.ndarray | None = None,
-    ):
-        """Element internal forces fe (e, nd) and, if asked, element tangents Ke (e, nd, nd),
-        written into out = (fe, Ke) when given (from `buffers`) and returned.  memory: the
-        step of a law with a history per quadrature point (materials.viscoelastic.Memory),
-        whose trial arrays are filled here; temperature: (e, q) at the points (the law's
-        constants that are tables of T), or None."""
+    ) -> tuple[np.ndarray, np.ndarray | None]:
+        """Element internal forces fe (e, nd) and, if asked, element tangents Ke (e, nd, nd) of a
+        step (update, whose trial state is left out)."""
+        fe, Ke, _ = self.update(u_full, tangent, out, state, dt, temperature)
+        return fe, Ke
+
+    def update(
+        self,
+        u_full: np.ndarray,
+        tangent: bool = True,
+        out: tuple | None = None,
+        state: State | None = None,
+        dt: float = 0.0,
+        temperature: np.ndarray | None = None,
+    ) -> tuple[np.ndarray, np.ndarray | None, State]:
+        """Element internal forces fe (e, nd), if asked element tangents Ke (e, nd, nd), written
+        into out = (fe, Ke) when given (from `buffers`) and returned, and the law's trial state
+        (arrays (e, q, ...)) after a step dt from the committed state `state` (arrays (e, q, ...);
+        None: the initial one), at the points' temperatures `temperature` (e, q) or None: the
+        law's update (materials.protocol) chunk by chunk of elements."""
         e, q, _, nd = self.G.shape
         fe, Ke = out if out is not None else self.buffers(tangent)
+        held = self.initial_state(temperature) if state is None else state
+        trial: State = {}
         for sl, x in self.chunks(u_full):
             m = sl.stop - sl.start
+            T = None if temperature is None else temperature[sl]
+            P, A, part = self.law.update(x, {k: v[sl] for k, v in held.items()}, dt, T, tangent=tangent)
+            gather(trial, part, sl, e)
             GdV_T = self._GdV[sl].transpose(0, 2, 1)
-            law = self.law(sl, temperature)
-            if memory is not None:  # the law's parts apart: the Prony series acts on the isochoric one
-                xt, shape = to_rows(x)
-                P, A = law.stress_rows(xt, 0.0, tangent)
-                memory.add_rows(sl, xt, P, A)
-                add_volumetric(xt, law.kappa, P, A)
-                P, A = from_rows(P, A, shape)
-            elif tangent:
-                P, A = law.stress_tangent(x)
-            else:
-                P, A = law.stress(x), None
             if tangent:
                 AG = np.matmul(A, self.G[sl]).reshape(m, q * 5, nd)
                 np.matmul(GdV_T, AG, out=Ke[sl])
             np.matmul(GdV_T, P.reshape(m, q * 5, 1), out=fe[sl, :, None])
-        return fe, Ke
+        return fe, Ke, trial
+
+
+def gather(trial: State, part: State, sl: slice, e: int) -> None:
+    """Place a chunk's trial state `part` (arrays (m, q, ...) of the elements sl) into `trial`
+    (arrays (e, q, ...) of all e elements, made at the first chunk)."""
+    for k, v in part.items():
+        if k not in trial:
+            trial[k] = np.empty((e, *v.shape[1:]), v.dtype)
+        trial[k][sl] = v

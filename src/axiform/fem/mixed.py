@@ -27,8 +27,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..materials.kinematics import from_rows, to_rows
-from .assembly import SolidAssembly
+from ..materials.kinematics import to_rows
+from ..materials.protocol import State
+from .assembly import SolidAssembly, gather
 
 PRESSURE_SPACES = ("p0", "p1")
 
@@ -56,34 +57,34 @@ def volumetric_rows(xt: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return f * j2, dJ
 
 
-def add_pressure_hessian(A: np.ndarray, xt: np.ndarray, p: np.ndarray) -> None:
-    """A += p d2J/dF2 in place on rows A (5, 5, n), xt (5, n), p (n,): J = f (a d - b c) is
+def add_pressure_hessian(A: np.ndarray, x: np.ndarray, p: np.ndarray) -> None:
+    """A += p d2J/dF2 in place on A (..., 5, 5), x (..., 5), p (...): J = f (a d - b c) is
     quadratic in each pair."""
-    a, b, c, d, f = xt
+    a, b, c, d, f = (x[..., k] for k in range(5))
     pf = p * f
-    A[0, 3] += pf
-    A[3, 0] += pf
-    A[1, 2] -= pf
-    A[2, 1] -= pf
+    A[..., 0, 3] += pf
+    A[..., 3, 0] += pf
+    A[..., 1, 2] -= pf
+    A[..., 2, 1] -= pf
     for i, v in ((0, d), (3, a)):
         pv = p * v
-        A[4, i] += pv
-        A[i, 4] += pv
+        A[..., 4, i] += pv
+        A[..., i, 4] += pv
     for i, v in ((1, c), (2, b)):
         pv = p * v
-        A[4, i] -= pv
-        A[i, 4] -= pv
+        A[..., 4, i] -= pv
+        A[..., i, 4] -= pv
 
 
 class MixedAssembly(SolidAssembly):
     """Internal forces and tangents of the mixed elements (module docstring), same interface
-    and dof layout as SolidAssembly.  The law must give the isochoric part alone:
-    `material.iso_stress_tangent(x)` -> (P_iso, A_iso), and its bulk modulus `kappa`."""
+    and dof layout as SolidAssembly.  The law (materials.protocol) gives its isochoric part
+    (update with volumetric=False), its bulk modulus and its volumetric energy U(J)."""
 
     chunk = 1024
 
-    def __init__(self, mesh, material, pressure_space: str):
-        super().__init__(mesh, material)
+    def __init__(self, mesh, material, pressure_space: str, shift=None):
+        super().__init__(mesh, material, shift)
         from .elements import gauss_quad, jacobian
 
         self.pressure_space = pressure_space
@@ -96,73 +97,74 @@ class MixedAssembly(SolidAssembly):
         self.NpdV = NpdV
         self._NpdV_T = np.ascontiguousarray(NpdV.transpose(0, 2, 1))  # (e, np, q)
 
-    def _pressure(self, xt: np.ndarray, sl: slice, kappa: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """p = kappa (J_bar - 1) (n,) and dJ (5, n) at the rows xt (5, n) of the elements sl,
-        kappa (m,) theirs (bulk_modulus)."""
+    def _pressure(self, xt: np.ndarray, sl: slice, kappa: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """p = U'(J_bar) (n,), U'' (m,) per element (the mean of its points' where U is not
+        quadratic in J) and dJ (5, n) at the rows xt (5, n) of the elements sl, kappa (m,) theirs
+        (bulk_modulus); U the law's volumetric energy."""
         J, dJ = volumetric_rows(xt)
         m, q = self.Np[sl].shape[:2]
         h = np.matmul(self._NpdV_T[sl], J.reshape(m, q, 1))  # int N_p J dV (m, np, 1)
         Jbar = np.matmul(self.Np[sl], np.matmul(self.Minv[sl], h))  # (m, q, 1)
-        return (kappa[:, None] * (Jbar[..., 0] - 1.0)).reshape(-1), dJ
+        dU, d2U = self.law.volumetric(Jbar[..., 0], kappa[:, None])
+        d2U = np.asarray(d2U)
+        return dU.reshape(-1), d2U[:, 0] if d2U.shape[1] == 1 else d2U.mean(1), dJ
 
-    @staticmethod
-    def bulk_modulus(law, m: int) -> np.ndarray:
-        """kappa (m,) of m elements from their law (SolidAssembly.law): the law's, or where it
-        is a table of T the mean of each element's points (one pressure field per element
-        needs one kappa)."""
-        kappa = np.asarray(law.kappa, float)
+    def bulk_modulus(self, temperature: np.ndarray | None, sl: slice, m: int) -> np.ndarray:
+        """kappa (m,) of the m elements sl from the law at their points' temperatures
+        (temperature (e, q) of all elements, or None): the law's, or where it is a table of T the
+        mean of each element's points (one pressure field per element needs one kappa)."""
+        kappa = np.asarray(self.law.bulk_modulus(None if temperature is None else temperature[sl]), float)
         return np.broadcast_to(kappa, (m,)) if kappa.ndim == 0 else kappa.reshape(m, -1).mean(1)
 
     def stress(
-        self, x: np.ndarray, sl: slice = slice(None), temperature: np.ndarray | None = None, memory=None
+        self,
+        x: np.ndarray,
+        sl: slice = slice(None),
+        temperature: np.ndarray | None = None,
+        state: State | None = None,
     ) -> np.ndarray:
-        """P = P_iso + p dJ/dF (e, q, 5) with the element pressure p (memory: a law's history
-        over a step on the isochoric part, applied as `evaluate` applies it)."""
+        """P = P_iso + p dJ/dF (e, q, 5) with the element pressure p, the law's isochoric part
+        at the committed state `state` (as SolidAssembly.stress)."""
         xt, shape = to_rows(x)
-        law = self.law(sl, temperature)
-        p, dJ = self._pressure(xt, sl, self.bulk_modulus(law, shape[0]))
-        P = law.stress_rows(xt, 0.0, False)[0]
-        if memory is not None:
-            memory.add_rows(sl, xt, P, None)
-        P += p * dJ
-        return from_rows(P, None, shape)[0]
+        p, _, dJ = self._pressure(xt, sl, self.bulk_modulus(temperature, sl, shape[0]))
+        held = self.initial_state(temperature) if state is None else state
+        T = None if temperature is None else temperature[sl]
+        P = self.law.update(x, {k: v[sl] for k, v in held.items()}, 0.0, T, volumetric=False, tangent=False)[0]
+        return P + (p * dJ).T.reshape(P.shape)
 
-    def evaluate(
+    def update(
         self,
         u_full: np.ndarray,
         tangent: bool = True,
         out: tuple | None = None,
-        memory=None,
+        state: State | None = None,
+        dt: float = 0.0,
         temperature: np.ndarray | None = None,
-    ):
-        """Element internal forces fe (e, nd) and, if asked, element tangents Ke (e, nd, nd),
-        written into out = (fe, Ke) when given (from `buffers`) and returned (memory,
-        temperature: as for SolidAssembly.evaluate).  The law's
-        isochoric part (`stress_rows` with kappa = 0) and the pressure terms are computed on the
-        contiguous component rows (5, n), then brought to (m, q, 5, 5) once."""
+    ) -> tuple[np.ndarray, np.ndarray | None, State]:
+        """Element internal forces fe (e, nd), if asked element tangents Ke (e, nd, nd), and the
+        law's trial state, as SolidAssembly.update: the law's isochoric part (update with
+        volumetric=False) and the pressure terms at the element's dilatation."""
         e, q, _, nd = self.G.shape
         fe, Ke = out if out is not None else self.buffers(tangent)
+        held = self.initial_state(temperature) if state is None else state
+        trial: State = {}
         for sl, x in self.chunks(u_full):
             m = sl.stop - sl.start
             xt, shape = to_rows(x)
-            law = self.law(sl, temperature)  # built once per chunk (a tabled law: one value per point)
-            kappa = self.bulk_modulus(law, m)
-            p, dJ = self._pressure(xt, sl, kappa)
-            P, A = law.stress_rows(xt, 0.0, tangent)
-            if memory is not None:  # the Prony series on the isochoric part
-                memory.add_rows(sl, xt, P, A)
-            P += p * dJ
-            if tangent:
-                add_pressure_hessian(A, xt, p)
-            P, A = from_rows(P, A, shape)
+            T = None if temperature is None else temperature[sl]
+            p, d2U, dJ = self._pressure(xt, sl, self.bulk_modulus(temperature, sl, m))
+            P, A, part = self.law.update(x, {k: v[sl] for k, v in held.items()}, dt, T, False, tangent)
+            gather(trial, part, sl, e)
+            P += (p * dJ).T.reshape(P.shape)
             GdV_T = self._GdV[sl].transpose(0, 2, 1)
             np.matmul(GdV_T, P.reshape(m, q * 5, 1), out=fe[sl, :, None])
             if tangent:
+                add_pressure_hessian(A, x, p.reshape(m, q))
                 AG = np.matmul(A, self.G[sl]).reshape(m, q * 5, nd)
                 np.matmul(GdV_T, AG, out=Ke[sl])
                 # B = int N_p dJ^T G dV (m, np, nd) as one product with the stacked G (m, 5q, nd);
-                # K += kappa B^T M^-1 B
+                # K += U'' B^T M^-1 B (U'' per element: exact where U is quadratic in J)
                 W = self._NpdV_T[sl][:, :, :, None] * dJ.T.reshape(m, 1, q, 5)  # (m, np, q, 5)
                 B = np.matmul(W.reshape(m, -1, q * 5), self._G2[sl])
-                Ke[sl] += np.matmul(B.transpose(0, 2, 1), kappa[:, None, None] * np.matmul(self.Minv[sl], B))
-        return fe, Ke
+                Ke[sl] += np.matmul(B.transpose(0, 2, 1), d2U[:, None, None] * np.matmul(self.Minv[sl], B))
+        return fe, Ke, trial

@@ -9,7 +9,6 @@ import io
 import os
 from contextlib import contextmanager
 from pathlib import Path
-from xml.etree import ElementTree as ET
 
 import numpy as np
 
@@ -58,6 +57,8 @@ def series_times(entries: list[tuple[int, float, str]]) -> list[float]:
 def write_pvd(path: Path, entries: list[tuple[int, float, str]]) -> None:
     """fields.pvd, atomically: a ParaView collection of the VTU files of the entries (step, t,
     file), in their order, with their timesteps (series_times)."""
+    from xml.etree import ElementTree as ET  # here: a run without VTU files does without it
+
     root = ET.Element("VTKFile", type="Collection", version="0.1")
     coll = ET.SubElement(root, "Collection")
     for (_, _, name), t in zip(entries, series_times(entries), strict=False):

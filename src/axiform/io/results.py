@@ -21,8 +21,8 @@ import shutil
 import sys
 import time
 from collections.abc import Sequence
-from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -33,6 +33,9 @@ from .columns import HISTORY_COLUMNS
 from .files import atomic, contact_table, mould_outlines, write_atomic, write_pvd, write_vtu
 from .folder_start import clear_folder, initial_step, initial_summary, read_summary
 from .run_report import RunRecord, thickness_summary
+
+if TYPE_CHECKING:
+    from concurrent.futures import Future, ThreadPoolExecutor
 
 
 class NonFiniteResult(ArithmeticError):
@@ -85,7 +88,7 @@ class ResultsWriter:
         self.plots = plots
         self.flush_every_s = flush_every_s
         self._flushed = -np.inf  # time of the last flush: the first step is written at once
-        self._thickness = None  # the table of the last field step, not yet in thickness.csv
+        self._thickness_step = None  # the last field step, its thickness not yet in thickness.csv
         self._contact = None  # the reports, nodes and load factor of the last step, not yet in contact.csv
         self._pvd_written = 0  # entries of self._pvd in fields.pvd
         self.thickness_every = thickness_every
@@ -193,10 +196,7 @@ class ResultsWriter:
         self._wait_for_vtu()
         write_atomic(self.out / "history.csv", self._history.getvalue())
         self._write_contact()
-        if self._thickness is not None:
-            with atomic(self.out / "thickness.csv") as tmp:
-                write_thickness_csv(tmp, self._thickness)
-            self._thickness = None
+        self._write_thickness()
         if self._pvd_written != len(self._pvd):
             write_pvd(self.out / "fields.pvd", self._pvd)
             self._pvd_written = len(self._pvd)
@@ -271,15 +271,26 @@ class ResultsWriter:
         write_atomic(self.out / "surfaces.csv", mould_outlines(self.model.contacts, lam))
         self._contact = None
 
+    def _write_thickness(self) -> None:
+        """thickness.csv and summary.json's `thickness` of the last field step, if not yet
+        written: the table is worked out here, once a flush, rather than at every step."""
+        step, self._thickness_step = self._thickness_step, None
+        if step is None:
+            return
+        u = step.u.reshape(-1, self.model.dpn)[:, :2]
+        table = thickness_table(self.model.mesh, u, self.model.contact_states(step.state), step.state.temperature)
+        if table is None:
+            return
+        self.summary["thickness"] = thickness_summary(table)
+        with atomic(self.out / "thickness.csv") as tmp:
+            write_thickness_csv(tmp, table)
+
     def _write_fields(self, step):
-        """Field output of one step: VTU (+ .pvd), GiD results, thickness.csv."""
+        """Field output of one step: VTU (+ .pvd), GiD results, thickness.csv (at the next flush)."""
         mesh = self.model.mesh
         self._last_written = step.number
-        u = step.u.reshape(-1, self.model.dpn)[:, :2]
+        self._thickness_step = step
         T = step.state.temperature
-        self._thickness = thickness_table(mesh, u, self.model.contact_states(step.state), T)
-        if self._thickness is not None:
-            self.summary["thickness"] = thickness_summary(self._thickness)
         if T is not None:
             self.summary["temperature"] = {"min": float(T.min()), "max": float(T.max())}
         if self.vtu and self.model.contacts:
@@ -299,6 +310,8 @@ class ResultsWriter:
             return
         name = f"step_{step.number:04d}.vtu"
         if self._vtu_writer is None:
+            from concurrent.futures import ThreadPoolExecutor
+
             self._vtu_writer = ThreadPoolExecutor(max_workers=1, thread_name_prefix="axiform-vtu")
         job = self._vtu_writer.submit(write_vtu, self.out / "fields" / name, mesh, with_components(data))
         self._vtu_pending.append((step.number, float(step.lam), f"fields/{name}", job))

@@ -9,21 +9,25 @@ q = sqrt(3/2 tau':tau'), lambda_v = sqrt(tr(Cv)/3), Cv = Fv^T Fv, and the flow
 (A, C, m, E named as Abaqus' parallel rheological framework).  The state is Cv^-1 (reference
 frame, symmetric; components RR, RZ, ZZ, TT): Be = F Cv^-1 F^T.
 
-Over a step (elastic predictor, viscous corrector): Be_tr = F Cv_n^-1 F^T; with isotropy the
-exponential map keeps the principal axes of Be_tr and works on the principal logarithmic
-strains e_i = ln(lambda_e,i) (i = 1, 2 in the meridian plane, 3 the hoop):
+Over a step (elastic predictor, viscous corrector): Be_tr = F Cv_n^-1 F^T, its meridian block
+diagonalized in closed form (eigenvalues mu_1 >= mu_2 on the unit axes n_1, n_2) and the hoop
+mu_3.  With isotropy the exponential map keeps these axes and acts on the principal log strains
+e_i = ln(lambda_e,i); the flow is isochoric and along tau', deviatoric, so sum(e) = sum(e_tr)
+and only the deviatoric part moves, two unknowns w = (y, z) on the plane sum(e) = 0
+(principal.py's basis, where the law gives tau' = (t_y, t_z) and k = dtau'/dw):
 
-    r(e) = e - e_tr + dt (3/2) g(q) tau'(e) = 0,   e_tr = ln(mu_i)/2,   g(q) = eps_dot / q,
+    r(w) = w - w_tr + a g(q) tau'(w) = 0,   a = 3/2 dt,   g(q) = eps_dot / q = rate q^(m - 1),
 
-a local Newton per point on the three e_i, vectorized; sum(e) = sum(e_tr) exactly, so that
-det Fv stays 1 to round-off.  lambda_v in eps_dot is the one of the start of the step (the
-hardening factor lags a step; stress and flow direction are implicit).  Then Be = sum
-exp(2 e_i) n_i n_i, Cv^-1 = F^-1 Be F^-T, P = tau F^-T.
+a 2 x 2 Newton per point, vectorized; lambda_v in eps_dot is the one of the start of the step
+(the hardening factor lags a step; stress and flow direction are implicit).  Then be_i =
+mu_i exp(2 (e_i - e_tr,i)) (det Fv = 1 to round-off), Cv^-1 = F^-1 Be F^-T, P = tau F^-T.
 
-Tangent: tau is an isotropic function of Be_tr with principal values t_i(mu_1, mu_2, mu_3),
-dt_i/dmu_j = K (dr/de)^-1 / (2 mu_j), K_ij = dtau_i/de_j; in the meridian plane dtau follows
-from the eigenvalue derivatives and the rotation of the axes, weighted by (t_1 - t_2) /
-(mu_1 - mu_2) (its limit where mu_1 = mu_2); A = dP/dx along the five components of x.
+Tangent: with h_j = F^-1 n_j, de_tr,j = n_j.dF h_j (meridian) and df/f (hoop), so that the
+directions O_j = n_j h_j^T (and e_theta/f) carry both de_tr along dx and tau's part in P.  The
+algorithmic modulus M = k (dr/dw)^-1 (= (k^-1 + a g I + a c tau' tau'^T)^-1 where k is regular,
+dg/dw = c k tau') is symmetric, and
+A = O_w M O_w^T + (t_1 - t_2)/(mu_1 - mu_2) O_12 d(Be_tr)_12 (the rotation of the axes; its
+limit where mu_1 = mu_2) - P dF^T F^-T (the geometric part), O_w = (O_y, O_z) on the plane.
 """
 
 from __future__ import annotations
@@ -34,12 +38,23 @@ from dataclasses import dataclass
 import numpy as np
 
 from .base import Hyperelastic
-from .principal import principal_function
+from .principal import SQRT2, SQRT6, Plane, plane_function
 
-Rows = tuple[np.ndarray, np.ndarray]
+PlaneLaw = Callable[[np.ndarray, np.ndarray], Plane]
 MAX_ITERATIONS = 50
-TOLERANCE = 1e-12  # on the local residual, a logarithmic strain
+TOLERANCE = 1e-12  # on the local residual, a logarithmic strain (its Euclidean norm)
 DEGENERATE = 1e-8  # relative gap of the meridian eigenvalues below which the limit is used
+# rows of the local state (local_system): the unknowns, the law's t and k there, the residual,
+# the Jacobian dr/dw and the residual's squared norm
+Y, Z, TY, TZ, KYY, KYZ, KZZ, RY, RZ, JYY, JYZ, JZY, JZZ, NORM = range(14)
+
+
+def power(x: np.ndarray, e: float) -> np.ndarray:
+    """x^e (n) for x > 0: NumPy's own power where it has a short way (e 0, 1/2, 1, 2), else
+    exp(e ln x) (two vectorized functions cost less than the general power)."""
+    if e in (0.0, 0.5, 1.0, 2.0):
+        return x**e
+    return np.exp(e * np.log(x))
 
 
 class LocalUpdateError(ArithmeticError):
@@ -74,7 +89,7 @@ class BergstromBoyce:
     def rate_factor(self, trace_Cv: np.ndarray, a_T: np.ndarray | float) -> np.ndarray:
         """A (lambda_v - 1 + E)^C / a_T (n), lambda_v = sqrt(tr(Cv)/3) from tr(Cv) (n)."""
         lam_v = np.sqrt(trace_Cv / 3.0)
-        return self.A * (lam_v - 1.0 + self.E) ** self.C / a_T
+        return self.A * power(lam_v - 1.0 + self.E, self.C) / a_T
 
 
 @dataclass(frozen=True)
@@ -89,121 +104,144 @@ class Network:
         if not self.scale > 0:
             raise ValueError(f"stiffness_ratio: must be > 0, got {self.scale}")
 
-    def principal(self, e: np.ndarray) -> Rows:
-        """Principal Kirchhoff stresses t (3, n) of the elastic part at principal log strains
-        e (3, n) and K = dt/de (3, 3, n) (principal.py)."""
-        return principal_function(self.law, self.scale)(e)
+    def plane(self, y: np.ndarray, z: np.ndarray) -> Plane:
+        """The elastic part on the deviatoric plane (principal.py): at log strains (y, z) (n
+        each), the principal Kirchhoff stresses (t_y, t_z) and k = dt/de (k_yy, k_yz, k_zz)."""
+        return plane_function(self.law, self.scale)(y, z)
 
 
-def inverse3(M: np.ndarray) -> np.ndarray:
-    """The inverse of 3x3 matrices M (3, 3, n) by cofactors, (3, 3, n)."""
-    C = np.empty_like(M)
-    for i in range(3):
-        for j in range(3):
-            i1, i2 = (i + 1) % 3, (i + 2) % 3
-            j1, j2 = (j + 1) % 3, (j + 2) % 3
-            C[j, i] = M[i1, j1] * M[i2, j2] - M[i1, j2] * M[i2, j1]  # adjugate: transposed cofactors
-    det = M[0, 0] * C[0, 0] + M[0, 1] * C[1, 0] + M[0, 2] * C[2, 0]
-    return C / det
+def local_system(
+    plane: PlaneLaw,
+    y: np.ndarray,
+    z: np.ndarray,
+    y_tr: np.ndarray,
+    z_tr: np.ndarray,
+    rate: np.ndarray,
+    m: float,
+    a: float,
+) -> tuple[np.ndarray, ...]:
+    """The local state (14 arrays (n), rows Y .. NORM) at w = (y, z) (n each): residual_system
+    of the law's t and k there."""
+    return residual_system(plane(y, z), y, z, y_tr, z_tr, rate, m, a)
 
 
-def local_system(t: np.ndarray, K: np.ndarray, rate: np.ndarray, m: float, dt: float) -> tuple[np.ndarray, np.ndarray]:
-    """dt (3/2) g(q) t' (3, n) and its Jacobian in e (3, 3, n), g = rate q^(m-1), from the
-    principal stresses t (3, n), K = dt/de (3, 3, n) and rate (n)."""
-    dev = t - t.mean(0)
-    q = np.sqrt(1.5 * (dev * dev).sum(0))
-    safe = np.where(q > 0, q, 1.0)  # q = 0: dev = 0, the terms with q^(m-3) vanish
-    power = rate * safe ** (m - 1.0)
-    g = power * np.where(q > 0, 1.0, 0.0 if m > 1.0 else 1.0)
-    flow = (1.5 * dt) * g * dev
-    Kdev = K - K.mean(0)
-    dg = (1.5 * (m - 1.0)) * power / (safe * safe) * (dev[:, None] * K).sum(0)  # dg/de (3, n)
-    jac = (1.5 * dt) * (g * Kdev + dev[:, None] * dg[None])
-    for i in range(3):
-        jac[i, i] += 1.0
-    return flow, jac
+def residual_system(
+    law: Plane, y: np.ndarray, z: np.ndarray, y_tr: np.ndarray, z_tr: np.ndarray, rate: np.ndarray, m: float, a: float
+) -> tuple[np.ndarray, ...]:
+    """The local state (14 arrays (n), rows Y .. NORM) at w = (y, z) (n each) where the law gives
+    t and k (law, principal.py's five arrays): the residual r = w - w_tr + a g t, g = rate
+    q^(m-1), and dr/dw = I + a (g k + c t (k t)^T), c = 3/2 (m - 1) rate q^(m-3) (dg/dw = c k t)."""
+    ty, tz, kyy, kyz, kzz = law
+    q2 = 1.5 * (ty * ty + tz * tz)
+    positive = q2 > 0
+    safe = np.where(positive, q2, 1.0)  # q = 0: t = 0, the terms with q^(m-3) vanish
+    rate_q = rate * power(safe, 0.5 * (m - 1.0))  # rate q^(m-1)
+    ag = a * (rate_q if m == 1.0 else np.where(positive, rate_q, 0.0))
+    ac = (1.5 * (m - 1.0) * a) * rate_q / safe
+    kty, ktz = ac * (kyy * ty + kyz * tz), ac * (kyz * ty + kzz * tz)
+    ry, rz = (y - y_tr) + ag * ty, (z - z_tr) + ag * tz
+    jyy = 1.0 + ag * kyy + ty * kty
+    jyz = ag * kyz
+    jzy = jyz + tz * kty
+    jyz += ty * ktz
+    jzz = 1.0 + ag * kzz + tz * ktz
+    return y, z, ty, tz, kyy, kyz, kzz, ry, rz, jyy, jyz, jzy, jzz, ry * ry + rz * rz
 
 
-def scalar_guess(
-    e_tr: np.ndarray, t: np.ndarray, rate: np.ndarray, m: float, dt: float
+def flow_guess(
+    ty: np.ndarray, tz: np.ndarray, y_tr: np.ndarray, z_tr: np.ndarray, rate: np.ndarray, m: float, a: float
 ) -> tuple[np.ndarray, np.ndarray]:
-    """A first iterate of the local Newton (3, n) and rho (n): the solution for an elastic part
-    linear in the deviatoric log strain (2 mu_eff = t':e_tr' / e_tr':e_tr' at the predictor), e =
-    mean(e_tr) + rho e_tr', rho (1 + c rho^(m-1)) = 1, c = 3/2 dt rate q_tr^(m-1) 2 mu_eff,
-    solved for u = ln(rho) (u + ln(1 + c e^((m-1) u)) = 0: convex, slope in [1, m]) by Newton
-    from u = 0.  For a steep flow and a long step the plain Newton from the predictor creeps."""
-    mean = e_tr.mean(0)
-    dev = e_tr - mean
-    tdev = t - t.mean(0)
-    ee = (dev * dev).sum(0)
-    two_mu = np.where(ee > 0, (tdev * dev).sum(0) / np.where(ee > 0, ee, 1.0), 0.0)
-    q = np.sqrt(1.5 * (tdev * tdev).sum(0))
-    c = 1.5 * dt * rate * np.where(q > 0, q, 1.0) ** (m - 1.0) * np.maximum(two_mu, 0.0)
-    u = np.zeros_like(mean)
-    for _ in range(30):
-        w = c * np.exp((m - 1.0) * u)
-        du = -(u + np.log1p(w)) / (1.0 + (m - 1.0) * w / (1.0 + w))
-        u += du
-        if not (np.abs(du) > 1e-3).any():  # the Newton of solve_local finishes the work
-            break
-    rho = np.exp(u)
-    return mean + rho * dev, rho
+    """The points that flow far within the step (their indices) and for them rho: the solution
+    for an elastic part linear in w (2 mu_eff = t.w_tr / w_tr.w_tr with t = (ty, tz) (n each)
+    at the predictor) is w = rho w_tr, rho (1 + c rho^(m-1)) = 1, c = a rate q_tr^(m-1) 2 mu_eff;
+    far: rho < 0.9.  For u = ln(rho), u + ln(1 + c e^((m-1) u)) = 0 (convex, slope in [1, m]):
+    one Newton step from u = -ln(1 + c)/m (right of the root), within the model's own error
+    of the root.  For a steep flow and a long step the plain Newton from the predictor creeps."""
+    ww = y_tr * y_tr + z_tr * z_tr
+    two_mu = np.where(ww > 0, (ty * y_tr + tz * z_tr) / np.where(ww > 0, ww, 1.0), 0.0)
+    q2 = 1.5 * (ty * ty + tz * tz)
+    c = a * rate * power(np.where(q2 > 0, q2, 1.0), 0.5 * (m - 1.0)) * np.maximum(two_mu, 0.0)
+    far = np.flatnonzero(c > (1.0 / 0.9 - 1.0) / 0.9 ** (m - 1.0))  # rho(c) < 0.9
+    c = c[far]
+    u = -np.log1p(c) / m
+    w = c * np.exp((m - 1.0) * u)
+    u -= (u + np.log1p(w)) * (1.0 + w) / (1.0 + m * w)
+    return far, np.exp(u)
 
 
 def solve_local(
-    principal: Callable[[np.ndarray], Rows], e_tr: np.ndarray, rate: np.ndarray, m: float, dt: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The principal log strains e (3, n) solving r(e) = 0, and at the solution t (3, n),
-    K (3, 3, n) and the local Jacobian dr/de (3, 3, n).  Newton from the elastic predictor, or
-    from scalar_guess where that one flows far (rho < 0.9), on the points not yet converged
-    only; a step that does not lower |r| is halved (up to 8 times)."""
-    n = e_tr.shape[1]
-    t, K = principal(e_tr)
-    e = e_tr.copy()
-    if dt > 0:
-        guess, rho = scalar_guess(e_tr, t, rate, m, dt)
-        far = np.flatnonzero(rho < 0.9)
+    plane: PlaneLaw, y_tr: np.ndarray, z_tr: np.ndarray, rate: np.ndarray, m: float, dt: float
+) -> tuple[np.ndarray, ...]:
+    """The local state (14 rows (n), local_system) at the w = (y, z) solving r(w) = 0.  Newton
+    from the elastic predictor, or from flow_guess where that one flows far; a step that does
+    not lower |r| is halved (up to 8 times).  While at least a quarter of the points iterate,
+    all points are evaluated and the converged ones held (a zero step: the same numbers again);
+    then only the others (gathered).  Either way a point's iterates are its own."""
+    n, a = y_tr.size, 1.5 * dt
+    law = plane(y_tr, z_tr)
+    far, rho = flow_guess(law[0], law[1], y_tr, z_tr, rate, m, a) if dt > 0 else (np.arange(0), None)
+    if far.size and 4 * far.size >= n:  # the predictor's residual and Jacobian are not needed
+        scale = np.ones(n)
+        scale[far] = rho
+        X = local_system(plane, scale * y_tr, scale * z_tr, y_tr, z_tr, rate, m, a)
+    else:
+        X = residual_system(law, y_tr, z_tr, y_tr, z_tr, rate, m, a)
         if far.size:
-            e[:, far] = guess[:, far]
-            t[:, far], K[:, :, far] = principal(guess[:, far])
-    flow, jac = local_system(t, K, rate, m, dt)
-    r = e - e_tr + flow
-    norm = np.abs(r).max(0)
+            new = local_system(plane, rho * y_tr[far], rho * z_tr[far], y_tr[far], z_tr[far], rate[far], m, a)
+            X = scatter(X, far, new)
+    tolerance = TOLERANCE * TOLERANCE
     for _ in range(MAX_ITERATIONS):
-        idx = np.flatnonzero(norm > TOLERANCE)
-        if not idx.size:
-            return e, t, K, jac
-        at: slice | np.ndarray = slice(None) if idx.size == n else idx
-        e_a, e_tr_a, rate_a, norm_a = e[:, at], e_tr[:, at], rate[at], norm[at]
-        step = -(inverse3(jac[:, :, at]) * r[None, :, at]).sum(1)
-        factor = np.ones_like(norm_a)
+        active = X[NORM] > tolerance
+        count = np.count_nonzero(active)
+        if not count:
+            return X
+        idx = None if 4 * count >= n else np.flatnonzero(active)
+        S = X if idx is None else tuple(row[idx] for row in X)
+        idet = 1.0 / (S[JYY] * S[JZZ] - S[JYZ] * S[JZY])
+        dy = (S[JYZ] * S[RZ] - S[JZZ] * S[RY]) * idet
+        dz = (S[JZY] * S[RY] - S[JYY] * S[RZ]) * idet
+        if idx is None:
+            dy, dz = np.where(active, dy, 0.0), np.where(active, dz, 0.0)
+            args = (y_tr, z_tr, rate, m, a)
+        else:
+            args = (y_tr[idx], z_tr[idx], rate[idx], m, a)
+        factor: float | np.ndarray = 1.0
         for _halving in range(9):
-            trial = e_a + factor * step
-            t_a, K_a = principal(trial)
-            flow_a, jac_a = local_system(t_a, K_a, rate_a, m, dt)
-            r_a = trial - e_tr_a + flow_a
-            new = np.abs(r_a).max(0)
-            worse = new > norm_a
+            new = local_system(plane, S[Y] + factor * dy, S[Z] + factor * dz, *args)
+            worse = new[NORM] > S[NORM]
             if not worse.any():
                 break
             factor = np.where(worse, 0.5 * factor, factor)
-        e[:, at], t[:, at], K[:, :, at], jac[:, :, at], r[:, at], norm[at] = trial, t_a, K_a, jac_a, r_a, new
-    raise LocalUpdateError(np.flatnonzero(norm > TOLERANCE))
+        X = new if idx is None else scatter(X, idx, new)
+    raise LocalUpdateError(np.flatnonzero(X[NORM] > tolerance))
 
 
-def meridian_eigen(p: np.ndarray, s: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Eigenvalues mu_1 >= mu_2 (n) of the symmetric positive [[p, r], [r, s]] and the axes as
-    c2 = cos(2 phi), s2 = sin(2 phi), phi the angle of the first axis from r; also the half gap
-    rad = (mu_1 - mu_2)/2 (n)."""
-    mean = 0.5 * (p + s)
+def scatter(X: tuple[np.ndarray, ...], idx: np.ndarray, new: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
+    """The rows of X (n each) with the points idx replaced by the rows of new (idx.size each)."""
+    out = []
+    for row, value in zip(X, new, strict=True):
+        row = row.copy()
+        row[idx] = value
+        out.append(row)
+    return tuple(out)
+
+
+def meridian_axes(p: np.ndarray, s: np.ndarray, r: np.ndarray, pm: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Eigenvalues mu_1 >= mu_2 (n) of the symmetric positive [[p, r], [r, s]] of determinant
+    pm, the unit axis (cos, sin) of mu_1 (the second is (-sin, cos)) and the half gap rad =
+    (mu_1 - mu_2)/2 (n each).  The axis from the column without cancellation."""
     half = 0.5 * (p - s)
-    rad = np.hypot(half, r)
-    mu1 = mean + rad
-    mu2 = (p * s - r * r) / mu1  # no cancellation where mu_2 << mu_1
-    safe = np.where(rad > 0, rad, 1.0)
-    c2 = np.where(rad > 0, half / safe, 1.0)
-    s2 = np.where(rad > 0, r / safe, 0.0)
-    return mu1, mu2, c2, s2, rad
+    rad = np.sqrt(half * half + r * r)
+    mu1 = 0.5 * (p + s) + rad
+    mu2 = pm / mu1  # no cancellation where mu_2 << mu_1
+    big = rad + np.abs(half)
+    norm = np.sqrt(2.0 * rad * big)  # |(big, r)|, rad = 0 only where the block is round
+    round_ = norm == 0
+    inv = 1.0 / np.where(round_, 1.0, norm)
+    up = half >= 0
+    cos = np.where(round_, 1.0, np.where(up, big, r) * inv)
+    sin = np.where(up, r, big) * inv
+    return mu1, mu2, cos, sin, rad
 
 
 def network_rows(network: Network, xt: np.ndarray, Cvi: np.ndarray, dt: float, a_T: np.ndarray | float) -> tuple:
@@ -211,94 +249,94 @@ def network_rows(network: Network, xt: np.ndarray, Cvi: np.ndarray, dt: float, a
     step dt from the committed Cv^-1 rows (4, n) (RR, RZ, ZZ, TT), a_T (n) or a number."""
     a, b, c, d, f = xt
     RR, RZ, ZZ, TT = Cvi
-    Y = (RR * a + RZ * b, RR * c + RZ * d, RZ * a + ZZ * b, RZ * c + ZZ * d)  # Cv^-1 F^T, meridian
-    p, r, s = a * Y[0] + b * Y[2], a * Y[1] + b * Y[3], c * Y[1] + d * Y[3]  # Be_tr = F Cv^-1 F^T
-    mu1, mu2, c2, s2, rad = meridian_eigen(p, s, r)
-    mu = np.stack([mu1, mu2, f * f * TT])
+    Ya, Yb, Yc, Yd = RR * a + RZ * b, RZ * a + ZZ * b, RR * c + RZ * d, RZ * c + ZZ * d  # Cv^-1 F^T
+    p, r, s = a * Ya + b * Yb, c * Ya + d * Yb, c * Yc + d * Yd  # Be_tr = F Cv^-1 F^T, meridian
+    h = f * f * TT  # its hoop value
+    j2 = a * d - b * c
     det_m = RR * ZZ - RZ * RZ
+    pm = j2 * j2 * det_m  # det of Be_tr's meridian block
+    mu1, mu2, cos, sin, rad = meridian_axes(p, s, r, pm)
+    y_tr = np.log(mu1 * mu1 / pm) * (0.5 / SQRT2)  # (e_1 - e_2)/sqrt 2, e = ln(mu)/2
+    z_tr = np.log(pm / (h * h)) * (0.5 / SQRT6)  # (e_1 + e_2 - 2 e_3)/sqrt 6
     rate = network.flow.rate_factor((RR + ZZ) / det_m + 1.0 / TT, a_T if network.flow.shift else 1.0)
     rate = np.broadcast_to(rate, a.shape)
-    e, t, K, jac = solve_local(network.principal, 0.5 * np.log(mu), rate, network.flow.m, dt)
-    j2 = a * d - b * c
-    Gi = (d / j2, -c / j2, -b / j2, a / j2)  # F^-T of the meridian block, rows r, z; columns R, Z
-    trial = elastic_state(np.exp(2.0 * e), c2, s2, Gi, f)
-    # the isotropic function tau(Be_tr): dt_i/dmu_j and the weight of the axes' rotation
-    G = (K[:, :, None] * inverse3(jac)[None]).sum(1) / (2.0 * mu[None])
-    gap = rad > DEGENERATE * mu1
-    ratio = np.where(gap, (t[0] - t[1]) / np.where(gap, mu1 - mu2, 1.0), 0.5 * (G[0, 0] - G[0, 1] + G[1, 1] - G[1, 0]))
-    tau = meridian_tensor(t[0], t[1], c2, s2) + (t[2],)
-    P = np.stack(piola(tau, Gi, f))
-    A = np.empty((5, 5, xt.shape[1]))
-    zero = np.zeros_like(a)
-    directions = (  # dBe_tr (p, s, r, hoop) along each component of x
-        (2.0 * Y[0], zero, Y[1], zero),
-        (2.0 * Y[2], zero, Y[3], zero),
-        (zero, 2.0 * Y[1], Y[0], zero),
-        (zero, 2.0 * Y[3], Y[2], zero),
-        (zero, zero, zero, 2.0 * f * TT),
+    X = solve_local(network.plane, y_tr, z_tr, rate, network.flow.m, dt)
+    ij = 1.0 / j2
+    H = np.stack(
+        [(d * cos - b * sin) * ij, (a * sin - c * cos) * ij, (-d * sin - b * cos) * ij, (c * sin + a * cos) * ij]
     )
-    for k, (dp, ds, dr, dh) in enumerate(directions):
-        dm, dd = 0.5 * (dp + ds), 0.5 * (dp - ds)
-        drad = c2 * dd + s2 * dr
-        w = c2 * dr - s2 * dd  # rad d(2 phi)
-        dmu = (dm + drad, dm - drad, dh)
-        dt_ = [G[i, 0] * dmu[0] + G[i, 1] * dmu[1] + G[i, 2] * dmu[2] for i in range(3)]
-        dmean, dhalf = 0.5 * (dt_[0] + dt_[1]), 0.5 * (dt_[0] - dt_[1])
-        dtau = (
-            dmean + dhalf * c2 - ratio * w * s2,
-            dmean - dhalf * c2 + ratio * w * s2,
-            dhalf * s2 + ratio * w * c2,
-            dt_[2],
-        )
-        A[:, k] = np.stack(piola(dtau, Gi, f)) + piola_geometric(tau, Gi, f, k)
+    # be_i = mu_i exp(2 (e_i - e_tr,i)), e - e_tr = (dy u_y + dz u_z)
+    ez = np.exp((2.0 / SQRT6) * (X[Z] - z_tr))
+    ey = np.exp(SQRT2 * (X[Y] - y_tr))
+    trial = elastic_state(mu1 * ez * ey, mu2 * ez / ey, TT / (ez * ez), H)
+    P, A = tangent_rows(X, H, (cos, sin), mu1, mu2, rad, xt)
     return P, A, trial
 
 
-def meridian_tensor(t1: np.ndarray, t2: np.ndarray, c2: np.ndarray, s2: np.ndarray) -> tuple[np.ndarray, ...]:
-    """(rr, zz, rz) of the symmetric tensor with principal values t1, t2 on the axes (c2, s2)."""
-    mean, half = 0.5 * (t1 + t2), 0.5 * (t1 - t2)
-    return mean + half * c2, mean - half * c2, half * s2
-
-
-def piola(tau: tuple, Gi: tuple, f: np.ndarray) -> tuple[np.ndarray, ...]:
-    """P = tau F^-T (5 rows) from tau (rr, zz, rz, tt) and Gi = F^-T (rR, rZ, zR, zZ)."""
-    rr, zz, rz, tt = tau
-    return (
-        rr * Gi[0] + rz * Gi[2],
-        rr * Gi[1] + rz * Gi[3],
-        rz * Gi[0] + zz * Gi[2],
-        rz * Gi[1] + zz * Gi[3],
-        tt / f,
-    )
-
-
-def piola_geometric(tau: tuple, Gi: tuple, f: np.ndarray, k: int) -> np.ndarray:
-    """tau d(F^-T) (5, n) along the component k of x: d(F^-T) = -F^-T dF^T F^-T."""
-    if k == 4:
-        out = np.zeros((5, f.size))
-        out[4] = -tau[3] / (f * f)
-        return out
-    alpha, beta = divmod(k, 2)  # dF = e_alpha e_beta^T (rows r, z; columns R, Z)
-    G = ((Gi[0], Gi[1]), (Gi[2], Gi[3]))
-    dG = [[-G[j][beta] * G[alpha][K] for K in range(2)] for j in range(2)]
-    rr, zz, rz, _ = tau
-    tm = ((rr, rz), (rz, zz))
-    out = np.zeros((5, f.size))
-    for i in range(2):
-        for K in range(2):
-            out[2 * i + K] = tm[i][0] * dG[0][K] + tm[i][1] * dG[1][K]
+def elastic_state(be1: np.ndarray, be2: np.ndarray, TT: np.ndarray, H: np.ndarray) -> np.ndarray:
+    """Cv^-1 = F^-1 Be F^-T (4, n) (RR, RZ, ZZ, TT) of Be = be1 n_1 n_1 + be2 n_2 n_2 (meridian)
+    from h_j = F^-1 n_j, H (4, n) = (h_1R, h_1Z, h_2R, h_2Z), and the new TT (n)."""
+    h1R, h1Z, h2R, h2Z = H
+    out = np.empty((4, be1.size))
+    out[0] = be1 * h1R * h1R + be2 * h2R * h2R
+    out[1] = be1 * h1R * h1Z + be2 * h2R * h2Z
+    out[2] = be1 * h1Z * h1Z + be2 * h2Z * h2Z
+    out[3] = TT
     return out
 
 
-def elastic_state(be: np.ndarray, c2: np.ndarray, s2: np.ndarray, Gi: tuple, f: np.ndarray) -> np.ndarray:
-    """Cv^-1 = F^-1 Be F^-T (4, n) (RR, RZ, ZZ, TT) from the principal values be (3, n) of Be
-    on the axes (c2, s2) and the hoop, Gi = F^-T."""
-    rr, zz, rz = meridian_tensor(be[0], be[1], c2, s2)
-    # F^-1 Be F^-T: (F^-1)_Ri = Gi[i, R]
-    g = ((Gi[0], Gi[1]), (Gi[2], Gi[3]))  # g[i][K] = (F^-T)_iK
-    B = ((rr, rz), (rz, zz))
-    out = np.empty((4, f.size))
-    for n_, (K, L) in enumerate(((0, 0), (0, 1), (1, 1))):
-        out[n_] = sum(g[i][K] * B[i][j] * g[j][L] for i in range(2) for j in range(2))
-    out[3] = be[2] / (f * f)
-    return out
+def tangent_rows(
+    X: tuple[np.ndarray, ...] | np.ndarray,
+    H: np.ndarray,
+    axis: tuple,
+    mu1: np.ndarray,
+    mu2: np.ndarray,
+    rad: np.ndarray,
+    xt: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """P (5, n) and A = dP/dx (5, 5, n) from the local state X at the solution (14, n), the
+    axes h_j = F^-1 n_j (H (4, n): h_1R, h_1Z, h_2R, h_2Z), n_1 = axis = (cos, sin) (n each),
+    the trial eigenvalues and half gap (module docstring).  A is symmetric (the update derives
+    from a potential of F at fixed Cv_n^-1): its upper triangle is computed, entry by entry."""
+    n = xt.shape[1]
+    f = xt[4]
+    cos, sin = axis
+    q1, q2 = (cos, sin), (-sin, cos)  # n_1, n_2 (r, z)
+    h1, h2 = (H[0], H[1]), (H[2], H[3])
+    pairs = [(i // 2, i % 2) for i in range(4)]  # x's meridian components (a, B): F_aB
+    O1 = [q1[a] * h1[B] for a, B in pairs]  # O_j = n_j h_j^T
+    O2 = [q2[a] * h2[B] for a, B in pairs]
+    Oy = [(u - v) * (1.0 / SQRT2) for u, v in zip(O1, O2, strict=True)]
+    Oz = [(u + v) * (1.0 / SQRT6) for u, v in zip(O1, O2, strict=True)] + [(-2.0 / SQRT6) / f]
+    ty, tz = X[TY], X[TZ]
+    P = np.empty((5, n))
+    for i in range(4):
+        P[i] = ty * Oy[i] + tz * Oz[i]
+    P[4] = tz * Oz[4]
+    # M = k (dr/dw)^-1, symmetric
+    kyy, kyz, kzz, jyy, jyz, jzy, jzz = X[KYY], X[KYZ], X[KZZ], X[JYY], X[JYZ], X[JZY], X[JZZ]
+    idet = 1.0 / (jyy * jzz - jyz * jzy)
+    Myy = (kyy * jzz - kyz * jzy) * idet
+    Myz = 0.5 * (kyz * jyy - kyy * jyz + kyz * jzz - kzz * jzy) * idet
+    Mzz = (kzz * jyy - kyz * jyz) * idet
+    Dy = [Myy * u + Myz * v for u, v in zip(Oy, Oz, strict=False)] + [Myz * Oz[4]]
+    Dz = [Myz * u + Mzz * v for u, v in zip(Oy, Oz, strict=False)] + [Mzz * Oz[4]]
+    # the rotation of the axes: dtau_12 = ratio dBe_12, dBe_12 = n_1.dF mu_2 h_2 + n_2.dF mu_1 h_1
+    gap = rad > DEGENERATE * mu1
+    ratio = np.where(gap, ty / (SQRT2 * np.where(gap, rad, 1.0)), Myy / (mu1 + mu2))
+    rO12 = [ratio * (q1[a] * h2[B] + q2[a] * h1[B]) for a, B in pairs]
+    m2h2, m1h1 = (mu2 * h2[0], mu2 * h2[1]), (mu1 * h1[0], mu1 * h1[1])
+    dBe12 = [q1[a] * m2h2[B] + q2[a] * m1h1[B] for a, B in pairs]
+    # the geometric part tau d(F^-T) = -P dF^T F^-T: [(a, B), (alpha, beta)] = -P_a,beta F^-T_alpha,B
+    ij = 1.0 / (xt[0] * xt[3] - xt[1] * xt[2])
+    Gi = (xt[3] * ij, -xt[2] * ij, -xt[1] * ij, xt[0] * ij)
+    A = np.empty((5, 5, n))
+    for i, (a, B) in enumerate(pairs):
+        for j in range(i, 4):
+            alpha, beta = pairs[j]
+            A[i, j] = Oy[i] * Dy[j] + Oz[i] * Dz[j] + rO12[i] * dBe12[j] - P[2 * a + beta] * Gi[2 * alpha + B]
+            if j > i:
+                A[j, i] = A[i, j]
+        A[i, 4] = A[4, i] = Oy[i] * Dy[4] + Oz[i] * Dz[4]
+    A[4, 4] = Oz[4] * Dz[4] - P[4] / f
+    return P, A

@@ -1,15 +1,21 @@
-"""The isochoric part of a law in principal logarithmic strains: the principal Kirchhoff
-stresses t_i = dW_iso/de_i and K_ij = dt_i/de_j at e_i = ln(lambda_i) (3, n), what the local
-update of a viscous network (network.py) evaluates a few times per point.
+"""The isochoric part of a law on the deviatoric plane of the principal logarithmic strains:
+what the local update of a viscous network (network.py) evaluates a few times per point.
 
-With bbar_i = J^(-2/3) lambda_i^2 (dbbar_i/de_j = 2 bbar_i (delta_ij - 1/3)):
-- a law of the isochoric invariants (invariant.InvariantLaw, W_iso = Psi(I1bar, I2bar)):
-  t = Psi_1 d1 + Psi_2 d2 with d1_j = dI1bar/de_j = 2 bbar_j - 2/3 I1bar and d2_j = dI2bar/de_j
-  = I1bar d1_j - 2 bbar_j^2 + 2/3 sum bbar_i^2, K from Psi's second derivatives;
-- Ogden, W_iso = sum_p 2 mu_p / alpha_p^2 (sum_i lbar_i^alpha_p - 3): t_j = sum_p 2 mu_p /
-  alpha_p (lbar_j^alpha_p - 1/3 sum_i lbar_i^alpha_p);
-- any other law: its stress_rows at the diagonal F = diag(lambda) (5 x 5 work per point).
-All three give the same numbers (a test); the first two on (3, n) arrays only.
+An isochoric law depends on the principal log strains e (3) through their deviatoric part
+only, and its principal Kirchhoff stresses t (3) are deviatoric.  Both live in the plane
+sum(e) = 0, written in the orthonormal basis u_y = (1, -1, 0)/sqrt 2, u_z = (1, 1, -2)/sqrt 6:
+e' = y u_y + z u_z, t = t_y u_y + t_z u_z, and K = dt/de = U k U^T (U = [u_y u_z], k the
+symmetric 2 x 2 (k_yy, k_yz, k_zz)).  With a diagonal v (3) written D(v) = U^T diag(v) U
+= ((v1 + v2)/2, (v1 - v2)/(2 sqrt 3), (v1 + v2 + 4 v3)/6):
+- a law of the isochoric invariants (invariant.InvariantLaw, W_iso = Psi(I1bar, I2bar)), with
+  bbar_i = exp(2 e'_i): t = Psi_1 d1 + Psi_2 d2, d1 = U^T 2 bbar, d2 = I1bar d1 - U^T 2 bbar^2,
+  k = Psi_1 4 D(bbar) + Psi_2 (d1 d1^T + I1bar 4 D(bbar) - 8 D(bbar^2)) + Psi_11 d1 d1^T
+  + Psi_12 (d1 d2^T + d2 d1^T) + Psi_22 d2 d2^T (the terms along (1, 1, 1) drop out);
+- Ogden, W_iso = sum_p 2 mu_p / alpha_p^2 (sum_i lbar_i^alpha_p - 3), L_pi = exp(alpha_p e'_i):
+  t = sum_p 2 mu_p / alpha_p U^T L_p, k = sum_p 2 mu_p D(L_p);
+- any other law: its stress_rows at the diagonal F = diag(exp(e')) (5 x 5 work per point),
+  projected on the plane (generic_principal gives t (3) and K (3, 3)).
+All three give the same numbers (a test); the first two on (n) arrays only.
 """
 
 from __future__ import annotations
@@ -22,22 +28,43 @@ from .base import Hyperelastic
 from .invariant import InvariantLaw
 from .ogden import Ogden
 
-Rows = tuple[np.ndarray, np.ndarray]
+Plane = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 PRINCIPAL = (0, 3, 4)  # components of x holding the principal stretches of a diagonal F
-THIRD = 1.0 / 3.0
+SQRT2, SQRT3, SQRT6 = np.sqrt(2.0), np.sqrt(3.0), np.sqrt(6.0)
+BASIS = np.array([[1.0 / SQRT2, 1.0 / SQRT6], [-1.0 / SQRT2, 1.0 / SQRT6], [0.0, -2.0 / SQRT6]])  # U (3, 2)
 
 
-def principal_function(law: Hyperelastic, scale: float = 1.0) -> Callable[[np.ndarray], Rows]:
-    """e (3, n) -> (t (3, n), K (3, 3, n)) of `scale` times the law's isochoric part."""
+def plane_function(law: Hyperelastic, scale: float = 1.0) -> Callable[[np.ndarray, np.ndarray], Plane]:
+    """(y, z) (n each) -> (t_y, t_z, k_yy, k_yz, k_zz) (n each) of `scale` times the law's
+    isochoric part (module docstring)."""
     if isinstance(law, InvariantLaw):
-        return lambda e: invariant_principal(law, e, scale)
+        return lambda y, z: invariant_plane(law, y, z, scale)
     if isinstance(law, Ogden):
-        return lambda e: ogden_principal(law, e, scale)
-    return lambda e: generic_principal(law, e, scale)
+        return lambda y, z: ogden_plane(law, y, z, scale)
+    return lambda y, z: generic_plane(law, y, z, scale)
 
 
-def generic_principal(law: Hyperelastic, e: np.ndarray, scale: float) -> Rows:
-    """t_i = l_i P_i, K_ij = delta_ij t_i + l_i l_j A_ij from the law's P and A at diag(l)."""
+def plane_strains(y: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """The principal log strains e' = y u_y + z u_z (3, n) of the plane coordinates (n)."""
+    return BASIS[:, 0, None] * y + BASIS[:, 1, None] * z
+
+
+def exponentials(alpha: float, y: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """exp(alpha e'_i) (three arrays (n)) of e' = y u_y + z u_z, with two exponentials."""
+    zeta = np.exp((alpha / SQRT6) * z)
+    eps = np.exp((alpha / SQRT2) * y)
+    return zeta * eps, zeta / eps, 1.0 / (zeta * zeta)
+
+
+def diagonal(v1: np.ndarray, v2: np.ndarray, v3: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """D(v) = U^T diag(v) U as (yy, yz, zz) (n each)."""
+    s = v1 + v2
+    return 0.5 * s, (0.5 / SQRT3) * (v1 - v2), (s + 4.0 * v3) / 6.0
+
+
+def generic_principal(law: Hyperelastic, e: np.ndarray, scale: float) -> tuple[np.ndarray, np.ndarray]:
+    """t (3, n) and K (3, 3, n) of the law's isochoric part at principal log strains e (3, n):
+    t_i = l_i P_i, K_ij = delta_ij t_i + l_i l_j A_ij from the law's P and A at diag(l)."""
     lam = np.exp(e)
     xe = np.zeros((5, e.shape[1]))
     xe[0], xe[3], xe[4] = lam
@@ -50,51 +77,70 @@ def generic_principal(law: Hyperelastic, e: np.ndarray, scale: float) -> Rows:
     return t, K
 
 
-def invariant_principal(law: InvariantLaw, e: np.ndarray, scale: float) -> Rows:
-    """t and K of W_iso = Psi(I1bar, I2bar) (module docstring)."""
-    eb = e - e.mean(0)
-    b = np.exp(2.0 * eb)  # bbar_i
-    I1 = b.sum(0)
-    bb = b * b
-    S2 = bb.sum(0)
-    I2 = 0.5 * (I1 * I1 - S2) if law.uses_I2 else None
-    P1, P2, P11, P12, P22 = law.psi_derivatives(I1, I2, True)
-    d1 = 2.0 * b - 2.0 * THIRD * I1
-    t = P1 * d1
-    # dd1_j/de_k = 4 b_j (delta_jk - 1/3) - 2/3 d1_k
-    dd1 = -4.0 * THIRD * b[:, None] - 2.0 * THIRD * d1[None]
-    for j in range(3):
-        dd1[j, j] += 4.0 * b[j]
-    K = P1 * dd1
+def generic_plane(law: Hyperelastic, y: np.ndarray, z: np.ndarray, scale: float) -> Plane:
+    """t and k of any law: generic_principal projected on the plane (U^T t, U^T K U)."""
+    t, K = generic_principal(law, plane_strains(y, z), scale)
+    ty, tz = np.einsum("ia,in->an", BASIS, t)
+    k = np.einsum("ia,ijn,jb->abn", BASIS, K, BASIS)
+    return ty, tz, k[0, 0], 0.5 * (k[0, 1] + k[1, 0]), k[1, 1]
+
+
+def invariant_plane(law: InvariantLaw, y: np.ndarray, z: np.ndarray, scale: float) -> Plane:
+    """t and k of W_iso = Psi(I1bar, I2bar) (module docstring), with b1 b2 b3 = 1 written out:
+    d1 = (sqrt 2 (b1 - b2), 2/sqrt 6 (b1 + b2 - 2 b3)), d2 = (sqrt 2 (b1 - b2) b3,
+    2/sqrt 6 (2 b1 b2 - (b1 + b2) b3)), 4 D(bbar) = (2 s, 2/sqrt 3 d, 2/3 (s + 4 b3)) and
+    I1bar 4 D(bbar) + d1 d1^T - 8 D(bbar^2) = (2 s b3, -2/sqrt 3 d b3, 2/3 (4 b1 b2 + s b3))
+    (s = b1 + b2, d = b1 - b2)."""
+    zeta = np.exp((2.0 / SQRT6) * z)
+    eps = np.exp(SQRT2 * y)
+    b1, b2 = zeta * eps, zeta / eps
+    p12 = zeta * zeta  # b1 b2
+    b3 = 1.0 / p12
+    s, d = b1 + b2, b1 - b2
+    I2 = p12 + b3 * s if law.uses_I2 else None
+    P1, P2, P11, P12, P22 = law.psi_derivatives(s + b3, I2, True)
+    if scale != 1.0:
+        P1, P2, P11, P12, P22 = (None if v is None else scale * v for v in (P1, P2, P11, P12, P22))
+    sd = SQRT2 * d
+    s2 = s - 2.0 * b3
+    if P2 is None:
+        ty, tz = P1 * sd, (2.0 / SQRT6) * P1 * s2
+        kyy, kyz, kzz = (2.0 * P1) * s, (2.0 / SQRT3) * P1 * d, (2.0 / 3.0) * P1 * (s + 4.0 * b3)
+    else:  # Psi_1 d1 + Psi_2 d2 and its moduli, gathered
+        P2b3 = P2 * b3
+        up, down = P1 + P2b3, P1 - P2b3
+        sb = s * b3
+        c = 2.0 * p12
+        ty, kyy, kyz = up * sd, 2.0 * up * s, (2.0 / SQRT3) * down * d
+        tz = (2.0 / SQRT6) * (P1 * s2 + P2 * (c - sb))
+        kzz = (2.0 / 3.0) * (P1 * (s + 4.0 * b3) + P2 * (2.0 * c + sb))
+    if P11 is None and P12 is None and P22 is None:
+        return ty, tz, kyy, kyz, kzz
+    d1y, d1z = sd, (2.0 / SQRT6) * s2
+    d2y, d2z = sd * b3, (2.0 / SQRT6) * (2.0 * p12 - s * b3)
     if P11 is not None:
-        K += P11 * (d1[:, None] * d1[None])
-    if P2 is not None:
-        d2 = I1 * d1 - 2.0 * bb + 2.0 * THIRD * S2
-        t += P2 * d2
-        # dd2_j/de_k = d1_j d1_k + I1 dd1_jk - 8 b_j^2 (delta_jk - 1/3) + 8/3 b_k^2 - 8/9 sum b^2
-        dd2 = d1[:, None] * d1[None] + I1 * dd1 + 8.0 * THIRD * (bb[:, None] + bb[None]) - 8.0 / 9.0 * S2
-        for j in range(3):
-            dd2[j, j] -= 8.0 * bb[j]
-        K += P2 * dd2
-        if P12 is not None:
-            K += P12 * (d1[:, None] * d2[None] + d2[:, None] * d1[None])
-        if P22 is not None:
-            K += P22 * (d2[:, None] * d2[None])
-    return scale * t, scale * K
+        kyy, kyz, kzz = kyy + P11 * (d1y * d1y), kyz + P11 * (d1y * d1z), kzz + P11 * (d1z * d1z)
+    if P12 is not None:
+        kyy, kyz, kzz = (
+            kyy + P12 * (2.0 * d1y * d2y),
+            kyz + P12 * (d1y * d2z + d2y * d1z),
+            kzz + P12 * (2.0 * d1z * d2z),
+        )
+    if P22 is not None:
+        kyy, kyz, kzz = kyy + P22 * (d2y * d2y), kyz + P22 * (d2y * d2z), kzz + P22 * (d2z * d2z)
+    return ty, tz, kyy, kyz, kzz
 
 
-def ogden_principal(law: Ogden, e: np.ndarray, scale: float) -> Rows:
-    """t and K of Ogden's W_iso: t_j = sum_p 2 mu_p/alpha_p (L_pj - S_p/3), L_pj = lbar_j^alpha_p,
-    S_p = sum_j L_pj; K_jk = sum_p 2 mu_p (L_pj (delta_jk - 1/3) - L_pk/3 + S_p/9)."""
-    eb = e - e.mean(0)
-    t = np.zeros_like(e)
-    K = np.zeros((3, 3, e.shape[1]))
+def ogden_plane(law: Ogden, y: np.ndarray, z: np.ndarray, scale: float) -> Plane:
+    """t and k of Ogden's W_iso (module docstring)."""
+    ty = tz = kyy = kyz = kzz = np.zeros_like(y)
     for mu_p, alpha_p in zip(law.mu, law.alpha, strict=True):
-        L = np.exp(alpha_p * eb)
-        S = L.sum(0)
-        t += 2.0 * mu_p / alpha_p * (L - THIRD * S)
-        Kp = -THIRD * (L[:, None] + L[None]) + S / 9.0
-        for j in range(3):
-            Kp[j, j] += L[j]
-        K += 2.0 * mu_p * Kp
-    return scale * t, scale * K
+        L1, L2, L3 = exponentials(alpha_p, y, z)
+        s12, d12 = L1 + L2, L1 - L2
+        c = 2.0 * scale * mu_p / alpha_p
+        ty = ty + (c / SQRT2) * d12
+        tz = tz + (c / SQRT6) * (s12 - 2.0 * L3)
+        Dyy, Dyz, Dzz = diagonal(L1, L2, L3)
+        w = 2.0 * scale * mu_p
+        kyy, kyz, kzz = kyy + w * Dyy, kyz + w * Dyz, kzz + w * Dzz
+    return ty, tz, kyy, kyz, kzz

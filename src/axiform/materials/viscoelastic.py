@@ -1,178 +1,25 @@
-"""Quasi-linear finite-strain viscoelasticity: a Prony series on the isochoric stress of any
-law (Simo 1987; Abaqus' convention for g_i).
-
-With S_iso the isochoric second Piola-Kirchhoff stress of the law (the instantaneous
-response), S = S_vol + S_iso - sum_i h_i, dh_i/dt = (g_i S_iso - h_i) / tau_i, h_i(0) = 0: a
-step of strain gives the law's stress at once and relaxes as g(t) = 1 - sum g_i (1 -
-exp(-t / tau_i)); the long-term response is (1 - sum g_i) times the law's isochoric part.
-The volumetric part stays elastic.
-
-Over a step of length dt, with S_iso linear in time (exact then):
-    h_i' = e_i h_i + g_i (gamma_i - e_i) S_n + g_i (1 - gamma_i) S',
-    e_i = exp(-dt / tau_i), gamma_i = (1 - e_i) tau_i / dt,
-so that P = F S = P_law(F) - c P_iso(F) - F H0 with H0 = sum_i (e_i h_i + g_i (gamma_i - e_i)
-S_n) and c = sum_i g_i (1 - gamma_i), and the consistent tangent A = A_law - c A_iso - d(F H0)/dF.
-
-Components: F and P as everywhere, x = (F_rR, F_rZ, F_zR, F_zZ, F_tT); the symmetric S and
-h_i as (S_RR, S_RZ, S_ZZ, S_TT).  History per quadrature point: h (..., m, 4) for m terms and
-the committed S_iso (..., 4).
-"""
+"""A hyperelastic law with a Prony series on its isochoric part (prony.py): the law of
+networks in parallel (parallel.NetworkLaw) with the series and no network."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from .base import Hyperelastic
+from .parallel import NetworkLaw
+from .prony import Prony
+from .temperature import Shift, TemperatureDependent
 
-import numpy as np
-
-MAX_TERMS = 8
-
-
-@dataclass(frozen=True)
-class Prony:
-    """g_i (relative moduli, 0 < g_i, sum < 1) and tau_i (relaxation times > 0), m terms."""
-
-    g: tuple[float, ...]
-    tau: tuple[float, ...]
-
-    def __post_init__(self):
-        g, tau = np.asarray(self.g, float), np.asarray(self.tau, float)
-        if not 1 <= g.size <= MAX_TERMS or g.shape != tau.shape:
-            raise ValueError(f"give 1 to {MAX_TERMS} terms, as many g as tau")
-        if not ((g > 0).all() and g.sum() < 1):
-            raise ValueError("g: every g_i > 0 and their sum < 1")
-        if not (tau > 0).all():
-            raise ValueError("tau: every tau_i > 0")
-
-    def relaxation(self, t: np.ndarray) -> np.ndarray:
-        """g(t) = 1 - sum g_i (1 - exp(-t / tau_i)), the relaxation of a step of strain."""
-        t = np.asarray(t, float)[..., None]
-        return 1.0 - (np.asarray(self.g) * (1.0 - np.exp(-t / np.asarray(self.tau)))).sum(-1)
-
-    def factors(self, dxi: np.ndarray | float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Per term over a step of reduced time dxi >= 0 (a number, or one per point (...)):
-        e_i, a_i = g_i (gamma_i - e_i), b_i = g_i (1 - gamma_i), each (..., m)."""
-        g, tau = np.asarray(self.g, float), np.asarray(self.tau, float)
-        dxi = np.asarray(dxi, float)[..., None]
-        e = np.exp(-dxi / tau)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            gamma = np.where(dxi > 0, -np.expm1(-dxi / tau) * tau / np.where(dxi > 0, dxi, 1.0), 1.0)
-        return e, g * (gamma - e), g * (1.0 - gamma)
-
-    def initial(self, points: tuple[int, ...]) -> dict[str, np.ndarray]:
-        """The history before the first step at quadrature points of shape `points`: no h, no S."""
-        return {"h": np.zeros(points + (len(self.g), 4)), "S": np.zeros(points + (4,))}
+__all__ = ["Prony", "Viscoelastic"]
 
 
-def second_piola_rows(xt: np.ndarray, P: np.ndarray) -> np.ndarray:
-    """S = F^-1 P as rows (4, n) (S_RR, S_RZ, S_ZZ, S_TT) from the rows of F and P (5, n)."""
-    a, b, c, d, f = xt.reshape(5, -1)
-    P = P.reshape(5, -1)
-    det = a * d - b * c
-    # inverse of the meridian block [[a, b], [c, d]] (rows r, z; columns R, Z)
-    S = np.empty((4, a.size))
-    S[0] = (d * P[0] - b * P[2]) / det
-    S[1] = 0.5 * ((d * P[1] - b * P[3]) + (-c * P[0] + a * P[2])) / det
-    S[2] = (-c * P[1] + a * P[3]) / det
-    S[3] = P[4] / f
-    return S
+class Viscoelastic(NetworkLaw):
+    """`law` (materials.Hyperelastic, or one whose constants are tables of T) as the
+    instantaneous response, with the Prony series `prony` on its isochoric part; `shift` the
+    shift of its relaxation times (or None: the model's, System)."""
 
+    def __init__(self, law: Hyperelastic | TemperatureDependent, prony: Prony, shift: Shift | None = None):
+        super().__init__(law, prony=prony, shift=shift)
 
-def viscous_rows(
-    xt: np.ndarray,
-    P: np.ndarray,
-    A: np.ndarray | None,
-    h: np.ndarray,
-    S_n: np.ndarray,
-    factors: tuple[np.ndarray, np.ndarray, np.ndarray],
-) -> tuple[np.ndarray, np.ndarray]:
-    """Add the Prony series to the law's isochoric P rows (5, n) and A rows (5, 5, n), in
-    place, at F rows xt (5, n) over a step (`factors` e, a, b: (m, 1) for every point or
-    (m, n) one set per point) from the committed history h (m, 4, n) and S_n (4, n); return
-    the trial h' (m, 4, n) and S' (4, n) (second_piola_rows of the law's P, taken first).
-
-    P <- (1 - c) P - F H0, A <- (1 - c) A - d(F H0)/dF, H0 = sum_i e_i h_i + (sum_i a_i) S_n,
-    c = sum_i b_i (module docstring)."""
-    e, a, b = factors
-    S = second_piola_rows(xt, P)
-    H0 = (e[:, None] * h).sum(0) + a.sum(0) * S_n  # (4, n)
-    keep = 1.0 - b.sum(0)  # (n,) or (1,)
-    trial = e[:, None] * h + a[:, None] * S_n + b[:, None] * S
-    RR, RZ, ZZ, TT = H0
-    x0, x1, x2, x3, x4 = xt
-    P *= keep
-    P[0] -= x0 * RR + x1 * RZ
-    P[1] -= x0 * RZ + x1 * ZZ
-    P[2] -= x2 * RR + x3 * RZ
-    P[3] -= x2 * RZ + x3 * ZZ
-    P[4] -= x4 * TT
-    if A is not None:
-        A *= keep
-        for row, col in ((0, 0), (2, 2)):  # (F H)_iR = F_iR H_RR + F_iZ H_ZR
-            A[row, col] -= RR
-            A[row, col + 1] -= RZ
-        for row, col in ((1, 0), (3, 2)):  # (F H)_iZ = F_iR H_RZ + F_iZ H_ZZ
-            A[row, col] -= RZ
-            A[row, col + 1] -= ZZ
-        A[4, 4] -= TT
-    return trial, S
-
-
-class Viscoelastic:
-    """A law (materials.Hyperelastic) as the instantaneous response, with a Prony series on its
-    isochoric part (`prony`).  Everything else (energy, moduli, kappa) is the law's."""
-
-    def __init__(self, law, prony: Prony):
-        self.law = law
-        self.prony = prony
-
-    def at(self, T: np.ndarray) -> Viscoelastic:
-        """The same series on the law at the temperatures T of a batch of points (where its
-        constants are tables of T: materials.temperature.TemperatureDependent)."""
-        return Viscoelastic(self.law.at(T), self.prony) if hasattr(self.law, "at") else self
-
-    def __getattr__(self, name: str):
-        if name in ("law", "prony"):
-            raise AttributeError(name)
-        return getattr(self.law, name)
-
-
-class Memory:
-    """One evaluation's use of the history of a law with memory: the committed history
-    (arrays (e, q, ...): h (e, q, m, 4), S (e, q, 4)), the step's factors (Prony.factors: (m,)
-    for every point or (e, q, m) one set per point), and the trial history filled chunk by
-    chunk of elements (`add_rows`)."""
-
-    def __init__(self, committed: dict[str, np.ndarray], factors: tuple[np.ndarray, np.ndarray, np.ndarray]):
-        self.committed = committed
-        self.factors = factors
-        self.trial = {k: np.empty_like(v) for k, v in committed.items()}
-
-    def add_rows(self, sl: slice, xt: np.ndarray, P: np.ndarray, A: np.ndarray | None) -> None:
-        """Add the memory to the law's isochoric P rows (5, n) and A rows (5, 5, n) of the
-        points of the elements sl (n = their number times q, element by element), in place."""
-        h = self.committed["h"][sl]  # (mc, q, m, 4)
-        mc, q, m, _ = h.shape
-        n = mc * q
-        # contiguous (m, 4, n) and (4, n) copies: every operation then runs over n numbers (on a
-        # strided view the sums ran loops of length 4 and cost the law's own stress and tangent)
-        h_rows = np.ascontiguousarray(h.reshape(n, m, 4).transpose(1, 2, 0))
-        S_rows = np.ascontiguousarray(self.committed["S"][sl].reshape(n, 4).T)
-        if self.factors[0].ndim == 1:
-            e, a, b = (f[:, None] for f in self.factors)
-        else:
-            e, a, b = (f[sl].reshape(n, m).T for f in self.factors)
-        trial, S = viscous_rows(xt, P, A, h_rows, S_rows, (e, a, b))
-        self.trial["h"][sl] = trial.transpose(2, 0, 1).reshape(mc, q, m, 4)
-        self.trial["S"][sl] = S.T.reshape(mc, q, 4)
-
-
-def committed_memory(material, state: dict[str, np.ndarray]) -> Memory | None:
-    """The history of a law with memory as it stands at a committed state (None for a law
-    without): a step of no length (every e_i = 1, a_i = b_i = 0), through which the solid's own
-    update gives the stress of the step that committed it, P = P_law - F sum_i h_i, so that
-    the pictures and fields ask the law instead of computing the series again."""
-    prony = getattr(material, "prony", None)
-    history = {k: v for k, v in state.items() if k != "t"}
-    if prony is None or not history:
-        return None
-    return Memory(history, prony.factors(0.0))
+    @property
+    def law(self) -> Hyperelastic | TemperatureDependent:
+        """The instantaneous law."""
+        return self.equilibrium

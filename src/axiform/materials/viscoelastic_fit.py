@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares, nnls
 
-from .viscoelastic import MAX_TERMS
+from .prony import MAX_TERMS
 
 G_MIN = 1e-8  # a term carrying less than this fraction of E0 is no term
 

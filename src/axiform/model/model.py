@@ -61,6 +61,7 @@ class Model:
     temperature: np.ndarray | None = None
     shift: Any = None
     conduction: Any = None
+    change: Curve | None = None
 
     def __post_init__(self):
         if self.sfr_edges not in SFR_EDGE_RULES:
@@ -105,6 +106,14 @@ class Model:
         if shift is not None:
             shift.check(T)
         self.temperature, self.shift = T, shift
+
+    def program(self, change: Curve | None) -> None:
+        """A prescribed change of the temperature in time (needs a temperature, `heat`):
+        T(x, t) = T(x) + dT(t), dT the Curve `change` (None: none); a step runs at the
+        temperature of its end (System.temperature_at)."""
+        if change is not None and self.temperature is None:
+            raise ValueError("a change of temperature needs the material's initial temperature (heat)")
+        self.change = change
 
     def conduct(self, conduction) -> None:
         """Heat conduction in the body (fem.heat.Conduction; needs a temperature, `heat`):
@@ -163,15 +172,15 @@ class Model:
         dofmap = DofMap(self.n_full, fixed, ties)
         n = self.n_full
         if self.formulation == "mixed":
-            solid: SolidAssembly = MixedAssembly(self.mesh, self.material, str(self.pressure_space))
+            solid: SolidAssembly = MixedAssembly(self.mesh, self.material, str(self.pressure_space), self.shift)
         else:
-            solid = SolidAssembly(self.mesh, self.material)
+            solid = SolidAssembly(self.mesh, self.material, self.shift)
         if self.temperature is None and tabled(self.material):
             raise ValueError("the law's constants are tables of temperature: give the model a temperature (heat)")
         by_curve: dict[Curve, np.ndarray] = {}  # point loads grouped by curve
         for d, v, c in self.point_loads:
             by_curve.setdefault(c, np.zeros(n))[d] += v
-        solid_term = SolidTerm(solid, n, self.shift)
+        solid_term = SolidTerm(solid, n, self.shift, self.temperature)
         terms: list[Term] = [solid_term, *(PressureTerm(p, n) for p in self.pressures)]
         terms += [PointLoadTerm(by_curve, n)] if by_curve else []
         terms += self.added
@@ -218,6 +227,7 @@ class Model:
             unknown_offsets=tuple(int(o) for o in offsets[:-1]),
             noise_floor=float(floor),
             rigid_modes=rigid_translations(self.mesh, self.dpn, dofmap, dofmap.nf + int(offsets[-1])),
+            change=self.change,
         )
 
 

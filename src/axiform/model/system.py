@@ -45,7 +45,8 @@ class System:
     """A finalized model (Model.finalize): its inputs as it uses them (the mesh, the material,
     the supports `fixed` {full dof: value}, the pressures, the contact pairs with their
     stabilization decided, the cavities, the initial temperature (n_nodes,) or None, the
-    shift of the relaxation times, the heat conduction) and what it derived from them: the
+    shift of the relaxation times, the heat conduction, the prescribed temperature change
+    dT(t) added to the initial temperature everywhere, `change`, or None) and what it derived from them: the
     solid's assembly, the terms of the residual in their order (`terms`; the solid's is
     `solid_term`; `contact_slots`, `cavity_slots`: the places of the contact pairs' and the
     cavities' terms), the dof map, the sparse pattern and its bordered form, each term's
@@ -80,6 +81,7 @@ class System:
     unknown_offsets: tuple[int, ...]
     noise_floor: float
     rigid_modes: sp.csc_matrix
+    change: Curve | None = None
 
     def finalize(self) -> System:
         """The system itself (already final): `solve` and callers take a Model or a System."""
@@ -104,15 +106,17 @@ class System:
     def knots(self) -> np.ndarray:
         """Every time at which some curve of the system changes its slope (sorted)."""
         curves = [c for term in self.terms for c in term.curves()] + list(self.prescribed_curves)
+        curves += [self.change] if self.change is not None else []
         return np.unique(np.concatenate([np.empty(0)] + [c.knots() for c in curves]))
 
     def timed(self) -> bool:
         """Whether the load factor is the process time: load curves with knots, moving tools,
-        or a law with memory follow it."""
+        or a law with memory (materials.protocol: `timed`) follow it."""
         return (
             bool(self.knots().size)
-            or getattr(self.material, "prony", None) is not None
+            or self.solid.law.timed
             or self.conduction is not None
+            or self.change is not None
             or any(np.any(np.asarray(c.surface.motion, float) != 0) for c in self.contacts)
         )
 
@@ -132,11 +136,20 @@ class System:
         """The history before the first step (t = 0): every term's initial state (contact
         pairs untouched, cavities at their initial volume and no gauge pressure) and the
         initial temperature."""
-        return ModelState(
+        state = ModelState(
             0.0,
             tuple(term.initial_state() for term in self.terms),
             None if self.temperature is None else self.temperature.copy(),
         )
+        return replace(state, temperature=self.temperature_at(state, 0.0))
+
+    def temperature_at(self, state: ModelState, t: float) -> np.ndarray | None:
+        """The nodes' temperature (n_nodes,) a step from `state` to time t runs at: with a
+        prescribed change, the initial temperature + dT(t), known at the step's end; else the
+        committed state's (heat conduction: the temperature of the step's start)."""
+        if self.change is None or self.temperature is None:
+            return state.temperature
+        return self.temperature + self.change(t)
 
     def restore(self, saved: dict) -> ModelState:
         """The state saved by ModelState.to_dict (a checkpoint), checked against this system."""
@@ -177,12 +190,12 @@ class System:
         relaxes (its stress moves with t), which Evaluation.dr_dlam (the loads') leaves out;
         a forward difference over h.  Zeros for a law without memory."""
         out = np.zeros(self.n_free)
-        if getattr(self.material, "prony", None) is None or h <= 0:
+        if not self.solid.law.timed or h <= 0:
             return out
         u = self.expand(u_f, t)
         held = self.solid_state(state)
-        context = EvaluationContext(tangent=False, temperature=state.temperature)
-        r0 = self.solid_term.evaluate(u, t, held, context).r
+        r0 = self.solid_term.evaluate(u, t, held, EvaluationContext(False, False, self.temperature_at(state, t))).r
+        context = EvaluationContext(False, False, self.temperature_at(state, t + h))
         r1 = self.solid_term.evaluate(u, t + h, held, context).r
         assert r0 is not None and r1 is not None
         out[: self.dofmap.nf] = self.dofmap.gather((r1 - r0) / h)[: self.dofmap.nf]
@@ -191,11 +204,11 @@ class System:
     def strain_energy(self, u_full: np.ndarray, state: ModelState | None = None) -> float:
         """The strain energy stored in the body at the displacements u_full (n_full,) (at the
         temperatures of `state`, default the initial ones): the law's W at every quadrature
-        point, integrated over the revolved body."""
+        point (of its elastic part: materials.protocol `energy`), integrated over the revolved body."""
         x = self.solid.gradient(u_full)
         T = (state or self.initial_state()).temperature
-        law = self.solid.law(slice(None), None if T is None else self.solid.point_values(T))
-        W = law.energy(x.reshape(-1, 5)).reshape(x.shape[:-1])
+        W = self.solid.law.energy(x.reshape(-1, 5), None if T is None else self.solid.point_values(T))
+        W = W.reshape(x.shape[:-1])
         return float((W * self.solid.dV).sum())
 
     def external_load(self, u_full: np.ndarray, t: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
@@ -230,7 +243,8 @@ class System:
         nf = dm.nf
         presc, presc_rate = self.prescribed(t)
         u = dm.expand(u_f, presc)
-        base = EvaluationContext(tangent, predicting, state.temperature)
+        temperature = self.temperature_at(state, t)
+        base = EvaluationContext(tangent, predicting, temperature)
         r_full, dr_full, f_ext, magnitude = (np.zeros(self.n_full) for _ in range(4))
         data = None
         constraints: list[Constraint] = []
@@ -267,7 +281,7 @@ class System:
             r, dr_dt, K = self.bordered(r, dr_dt, K, constraints, presc_rate)
             constraint_error = float(np.max([abs(c.value) / c.scale for c in constraints]))
         scale = float(np.linalg.norm(magnitude) + np.linalg.norm(f_ext))
-        trial = ModelState(float(t), tuple(trials), state.temperature)
+        trial = ModelState(float(t), tuple(trials), temperature)
         u_norm = float(np.linalg.norm(u))
         return Evaluation(r, dr_dt, K, r_full, f_ext, scale, self.noise_floor, nf, constraint_error, u_norm, trial)
 

@@ -16,44 +16,54 @@ from ..contact.state import ContactState
 from ..fem.cavity import Cavity
 from ..fem.curves import PROPORTIONAL, Curve
 from ..fem.loads import FollowerPressure
-from ..materials.viscoelastic import Memory
 from .protocol import Constraint, Contribution, EvaluationContext, assemble, stateless
 from .state import CavityState
 
 
 class SolidTerm:
     """The body's internal forces f_int (eqs. 17-30) and material tangent, by the assembly
-    of its formulation (fem.assembly.SolidAssembly or fem.mixed.MixedAssembly).  Elastic
-    laws carry no history: its state is an empty dict (a law with memory keeps its arrays
-    per quadrature point there, (e, q, ...)).  The element arrays are written into scratch
-    buffers reused from call to call (work space, not state: nothing of one call is read by
-    the next).  With a temperature (the nodes' T of the committed state: a step's mechanics
-    at the temperatures of its start) the law's constants that are tables of T are taken at
-    the points' T, and with a shift of the relaxation times (materials.temperature) each
-    point's history advances by its reduced time dxi = dt / a_T(T)."""
+    of its formulation (fem.assembly.SolidAssembly or fem.mixed.MixedAssembly), whose law
+    (materials.protocol) carries its own state per quadrature point: the term's state is the
+    law's (arrays (e, q, ...); an empty dict for an elastic law) and, where the law has one,
+    the time t of the state, so that a step's length dt = t - state["t"] reaches the law.  The
+    element arrays are written into scratch buffers reused from call to call (work space, not
+    state: nothing of one call is read by the next).  With a temperature (the nodes' T of the
+    evaluation's context) the law is given each point's T; `shift` (materials.temperature WLF
+    or Arrhenius, or None) is checked on the points' temperatures before the law sees them (a
+    temperature beyond its domain names its element).  temperature: the nodes' initial T (n,)
+    or None, for the law's initial state."""
 
     border: tuple[tuple[np.ndarray, bool], ...] = ()
 
-    def __init__(self, assembly, n_full: int, shift=None):
+    def __init__(self, assembly, n_full: int, shift=None, temperature: np.ndarray | None = None):
         self.assembly = assembly
         self.n_full = n_full
-        self.shift = shift  # of the relaxation times (materials.temperature.WLF, Arrhenius) or None
+        self.shift = shift
+        self.temperature = temperature
         self.blocks = (assembly.dofs,)
         self._scratch: dict[bool, tuple] = {}
-        # memos of pure functions of the step's inputs (the same at every iteration of a step):
-        # the nodes' temperature -> the points' T (e, q) and dxi/dt = 1 / a_T; (dt, T) -> the
-        # Prony factors (an exp per point and term, a sixth of an elastic evaluation)
-        self._points: tuple = (None, None, None)
-        self._factors: tuple = (None, None)
+        # memo of a pure function of the step's inputs (the same at every iteration of a step):
+        # the nodes' temperature -> the points' T (e, q), checked against the shift's domain
+        self._points: tuple = (None, None)
+
+    def point_temperature(self, temperature: np.ndarray | None) -> np.ndarray | None:
+        """The points' T (e, q) of the nodes' T (n,) (None: None), checked against the shift."""
+        if temperature is None:
+            return None
+        key = temperature.tobytes()
+        if self._points[0] != key:
+            T = self.assembly.point_values(temperature)
+            if self.shift is not None:
+                self.shift.check(T)
+            self._points = (key, T)
+        return self._points[1]
 
     def initial_state(self) -> dict:
-        """The history per quadrature point before the first step: none for elastic laws; for
-        a law with a Prony series (materials.viscoelastic) its arrays (e, q, ...) and the
-        time t of the state."""
-        prony = getattr(self.assembly.material, "prony", None)
-        if prony is None:
-            return {}
-        return prony.initial(self.assembly.dV.shape) | {"t": np.zeros(())}
+        """The law's state before the first step at every quadrature point (arrays (e, q, ...)),
+        at the points' initial temperatures, and the time t = 0 of the state (none for a law
+        without state)."""
+        held = self.assembly.initial_state(self.point_temperature(self.temperature))
+        return held | {"t": np.zeros(())} if held else {}
 
     def restore(self, saved: Any) -> dict:
         """The history per point of a checkpoint, checked against this law's (the same arrays
@@ -68,41 +78,24 @@ class SolidTerm:
         return ()
 
     def evaluate(self, u: np.ndarray, t: float, state: dict | None, context: EvaluationContext) -> Contribution:
-        """state: the solid's history per point (empty or None for an elastic law); the
-        context's temperature: the nodes' T (n,) or None."""
-        tangent, temperature = context.tangent, context.temperature
+        """state: the solid's (empty or None for a law without state); the context's
+        temperature: the nodes' T (n,) or None."""
+        tangent = context.tangent
         if tangent not in self._scratch:
             self._scratch[tangent] = self.assembly.buffers(tangent)
-        key = None if temperature is None else temperature.tobytes()
-        if key is not None and self._points[0] != key:
-            T = self.assembly.point_values(temperature)
-            self._points = (key, T, None if self.shift is None else 1.0 / self.shift.shift(T))
-        T = None if key is None else self._points[1]
-        memory = None
-        if state:  # a law with memory: the step from the committed state's time to t
-            history = {k: v for k, v in state.items() if k != "t"}
-            memory = Memory(history, self.step_factors(float(t) - float(state["t"]), key))
-        fe, Ke = self.assembly.evaluate(u, tangent, self._scratch[tangent], memory, T)
+        T = self.point_temperature(context.temperature)
+        held, dt = None, 0.0
+        if state:  # a law with state: the step from the committed state's time to t
+            held = {k: v for k, v in state.items() if k != "t"}
+            dt = float(t) - float(state["t"])
+        fe, Ke, trial = self.assembly.update(u, tangent, self._scratch[tangent], held, dt, T)
         dofs = self.assembly.dofs
-        trial = {} if memory is None else memory.trial | {"t": np.asarray(float(t))}
         return Contribution(
             assemble(dofs, fe, self.n_full),
             K=(Ke,) if tangent else (),
             magnitude=assemble(dofs, np.abs(fe), self.n_full),
-            trial=trial,
+            trial=trial | {"t": np.asarray(float(t))} if state else {},
         )
-
-    def step_factors(self, dt: float, temperature_key: bytes | None) -> Any:
-        """The Prony factors of a step dt (each point's reduced time dt / a_T under a shift, at
-        the temperature field of `temperature_key`, the memo's): computed once per step, then
-        reused by the step's iterations."""
-        dt = max(dt, 0.0)
-        if self.shift is None or temperature_key is None:
-            return self.assembly.material.prony.factors(dt)
-        key = (dt, temperature_key)
-        if self._factors[0] != key:
-            self._factors = (key, self.assembly.material.prony.factors(dt * self._points[2]))
-        return self._factors[1]
 
 
 class PressureTerm:

@@ -332,17 +332,18 @@ def _draw_monitors(ax, case, built) -> None:
             continue
         monitor = next(x for x in built.monitors if x.name == m.name)
         if monitor.quantity == "temperature":  # a node's temperature: the node, no dof
-            nodes, what, dof = np.array([monitor.index]), "temperature monitor", "T"
+            nodes, what, dof, marker = np.array([monitor.index]), "temperature monitor", "T", "D"
         else:
             nodes, dof = np.unique(monitor.dofs // model.dpn), m.dof
             what = "monitor" if m.at is not None else "reaction monitor"
-        marker = "*" if m.at is not None else "x"
+            marker = "*" if m.at is not None else "x"
         ax.plot(
             X[nodes, 0],
             X[nodes, 1],
             marker,
             ls="none",
-            ms=10 if marker == "*" else 6,
+            ms={"*": 10, "D": 7}.get(marker, 6),
+            mfc="none" if marker == "D" else None,
             color=COLOURS["monitor"],
             label=f"{what} {m.name} ({dof})",
         )

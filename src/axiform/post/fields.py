@@ -15,7 +15,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..materials import cauchy_stress
-from ..materials.viscoelastic import committed_memory
 from .thickness import contact_times, nodal_thickness, pieces, thickness_table
 
 
@@ -33,9 +32,10 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
     solid = model.solid
     x = solid.gradient(u_full)
     T = (state or model.initial_state()).temperature  # the nodes' (n,) or None
-    # mixed: with the element pressure; a law with memory: its stress at the committed history
-    memory = committed_memory(solid.material, model.solid_state(state) if state is not None else {})
-    P = solid.stress(x, temperature=None if T is None else solid.point_values(T), memory=memory)
+    # mixed: with the element pressure; a law with state: its stress at the committed state
+    held = model.solid_state(state) if state is not None else {}
+    held = {k: v for k, v in held.items() if k != "t"} or None
+    P = solid.stress(x, temperature=None if T is None else solid.point_values(T), state=held)
     J = x[..., 4] * (x[..., 0] * x[..., 3] - x[..., 1] * x[..., 2])
     sig = cauchy_stress(x, P)  # (e, q, 4): rr, zz, tt, rz
     s_rr, s_zz, s_tt, s_rz = (sig[..., i] for i in range(4))

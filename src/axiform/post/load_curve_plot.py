@@ -26,6 +26,7 @@ import numpy as np
 
 from .figures import new_figure, save, title
 from .labels import load_values, with_unit
+from .margins import grid_margins
 from .results_folder import FolderInfo, read_history
 
 _STARTS_AT_ZERO = ("displacement", "rotation", "force", "area")
@@ -171,7 +172,7 @@ def load_curve_figure(history: Path, info: FolderInfo):
     n = len(panels)
     ncols = 1 if n == 1 else 2 if n in (2, 4) else 3
     nrows = -(-n // ncols)
-    fig = new_figure((4.6 * ncols, 3.6 * nrows + 0.5 + 0.3 * bool(dropped)))
+    fig = new_figure((4.6 * ncols, 3.6 * nrows + 0.5 + 0.3 * bool(dropped)), layout=None)
     axes = fig.subplots(nrows, ncols, squeeze=False, sharex=timed)
     for ax, p in zip(axes.flat, panels, strict=False):
         ax.plot(p.x, p.y, "o-", ms=2.5, lw=1.2, color=p.colour)
@@ -195,6 +196,7 @@ def load_curve_figure(history: Path, info: FolderInfo):
         assert info.load is not None, "monitors are dropped against a loaded displacement (_stroke_panels)"
         text += f"\n({', '.join(dropped)} follows {info.load['name']}: not drawn)"
     title(fig, text)
+    grid_margins(fig, axes)
     return fig
 
 

@@ -5,8 +5,9 @@ sequence (forming.gif).  `axiform plot DIR` calls `plot_folder`; a run calls it 
 Everything is drawn from the folder alone: summary.json says the units, what the load factor
 lambda scales and what each monitor measures (axiform.post.labels), so that every axis and colour
 bar names its quantity and unit.  The pictures are drawn by load_curve_plot, thickness_plot and
-section_plot on matplotlib Figures (axiform.post.figures); this module is the folder's driver
-and keeps their names importable from one place.
+section_plot on matplotlib Figures (axiform.post.figures), laid out by fixed margins
+(axiform.post.margins); this module is the folder's driver and keeps their names importable
+from one place.
 """
 
 from __future__ import annotations

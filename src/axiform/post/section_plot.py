@@ -9,6 +9,7 @@ import numpy as np
 
 from .figures import colormap, new_figure, save, title, wrapped
 from .labels import with_unit
+from .margins import EDGE, room, title_room
 from .results_folder import FieldError, FolderInfo, read_history, surfaces_of, written_steps
 
 FIELD_NAMES = {
@@ -163,19 +164,62 @@ def finish_axes(ax, lo, hi, units) -> None:
     ax.set_ylabel(with_unit("z", "length", units))
 
 
-def _colourbar(fig, ax, norm, cmap, label, beside):
+def _colourbar(fig, ax, norm, cmap, label, beside, cax=None):
+    """The colour bar of the drawing: in cax where given (placed by _place), else taken from
+    the room of ax."""
     from matplotlib.cm import ScalarMappable
 
     bar = fig.colorbar(
         ScalarMappable(norm=norm, cmap=cmap),
-        ax=ax,
+        ax=None if cax is not None else ax,
+        cax=cax,
         label=label,
         orientation="vertical" if beside else "horizontal",
-        shrink=0.9 if beside else 0.7,
+        **({} if cax is not None else {"shrink": 0.9 if beside else 0.7}),
     )
     bar.formatter.set_useOffset(False)
     bar.update_ticks()
     return bar
+
+
+BAR_WIDTH, BAR_GAP = 0.22, 0.2  # inches: the colour bar of deformed.png and its gap to the drawing
+
+
+def _place(fig, ax, cax, beside: bool) -> None:
+    """Fixed margins (post.margins) for the drawing ax and its colour bar cax: the drawing takes
+    what its texts, the title and the bar (beside it, or under it) leave; the bar then runs
+    along the drawing's box (its aspect kept), over 90 % of its height or 70 % of its width."""
+    width, height = fig.get_size_inches()
+    need, bar = room(ax), room(cax)
+    top = title_room(fig) + need["top"]
+    if beside:
+        right = BAR_GAP + BAR_WIDTH + bar["left"]
+        ax.set_position(
+            (
+                need["left"] / width,
+                need["bottom"] / height,
+                1 - (need["left"] + right) / width,
+                1 - (need["bottom"] + top) / height,
+            )
+        )
+    else:
+        under = BAR_GAP - EDGE + BAR_WIDTH + bar["bottom"]  # the x label's edge is the bar's gap
+        low = need["bottom"] + under
+        ax.set_position(
+            (
+                need["left"] / width,
+                low / height,
+                1 - (need["left"] + need["right"] + EDGE) / width,
+                1 - (low + top) / height,
+            )
+        )
+    ax.apply_aspect()
+    box = ax.get_position()
+    if beside:
+        cax.set_position((box.x1 + BAR_GAP / width, box.y0 + 0.05 * box.height, BAR_WIDTH / width, 0.9 * box.height))
+    else:
+        y = box.y0 - (need["bottom"] - EDGE + BAR_GAP + BAR_WIDTH) / height
+        cax.set_position((box.x0 + 0.15 * box.width, y, 0.7 * box.width, BAR_WIDTH / height))
 
 
 def deformed_figure(
@@ -193,19 +237,20 @@ def deformed_figure(
     lo, hi = _frame([X, x], moulds)
     size, beside = _figure_size(lo, hi)
     thin = _is_thin(x, cells, (hi - lo).max())
-    fig = new_figure(size)
+    fig = new_figure(size, layout=None)
     ax = fig.add_subplot()
     cmap = colormap("viridis")
     norm = _norm(values)
     _draw(ax, X, x, outline, values[cells].mean(axis=1), norm, cmap, moulds, thin)
     finish_axes(ax, lo, hi, info.units)
-    _colourbar(fig, ax, norm, cmap, label, beside)
+    bar = _colourbar(fig, ax, norm, cmap, label, beside, cax=fig.add_axes((0.0, 0.0, 1.0, 1.0)))
     step = int(Path(vtu).stem.split("_")[-1])
     note = "grey: initial" + (", red: moulds" if moulds else "") + (", wall drawn wider than it is" if thin else "")
     state = info.state(step, history or {})
     # a line holds about 11 characters per inch at 11 pt: a tall part's narrow figure takes the note below
     gap = "  " if len(state) + len(note) + 4 < 11 * size[0] else "\n"
     title(fig, (info.title + "\n" if info.title else "") + f"{state}{gap}({note})", fontsize=11)
+    _place(fig, ax, bar.ax, beside)
     return fig
 
 

@@ -12,6 +12,7 @@ import numpy as np
 
 from .figures import colormap, new_figure, save, title
 from .labels import short, with_unit
+from .margins import grid_margins
 from .results_folder import FolderInfo
 
 
@@ -78,7 +79,7 @@ def thickness_figure(thickness: Path, info: FolderInfo, history: dict[str, np.nd
     heat = "temperature" in t and np.ptp(t["temperature"]) > 0
     panels = 3 + contact + heat
     rows, cols = (1, 3) if panels == 3 else (2, 2) if panels == 4 else (2, 3)
-    fig = new_figure((13, 4) if rows == 1 else (10, 7.2) if cols == 2 else (14, 7.2))
+    fig = new_figure((13, 4) if rows == 1 else (10, 7.2) if cols == 2 else (14, 7.2), layout=None)
     axes = fig.subplots(rows, cols, squeeze=False)
     for extra in axes.flat[panels:]:
         extra.remove()
@@ -129,6 +130,7 @@ def thickness_figure(thickness: Path, info: FolderInfo, history: dict[str, np.nd
         a_T.grid(True, alpha=0.3)
     state = info.state(step, history) if history else f"step {step}"
     title(fig, (info.title + "\n" if info.title else "") + f"wall thickness, {state}")
+    grid_margins(fig, axes)
     return fig
 
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..materials import InvertedElementError
+from ..materials import InvertedElementError, LocalUpdateError
 from ..materials.temperature import TemperatureDomainError
 from ..model.evaluation import Evaluation
 from ..model.guards import evaluation_fault
@@ -57,7 +57,7 @@ def evaluate_checked(model: System, history: ModelState, u_f, lam, predicting: b
     temperature left the domain of the shift of the relaxation times."""
     try:
         ev = model.evaluate(u_f, lam, history, predicting=predicting)
-    except InvertedElementError as exc:
+    except (InvertedElementError, LocalUpdateError) as exc:
         raise StepFailed(str(exc)) from exc
     except TemperatureDomainError as exc:  # a temperature beyond the shift's pole: no step size helps
         raise PathEnded(f"the material left the domain of its shift: {exc}") from exc
