@@ -53,7 +53,7 @@ def test_steps_hold_results_not_the_tangent():
     assert result.n_steps == len(result.steps) == 4
     held = {f.name for f in Step.__dataclass_fields__.values()}
     # state: the committed history (per slave node and cavity), not the tangent
-    assert held == {"number", "lam", "iterations", "residuals", "u_f", "u", "r_full", "checkpoint", "state"}
+    assert held == {"number", "lam", "iterations", "residuals", "u_f", "u", "r_full", "checkpoint", "state", "fraction"}
 
     def arrays(value):  # the checkpoint (restart state) holds vectors and scalars, no matrix
         if isinstance(value, dict):

@@ -335,7 +335,10 @@ def test_three_mould_pieces_with_their_own_motions_compress_a_cylinder_homogeneo
     closed-form Cauchy stress
     of the neo-Hookean law at the computed stretches (sigma = 2 C1 J^(-5/3) (b - I1/3 1) +
     kappa (J - 1) 1) equals the lower half's force and the sum of the plug's and the ring's,
-    and the lateral stress vanishes."""
+    and the lateral stress vanishes.  12 steps: the first, where the whole face touches at once,
+    leaves the top face uneven, which the augmented Lagrange update evens out step by step
+    (Q4: 1.3e-6 after 4 steps, 1.4e-11 after 8; Q8: 1.8e-8 after 8, 8e-11 after 12; the first
+    contact, wrongly taken for a divergence, used to be cut 6 times, which gave 4 steps 13)."""
     C1, kappa = 0.5, 5.0
     mesh = rectangle((0.0, 1.0), (0.0, 1.0), (4, 4), element)
     model = Model(mesh, NeoHooke(C1, kappa))
@@ -349,7 +352,7 @@ def test_three_mould_pieces_with_their_own_motions_compress_a_cylinder_homogeneo
     for pair in (lower, plug, ring):
         model.contact(pair)
     system = model.finalize()
-    res = solve(system, LoadControl(1.0, 4))
+    res = solve(system, LoadControl(1.0, 12))
     assert res.status == "finished"
     u = res.last.u.reshape(-1, 2)
     lam_z = 1.0 + u[top, 1].mean() - u[bottom, 1].mean()

@@ -78,7 +78,7 @@ def test_the_line_search_commits_the_state_of_the_u_it_accepts():
     assert res.status == "finished"
     touched = 0
     for step, before in zip(steps, committed, strict=False):
-        again = model.evaluate(step.u_f, step.lam, before).trial
+        again = model.evaluate(step.u_f, step.lam, model.begin_step(before, step.fraction)).trial
         for held, fresh in zip(model.contact_states(step.state), model.contact_states(again), strict=False):
             for name in ContactState.HISTORY:
                 assert np.array_equal(getattr(held, name), getattr(fresh, name), equal_nan=True), (step.number, name)

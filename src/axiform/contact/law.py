@@ -5,11 +5,12 @@ stabilization.  Arrays over the slave nodes (n,), vectorized; nothing kept betwe
 
 Augmented Lagrange: the normal law carries the normal traction of the last converged step
 (the multiplier of the history, ContactState.multiplier) and adds the penalty of the gap to
-it: fn = law(g - lambda / kn), ~ lambda - kn g.  At the end of every converged step the
-multiplier takes the step's traction (`updated_multipliers`, Uzawa's update), so that the
-penalty carries only the change of traction over one step: the penetration left is that
-change over kn, not the whole pressure over kn, and it shrinks again at the next step where
-the pressure holds.
+it: fn = law(g - lambda / kn), ~ lambda - kn g.  At the start of every step the multiplier
+moves towards the last converged traction (Uzawa's update; all the way for a nominal step,
+the step's fraction of the way for a cut one: ContactState.advanced), so that the penalty
+carries only the change of traction over one step: the penetration left is that change over
+kn, not the whole pressure over kn, and it shrinks again at the next step where the
+pressure holds.
 
 A sticky node's tie is a spring TIE times the normal penalty, anchored where it pulls as the
 normal law pushed when the node froze (the force does not jump there): a linear spring, whose
@@ -108,11 +109,13 @@ def traction(law: Law, x: np.ndarray, proj, state: ContactState, resting: bool) 
     return Traction(f, K, status, slip_state, fn)
 
 
-def updated_multipliers(state: ContactState, law: Traction, new: np.ndarray) -> np.ndarray:
-    """Uzawa's update at the end of a converged step: the normal multiplier (n,) takes the
-    step's normal traction fn (zero where a node left the surface, and for the nodes tied,
-    `state.stuck`, or tied at this step, `new`)."""
-    return np.where(state.stuck | new, 0.0, law.fn)
+def updated_multipliers(state: ContactState, law: Traction, new: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """At the end of a converged step: the multiplier it used and its normal traction fn, the
+    target of Uzawa's update at the next step (ContactState.advanced), each (n,) (zero where
+    a node left the surface, and for the nodes tied, `state.stuck`, or tied at this step,
+    `new`)."""
+    tied = state.stuck | new
+    return np.where(tied, 0.0, state.multiplier), np.where(tied, 0.0, law.fn)
 
 
 def _friction(law: Law, proj, state: ContactState, contact, fn, dfn, f, K, status) -> tuple:

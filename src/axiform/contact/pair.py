@@ -197,6 +197,7 @@ class ContactPair:
             np.zeros((n, 2)),
             np.full(n, np.nan),
             np.zeros(n),
+            np.zeros(n),
         )
 
     def dofs(self, dpn: int) -> np.ndarray:
@@ -287,6 +288,7 @@ class ContactPair:
             state.stuck,
             state.stuck_point,
             state.first_contact,
+            np.zeros(n),
             np.zeros(n),
             seen,
             state.damping_work,
@@ -382,8 +384,8 @@ class ContactPair:
             stuck_point[new] = x[new] + (law.fn[new] / (TIE * self.kn0[new]))[:, None] * proj.n[new]
             stuck = stuck | new
         first = np.where((status > 0) & np.isnan(state.first_contact), lam, state.first_contact)
-        multiplier = updated_multipliers(state, law, new)
-        return ContactState(self.nodes, x.copy(), s_stick, stuck, stuck_point, first, multiplier, seen, work)
+        multiplier, fn = updated_multipliers(state, law, new)
+        return ContactState(self.nodes, x.copy(), s_stick, stuck, stuck_point, first, multiplier, fn, seen, work)
 
     def report(self, state: ContactState) -> dict:
         """Per node of the committed `state`'s evaluation: current (r, z) in the global frame, gap, contact

@@ -32,8 +32,9 @@ class ContactState:
     """The history of a pair, per slave node (n,), as of one converged step: positions for
     the crossing test x_prev (n, 2) (surface frame), friction stick points s_stick (NaN:
     none), sticky nodes and their points, the time of first contact (NaN: never), the
-    augmented Lagrange multiplier (the normal traction `multiplier` (n,) of the last
-    converged step, per unit of the pair's weighted area, see contact.law); and what
+    augmented Lagrange multiplier in use (`multiplier` (n,)) and the normal traction of the
+    last converged step (`traction` (n,), where Uzawa's update takes the multiplier), both
+    per unit of the pair's weighted area (see contact.law); and what
     the step's evaluation found (`seen`, None before the first step and after a restart),
     and the energy the contact stabilization has dissipated.
     Immutable: an evaluation returns a new (trial) state, the solver keeps the committed one."""
@@ -45,11 +46,14 @@ class ContactState:
     stuck_point: np.ndarray
     first_contact: np.ndarray
     multiplier: np.ndarray
+    traction: np.ndarray
     seen: ContactSeen | None = None
     damping_work: float = 0.0  # the energy the contact stabilization dissipated so far
 
-    HISTORY = ("x_prev", "s_stick", "stuck", "stuck_point", "first_contact", "multiplier", "damping_work")
-    LATER = ("multiplier",)  # history a checkpoint may lack (written before they were kept): zero
+    HISTORY = ("x_prev", "s_stick", "stuck", "stuck_point", "first_contact", "multiplier", "traction", "damping_work")
+    # history a checkpoint may lack (written before it was kept): no multiplier is zero; no
+    # traction is the multiplier (which the update of those versions had set to the traction)
+    LATER = ("multiplier", "traction")
 
     def to_dict(self) -> dict[str, np.ndarray]:
         """The history arrays (a checkpoint)."""
@@ -60,6 +64,8 @@ class ContactState:
         values = {}
         for k in self.HISTORY:
             if k not in saved and k in self.LATER:
+                if k == "traction":
+                    values[k] = values.get("multiplier", self.multiplier).copy()
                 continue
             v = np.asarray(saved[k])
             ref = np.asarray(getattr(self, k))
@@ -67,6 +73,16 @@ class ContactState:
                 raise ValueError(f"contact state '{k}' has shape {v.shape}, not {ref.shape}")
             values[k] = v.astype(ref.dtype, copy=True) if ref.ndim else float(v)
         return replace(self, seen=None, **values)  # type: ignore[arg-type]
+
+    def advanced(self, fraction: float) -> ContactState:
+        """This committed state at the start of a step of `fraction` (0, 1] of the nominal one:
+        the multiplier moved that fraction of the way to the last converged traction (Uzawa's
+        update, relaxed; zero where a node is tied).  The update shifts the traction of every
+        touching node by its penetration times the penalty at the step's start, whatever the
+        step's size: taken whole, a step cut ever smaller kept that jump and Newton never
+        converged (an O-ring squeezed into a groove); a nominal step takes it whole."""
+        moved = self.multiplier + min(max(fraction, 0.0), 1.0) * (self.traction - self.multiplier)
+        return replace(self, multiplier=np.where(self.stuck, 0.0, moved))
 
 
 @dataclass(frozen=True)

@@ -163,9 +163,10 @@ def sensitivity(
     def differentiate(step: Step) -> None:
         nonlocal lag_state
         u_f, lam = step.u_f, step.lam
-        ev = model.evaluate(u_f, lam, lag_state)
+        ev = model.evaluate(u_f, lam, model.begin_step(lag_state, step.fraction))
         lag_state = step.state  # committed by the solver: h_n, the history of the next step's K
         dR = np.empty((model.n_free, m))
+        _begin_shadow_steps(shadows, shadow_states, step.fraction)
         for k, ((plus, minus), (s_plus, s_minus)) in enumerate(zip(shadows, shadow_states, strict=False)):
             dR[:, k] = (
                 plus.evaluate(u_f, lam, s_plus, tangent=False).r - minus.evaluate(u_f, lam, s_minus, tangent=False).r
@@ -194,6 +195,13 @@ def sensitivity(
         if out.thickness is not None:
             out.dthickness_ds = thickness_derivative(model, u2, out.dx_ds, out.du_final_ds())
     return out
+
+
+def _begin_shadow_steps(shadows: list, shadow_states: list, fraction: float) -> None:
+    """Each shadow's committed state as the step of `fraction` of the nominal one starts from
+    it (System.begin_step), in place: the shadows start their steps as the solver did."""
+    for pair, states in zip(shadows, shadow_states, strict=True):
+        states[:] = [shadow.begin_step(held, fraction) for shadow, held in zip(pair, states, strict=True)]
 
 
 def thickness_derivative(model: System, u: np.ndarray, dX: np.ndarray, du: np.ndarray) -> np.ndarray:

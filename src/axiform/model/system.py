@@ -173,6 +173,16 @@ class System:
         """The solid's history per quadrature point of a model state (empty for an elastic law)."""
         return state.terms[self.terms.index(self.solid_term)]
 
+    def begin_step(self, committed: ModelState, fraction: float) -> ModelState:
+        """The committed state as a step of `fraction` of the nominal one starts from it: the
+        contact pairs' multipliers advanced that fraction of the way (ContactState.advanced)."""
+        if not self.contact_slots:
+            return committed
+        terms = list(committed.terms)
+        for k in self.contact_slots:
+            terms[k] = terms[k].advanced(fraction)
+        return replace(committed, terms=tuple(terms))
+
     def settle(self, committed: ModelState, trial: ModelState, u_full: np.ndarray) -> ModelState:
         """The state to commit after a converged step: the trial state of its accepted
         evaluation, with the temperature advanced from the committed state's over the step

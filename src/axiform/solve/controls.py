@@ -103,6 +103,7 @@ class Step:
     r_full: np.ndarray  # the residual, reactions at the supports (full vector)
     checkpoint: dict | None = None  # the whole state after this step, to resume from (restart)
     state: ModelState | None = None  # the committed history after this step (contact, cavities)
+    fraction: float = 1.0  # the step's size over the nominal one: it started from System.begin_step(h, fraction)
 
 
 @dataclass

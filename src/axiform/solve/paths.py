@@ -59,6 +59,17 @@ class PathFollowing:
         if self.grid and self.goal is None:
             self.goal = self.aim
 
+    def hold(self, size: float) -> None:
+        """The next step is `size`: where it is shorter than the nominal one on a scheme with a
+        grid, the nominal interval ahead is sub-stepped (its end becomes the goal), so that
+        sizes carried from a cut interval never take the run off the nominal points."""
+        if self.grid and self.goal is None and abs(size) < abs(self.nominal) and not self.done():
+            self.goal = self._nominal_end()
+
+    def _nominal_end(self) -> float:
+        """Where a nominal step from the last converged state ends (grid schemes)."""
+        raise NotImplementedError
+
     def state(self) -> dict:
         """What the path needs to go on from its last converged step (restart)."""
         out = {}
@@ -178,6 +189,10 @@ class LoadPath(PathFollowing):
         ahead = (self.stops - self.lam) * np.sign(self.target) > 1e-12 * abs(self.target)
         return float(self.stops[np.argmax(ahead)]) if ahead.any() else self.target
 
+    def _nominal_end(self) -> float:
+        stop = self._next_stop()
+        return stop if abs(stop - self.lam) <= abs(self.nominal) * (1 + 1e-12) else self.lam + self.nominal
+
     def clip(self, size):
         remaining = self._next_stop() - self.lam
         return remaining if abs(size) > abs(remaining) else size
@@ -265,6 +280,10 @@ class DisplacementPath(PathFollowing):
     def _end(self) -> float:
         """The end of the interval being sub-stepped, or else the target."""
         return self.target if self.goal is None else self.goal
+
+    def _nominal_end(self) -> float:
+        end = self._end()
+        return end if abs(end - self.reached) <= abs(self.nominal) * (1 + 1e-12) else self.reached + self.nominal
 
     def clip(self, size):
         remaining = self._end() - self.reached

@@ -64,13 +64,18 @@ def solve(
         result.newton_iterations = int(resume["newton_iterations"])
     while not path.done():
         trial = path.clip(size)  # shortened to land on a knot or the end; size is kept
+        committed = path.history
+        fraction = abs(trial) / abs(path.nominal)
+        path.history = system.begin_step(committed, fraction)
         try:
             u_new, lam_new, its, res, ev = path.attempt(trial)
         except PathEnded as exc:
+            path.history = committed
             result.status = "stopped"
             result.message = _stop_message(first + result.n_steps, str(exc), path.diagnosis())
             break
         except StepFailed as exc:
+            path.history = committed
             path.cut()  # the rest of this step's nominal interval is sub-stepped
             size = trial / 2.0
             if abs(size) < opts.min_step * abs(path.nominal):
@@ -82,7 +87,6 @@ def solve(
                 )
                 break
             continue
-        substepping = path.goal is not None
         path.accept(u_new, lam_new, trial)
         u_full = system.expand(u_new, lam_new)
         path.history = system.settle(path.history, ev.trial, u_full)  # the trial of the accepted u only
@@ -90,12 +94,11 @@ def solve(
         if its <= opts.easy_iterations:
             size *= opts.growth
         size = min(size, path.nominal, key=abs)  # the nominal step may change (arc length)
-        if substepping and path.goal is None:  # the end of the cut interval reached: the nominal grid resumes
-            size = path.nominal
+        path.hold(size)  # a size below the nominal one sub-steps the nominal interval ahead
         result.n_steps += 1
         number = first + result.n_steps - 1
         checkpoint = _checkpoint(path, size, number, result.newton_iterations)
-        step = Step(number, lam_new, its, res, u_new, u_full, ev.r_full, checkpoint, path.history)
+        step = Step(number, lam_new, its, res, u_new, u_full, ev.r_full, checkpoint, path.history, fraction)
         del ev  # the tangent goes now, not at the next step
         result.steps.append(step)
         if keep is not None and len(result.steps) > keep:
