@@ -96,3 +96,20 @@ def test_states_are_values_the_evaluation_does_not_change():
     ev = model.evaluate(res.last.u_f * 1.5, res.last.lam + 0.05, start)
     assert ev.trial is not start and ev.trial.t == res.last.lam + 0.05
     assert same([held.to_dict() for held in model.contact_states(start)], copies)
+
+
+def test_a_cut_step_moves_the_multipliers_by_its_fraction_and_old_checkpoints_keep_theirs():
+    """ContactState.advanced: a step of a fraction f of the nominal size starts with each
+    multiplier moved f of the way to the last converged traction (a nominal step: all of it;
+    a tied node: zero).  A checkpoint written before the traction was kept restores it as the
+    multiplier, which the update of that version had set to the traction."""
+    built = die_drawing(steps=4, target=0.2)
+    res = solve(built.model, built.control, built.options)
+    held = [s for s in built.model.contact_states(res.last.state) if (s.traction > 0).any()][0]
+    lam, fn = held.multiplier, held.traction
+    assert not np.allclose(lam, fn)  # the last step's traction is not yet the multiplier
+    for f in (0.0, 0.25, 1.0):
+        assert np.allclose(held.advanced(f).multiplier, lam + f * (fn - lam), rtol=0, atol=1e-15)
+    old = {k: v for k, v in held.to_dict().items() if k != "traction"}
+    restored = held.from_dict(old)
+    assert np.array_equal(restored.traction, restored.multiplier)

@@ -5,6 +5,7 @@ Immutable values: the solver holds the committed state, an evaluation returns a 
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
@@ -61,7 +62,7 @@ class ContactState:
 
     def from_dict(self, saved: dict[str, np.ndarray]) -> ContactState:
         """This state with the history arrays of `saved` (ContactState.to_dict), checked."""
-        values = {}
+        values: dict[str, Any] = {}
         for k in self.HISTORY:
             if k not in saved and k in self.LATER:
                 if k == "traction":
@@ -72,7 +73,7 @@ class ContactState:
             if v.shape != ref.shape:
                 raise ValueError(f"contact state '{k}' has shape {v.shape}, not {ref.shape}")
             values[k] = v.astype(ref.dtype, copy=True) if ref.ndim else float(v)
-        return replace(self, seen=None, **values)  # type: ignore[arg-type]
+        return replace(self, seen=None, **values)
 
     def advanced(self, fraction: float) -> ContactState:
         """This committed state at the start of a step of `fraction` (0, 1] of the nominal one:

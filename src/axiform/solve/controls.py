@@ -74,10 +74,13 @@ class NewtonOptions:
     reference and its first residual), or an element inverts.  Under load and displacement
     control the rest of a cut step's nominal interval is then sub-stepped, the sub-steps
     growing by `growth` after a step converged in at most `easy_iterations`, the last one
-    landing on the interval's end, where the nominal steps resume (every run passes the same
-    nominal points, however it cut); under arc length the step grows back so, up to the
-    nominal arc.  The run stops when a step would be smaller than min_step times the nominal
-    step."""
+    landing on the interval's end.  There the nominal steps resume if that last sub-step was
+    easy; if not, its size is carried into the next interval, which is sub-stepped the same
+    way: no step crosses a nominal point, so every run passes the same nominal points however
+    it cut.  Under arc length the step grows back by `growth` up to the nominal arc.  A step
+    of a fraction f of the nominal size moves the contact multipliers f of the way
+    (ContactState.advanced).  The run stops when a step would be smaller than min_step times
+    the nominal step."""
 
     tolerance: float = 1e-8
     max_iterations: int = 20

@@ -31,10 +31,13 @@ class PathFollowing:
     A scheme with a nominal grid (`grid`: load and displacement control) sub-steps a failed
     step to the end of its own nominal interval: `cut()` keeps that end as `goal`, every
     step is clipped to it and the last one lands exactly on it; then the grid resumes
-    (`goal` None), so that runs which cut different steps still pass the same nominal points."""
+    (`goal` None), or, where the size carried on is below the nominal one, `hold` makes the
+    next nominal interval the goal, so that runs which cut different steps still pass the same
+    nominal points."""
 
     max_steps = 10**9
     grid = False
+    nominal: float  # the nominal step (lambda, the driven dof's value or the arc)
 
     def __init__(self, model: System, opts: NewtonOptions):
         self.model = model
@@ -68,6 +71,10 @@ class PathFollowing:
 
     def _nominal_end(self) -> float:
         """Where a nominal step from the last converged state ends (grid schemes)."""
+        raise NotImplementedError
+
+    def done(self) -> bool:
+        """Whether the path has reached its end (each scheme's own)."""
         raise NotImplementedError
 
     def state(self) -> dict:

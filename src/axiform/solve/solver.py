@@ -87,14 +87,12 @@ def solve(
                 )
                 break
             continue
+        substepping = path.goal is not None
         path.accept(u_new, lam_new, trial)
         u_full = system.expand(u_new, lam_new)
         path.history = system.settle(path.history, ev.trial, u_full)  # the trial of the accepted u only
         result.newton_iterations += its
-        if its <= opts.easy_iterations:
-            size *= opts.growth
-        size = min(size, path.nominal, key=abs)  # the nominal step may change (arc length)
-        path.hold(size)  # a size below the nominal one sub-steps the nominal interval ahead
+        size = _next_size(path, size, its <= opts.easy_iterations, substepping, opts.growth)
         result.n_steps += 1
         number = first + result.n_steps - 1
         checkpoint = _checkpoint(path, size, number, result.newton_iterations)
@@ -111,6 +109,20 @@ def solve(
             break
     result.wall_time_s = time.perf_counter() - t0
     return result
+
+
+def _next_size(path, size: float, easy: bool, substepping: bool, growth: float) -> float:
+    """The size of the next step after one of `size` converged (`easy`: in at most
+    easy_iterations): grown by `growth` after an easy step, at most the nominal one (which may
+    change: arc length); the nominal one where a cut interval ended with an easy sub-step; a
+    size below the nominal one sub-steps the nominal interval ahead (PathFollowing.hold)."""
+    if easy:
+        size *= growth
+    size = min(size, path.nominal, key=abs)
+    if substepping and path.goal is None and easy:
+        size = path.nominal
+    path.hold(size)
+    return size
 
 
 def _checkpoint(path, size: float, number: int, newton_iterations: int) -> dict:
