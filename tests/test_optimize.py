@@ -268,3 +268,26 @@ def test_bottle_whole_wall_within_5_percent_in_fewer_forward_solves_than_the_rul
         assert np.abs(wall / 1.1 - 1).max() == pytest.approx(result.best.deviation, rel=1e-12)
         assert result.best.deviation <= 0.05
     assert (grad.forward_solves, rule.forward_solves) == (3, 5)
+
+
+def test_every_design_and_the_final_run_take_the_first_designs_steps(tmp_path):
+    """A sticky tube whose steps are cut (at most 6 Newton iterations a step): with sticky or
+    frictional contact the wall depends on the steps as well as on the design, so every design
+    after the first lands on the first one's step ends, and optimized.toml carries them as
+    `solver.stops`: the final run takes the same path and its wall is the best design's."""
+    from test_sensitivity import tube
+
+    tree = tube("mixed", contact={"sticky": True})
+    tree["solver"].update(max_iterations=6)
+    case, target, out = tmp_path / "tube.toml", tmp_path / "target.csv", tmp_path / "out"
+    case.write_text(tomli_w.dumps(tree))
+    target.write_text("s,thickness\n0,0.6\n12,0.6\n")
+    main(["optimize", str(case), "--target", str(target), "--out", str(out), "-q", "--max-iter", "3"])
+    stops = tomllib.loads((out / "optimized.toml").read_text())["solver"]["stops"]
+    history = rows(out / "final" / "history.csv")
+    lams = [float(r["load_factor"]) for r in history[1:]]
+    assert len(stops) > tree["solver"]["steps"]  # the first design cut its steps
+    assert lams == pytest.approx(stops, abs=1e-12)  # the same path
+    summary = json.loads((out / "optimize.json").read_text())
+    final = np.genfromtxt(out / "final" / "thickness.csv", delimiter=",", names=True)
+    assert np.abs(final["thickness"] / 0.6 - 1).max() == pytest.approx(summary["max_rel_deviation"], rel=1e-9)

@@ -6,9 +6,11 @@ unloaded body is no divergence."""
 
 import copy
 import dataclasses
+import re
 
 import pytest
 
+from axiform.case.base import CaseError
 from axiform.case.schema import build, parse
 from axiform.solve.solver import solve
 
@@ -75,3 +77,26 @@ def test_a_hard_interval_carries_its_size_onto_the_grid():
     sizes = [b - a for a, b in zip([0.0, *lams], lams, strict=False)]
     assert {0.25, 0.5, 0.75, 1.0} <= set(lams)
     assert any(size < 0.25 for lam, size in zip(lams, sizes, strict=True) if lam > 0.25)  # carried on
+
+
+def test_solver_stops_are_step_ends():
+    """solver.stops: load factors every step lands on besides the curves' knots (what
+    `axiform optimize` writes into optimized.toml: the path its designs were measured on)."""
+    lams = [s.lam for s in run(stops=[0.1, 0.3, 0.35]).steps]
+    assert {0.1, 0.3, 0.35, 1.0} <= set(lams)
+    assert max(b - a for a, b in zip([0.0, *lams], lams, strict=False)) <= 0.25 + 1e-12
+
+
+@pytest.mark.parametrize(
+    ("solver", "message"),
+    [
+        ({"stops": [0.5, 1.5]}, "solver.stops: 1.5 lies beyond the target 1"),
+        ({"stops": [-0.5]}, "solver.stops[0]: Input should be greater than 0"),
+        ({"control": "arc-length", "stops": [0.5]}, "'stops' belongs to control = \"load\""),
+    ],
+)
+def test_bad_stops_are_refused_naming_the_key(solver, message):
+    case = copy.deepcopy(PUNCH)
+    case["solver"].update(solver)
+    with pytest.raises(CaseError, match=re.escape(message)):
+        build(parse(case))

@@ -53,7 +53,7 @@ class Progress:
         with self.stops.held():
             write_atomic(self.out / "optimize.csv", csv_text(self.rows))
             if better:
-                write_atomic(self.out / "optimized.toml", case_text(self.design, it.design))
+                write_atomic(self.out / "optimized.toml", case_text(self.design, it.design, it.stops))
         if not self.quiet:
             say(
                 f"iteration {row[0]}  objective {row[1]:.4g}  max deviation {100 * row[2]:.3g} %  "
@@ -124,7 +124,7 @@ def write_outputs(
     """optimized.toml (the best finished design), optimize.csv, optimize.json and optimize.png
     (where the initial design finished) in `out`."""
     if result.best.finished:
-        write_atomic(out / "optimized.toml", case_text(design, result.best.design))
+        write_atomic(out / "optimized.toml", case_text(design, result.best.design, result.best.stops))
     write_atomic(out / "optimize.csv", csv_text(result.rows))
     quantity = "temperature" if isinstance(design, TemperatureDesign) else "thickness"
     summary = {
@@ -177,7 +177,7 @@ def run_final(out_dir: Path, design: Design, result: OptimizeResult, quiet: bool
     if not result.best.finished:
         return None, 0
     case_out = out_dir / "optimized.toml"
-    write_atomic(case_out, case_text(design, result.best.design))
+    write_atomic(case_out, case_text(design, result.best.design, result.best.stops))
     final = out_dir / "final"
     with contextlib.redirect_stderr(io.StringIO()) if quiet else contextlib.nullcontext():
         code = run_case(str(case_out), str(final), quiet=True)

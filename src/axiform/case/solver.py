@@ -44,6 +44,8 @@ class SolverSpec(Strict):
     min_step: Annotated[float, Field(gt=0, le=1)] = 1e-4
     growth: Annotated[float, Field(ge=1)] = 1.5
     max_dt: PositiveFloat | None = None  # load control: no step longer than this (process time)
+    # load control: load factors every step lands on besides the curves' knots
+    stops: Annotated[list[PositiveFloat], Field(max_length=MAX_STEPS)] | None = None
 
     @model_validator(mode="after")
     def _control(self):
@@ -56,8 +58,9 @@ class SolverSpec(Strict):
             for key in ("arc_length", "stop"):
                 if getattr(self, key) is not None:
                     raise ValueError(f"'{key}' belongs to control = \"arc-length\"")
-        if self.max_dt is not None and self.control != "load":
-            raise ValueError("'max_dt' belongs to control = \"load\"")
+        for key in ("max_dt", "stops"):
+            if getattr(self, key) is not None and self.control != "load":
+                raise ValueError(f"'{key}' belongs to control = \"load\"")
         if self.target is not None and self.target == 0:
             raise ValueError("target must not be 0")
         return self
@@ -119,7 +122,11 @@ def build_control(model: Model, mesh: Mesh, spec: SolverSpec) -> LoadControl | D
             f"solver.max_dt: {spec.max_dt:g} makes at least {target / spec.max_dt:.3g} steps from 0 to the "
             f"target {target:g}, more than {MAX_STEPS:,}: give a longer max_dt (or a shorter target)"
         )
-    return LoadControl(target, spec.steps, spec.max_dt)
+    stops = tuple(spec.stops or ())
+    beyond = [t for t in stops if t > target]
+    if beyond:
+        raise CaseError(f"solver.stops: {beyond[0]:g} lies beyond the target {target:g}")
+    return LoadControl(target, spec.steps, spec.max_dt, stops)
 
 
 def check_resumed_target(spec: SolverSpec, reached: float) -> None:

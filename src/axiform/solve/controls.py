@@ -17,11 +17,14 @@ from ..model.state import ModelState
 @dataclass
 class LoadControl:
     """lambda from 0 to target in `steps` equal steps (cut back or grown as needed), none
-    longer than max_dt where given (lambda is then the process time t: a law with memory)."""
+    longer than max_dt where given (lambda is then the process time t: a law with memory);
+    `stops`: load factors every run lands on besides the curves' knots (the step ends of a
+    reference run: the designs of an optimization follow its first design's path)."""
 
     target: float = 1.0
     steps: int = 10
     max_dt: float | None = None
+    stops: tuple[float, ...] = ()
 
 
 @dataclass
@@ -112,7 +115,8 @@ class Step:
 @dataclass
 class SolveResult:
     """status "finished" | "stopped"; steps: the converged steps kept (all, or the latest
-    `keep` of them); n_steps: how many converged."""
+    `keep` of them); n_steps: how many converged; cuts: how many attempted steps failed and
+    were cut."""
 
     status: str
     steps: list[Step] = field(default_factory=list)
@@ -120,6 +124,7 @@ class SolveResult:
     message: str = ""
     wall_time_s: float = 0.0
     n_steps: int = 0
+    cuts: int = 0
 
     @property
     def last(self) -> Step | None:

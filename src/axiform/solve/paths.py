@@ -167,7 +167,8 @@ class PathFollowing:
 
 
 class LoadPath(PathFollowing):
-    """lambda = t from 0 to the target; every knot of every curve is a step's end."""
+    """lambda = t from 0 to the target; every knot of every curve, and every one of the
+    control's `stops`, is a step's end."""
 
     _state_keys = ("u_f", "lam", "rate", "previous", "goal")
     _optional = {"goal": None}
@@ -179,8 +180,10 @@ class LoadPath(PathFollowing):
         self.nominal = control.target / control.steps
         if control.max_dt is not None:  # the steps grow up to the nominal one: no longer than max_dt
             self.nominal = float(np.copysign(min(abs(self.nominal), control.max_dt), self.nominal))
-        k = model.knots()
         lo, hi = sorted((0.0, self.target))
+        k = model.knots()
+        self.knots = np.append(k[(k > lo) & (k < hi)], self.target)  # where the loads' rates jump
+        k = np.unique(np.concatenate([k, np.asarray(control.stops, float)]))
         self.stops = np.append(k[(k > lo) & (k < hi)][:: 1 if self.target > 0 else -1], self.target)
         self.rate = None  # du_f/dlambda at the last converged state (None: not yet computed)
         self.previous = None  # the last converged increment (du_f, dlambda), within the curves' pieces
@@ -247,7 +250,7 @@ class LoadPath(PathFollowing):
         # the last increment, none across a knot (the rate jumps there); the rate at the new state
         # from the tangent of the step's converged evaluation (whose history is that of the step's
         # start: a node that stuck in the step is not yet tied in it)
-        knot = np.abs(self.stops - lam).min() <= 1e-12 * abs(self.target)
+        knot = np.abs(self.knots - lam).min() <= 1e-12 * abs(self.target)
         self.previous = None if knot else (u_f - self.u_f, lam - self.lam)
         self.rate = self._tangent_rate(self.converged, u_f, lam)
         self.converged = None

@@ -76,6 +76,7 @@ def solve(
             break
         except StepFailed as exc:
             path.history = committed
+            result.cuts += 1
             path.cut()  # the rest of this step's nominal interval is sub-stepped
             size = trial / 2.0
             if abs(size) < opts.min_step * abs(path.nominal):
