@@ -1,6 +1,6 @@
 #!/usr/bin/env python
 """The paper's plate against FElupe at every size from 1e3 to 2e4 dofs, whole processes side
-by side (DESIGN § 17: axiform at most 0.15 x FElupe, its solve growing no faster than n^1.2).
+by side (the goal: axiform at most 0.15 x FElupe, its solve growing no faster than n^1.2).
 
     .venv/bin/python benchmarks/plate_scaling.py                       # 5 meshes, about 15 min
     .venv/bin/python benchmarks/plate_scaling.py --meshes 4x40 --repeat 1   # smoke run

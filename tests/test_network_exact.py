@@ -1,5 +1,5 @@
 """A law of one Bergström–Boyce network against exact homogeneous answers written from the
-flow rule (DESIGN § 14.2): uniaxial and equibiaxial stretch at two rates, each followed by a
+flow rule: uniaxial and equibiaxial stretch at two rates, each followed by a
 hold, at the reference temperature and 2 K above it (the WLF shift dividing the flow).
 
 For an incompressible neo-Hooke network the viscous stretch lam_v of a homogeneous test obeys
