@@ -1,6 +1,6 @@
 #!/usr/bin/env python
 """The frictionless die drawing against CalculiX CAX4 on the same mesh, whole processes side by
-side (DESIGN § 17: axiform at most 0.1 x CalculiX, the punch force within 2 %).
+side (the goal: axiform at most 0.1 x CalculiX, the punch force within 2 %).
 
     .venv/bin/python benchmarks/die_drawing_speed.py [--repeat 3] [--before OLD/src]
 

@@ -1,6 +1,7 @@
 #!/usr/bin/env python
 """The fixed cost of a run beside the import floor: the paper's plate (`make demo`) as a whole
-process, its solve, and its pictures, side by side in one run (DESIGN.md § 17).
+process, its solve, and its pictures, side by side in one run (the goals: the fixed cost at
+most 1.5x the floor, the pictures 1.5x more).
 
     python benchmarks/fixed_cost.py [--repeat 5] [--before OLD/src] [--case CASE.toml]
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env python
 """The paper's plate against FElupe at every size from 1e3 to 2e4 dofs, whole processes side
-by side (DESIGN § 17: axiform at most 0.15 x FElupe, its solve growing no faster than n^1.2).
+by side (the goal: axiform at most 0.15 x FElupe, its solve growing no faster than n^1.2).
 
     .venv/bin/python benchmarks/plate_scaling.py                       # 5 meshes, about 15 min
     .venv/bin/python benchmarks/plate_scaling.py --meshes 4x40 --repeat 1   # smoke run
@@ -41,11 +41,12 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
-from speed import env_for, machine, md_table, timed  # noqa: E402
+from speed import FELUPE_PLATE, env_for, machine, md_table, timed  # noqa: E402
 
 PLATE = ROOT / "examples" / "hughes_carnoy_plate.toml"
 
-FELUPE_SCRIPT = r"""
+FELUPE_SCRIPT = (
+    r"""
 import sys, time, warnings
 t_start = time.perf_counter()
 import numpy as np
@@ -54,21 +55,9 @@ warnings.filterwarnings("ignore")
 R, H = 7.5, 0.5
 nr, nz = int(sys.argv[1]), int(sys.argv[2])
 pressures = np.loadtxt(sys.argv[3], ndmin=1)
-import axiform as af  # the mesh only: the same points and cells as axiform's rectangle
-m = af.rectangle((0.0, R), (0.0, H), (nr, nz), "q8")
-mesh = fem.Mesh(m.points[:, ::-1].copy(), m.cells[:, [0, 3, 2, 1, 7, 6, 5, 4]].copy(), "quad8")
-x = mesh.points  # FElupe's x is the axis, y the radius
-field = fem.FieldContainer([fem.FieldAxisymmetric(fem.RegionQuadraticQuad(mesh), dim=2)])
-bounds = {"rim": fem.Boundary(field[0], mask=np.isclose(x[:, 1], R)),
-          "axis": fem.Boundary(field[0], mask=np.isclose(x[:, 1], 0.0), skip=(1, 0))}
-umat = fem.Hyperelastic(fem.mooney_rivlin, C10=80.0, C01=20.0) & fem.Volumetric(bulk=1.0e4)
-solid = fem.SolidBody(umat, field)
-face = fem.RegionQuadraticQuadBoundary(mesh, only_surface=True, mask=np.isclose(x[:, 0], 0.0), ensure_3d=True)
-pressure = fem.SolidBodyPressure(fem.FieldContainer([fem.FieldAxisymmetric(face, dim=2)]))
-centre = int(np.flatnonzero(np.isclose(x[:, 0], H) & np.isclose(x[:, 1], 0.0))[0])
-dof0, dof1 = fem.dof.partition(field, bounds)
-ext0 = fem.dof.apply(field, bounds, dof0)
-newton = getattr(fem, "newtonraphson", None) or fem.newtonrhapson
+"""
+    + FELUPE_PLATE
+    + r"""
 its, w = 0, []
 t_solve, c_solve = time.perf_counter(), time.process_time()
 for p in pressures:
@@ -82,6 +71,7 @@ import json
 print("FELUPE " + json.dumps({"dofs": int(len(dof1)), "iterations": its, "w": w, "solve_s": t_end - t_solve,
                               "solve_cpu": c_end - c_solve}))
 """
+)
 
 
 SOLVE_SCRIPT = r"""

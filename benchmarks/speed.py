@@ -45,16 +45,11 @@ PLATE = ROOT / "examples" / "hughes_carnoy_plate.toml"
 Q8_4X40 = ["--set", 'mesh.element="q8"', "--set", "mesh.divisions=[40,4]"]
 ONE_THREAD = {v: "1" for v in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")}
 
-FELUPE_SCRIPT = r"""
-import sys, time, warnings
-import numpy as np
-import felupe as fem
-warnings.filterwarnings("ignore")
-R, H = 7.5, 0.5
-nr, nz = 40, 4
-# the same Q8 mesh as axiform's rectangle, mirrored: FElupe's x is the axis, y the radius
-sys.path.insert(0, sys.argv[1])
-import axiform as af
+# the paper's plate in FElupe on the same Q8 mesh as axiform's rectangle, mirrored (FElupe's x
+# is the axis, y the radius): R, H, nr, nz and axiform importable come first; leaves field,
+# solid, pressure, the centre's node, the partition and FElupe's Newton
+FELUPE_PLATE = r"""
+import axiform as af  # the mesh only: the same points and cells as axiform's rectangle
 m = af.rectangle((0.0, R), (0.0, H), (nr, nz), "q8")
 mesh = fem.Mesh(m.points[:, ::-1].copy(), m.cells[:, [0, 3, 2, 1, 7, 6, 5, 4]].copy(), "quad8")
 x = mesh.points
@@ -69,6 +64,20 @@ centre = int(np.flatnonzero(np.isclose(x[:, 0], H) & np.isclose(x[:, 1], 0.0))[0
 dof0, dof1 = fem.dof.partition(field, bounds)
 ext0 = fem.dof.apply(field, bounds, dof0)
 newton = getattr(fem, "newtonraphson", None) or fem.newtonrhapson
+"""
+
+FELUPE_SCRIPT = (
+    r"""
+import sys, time, warnings
+import numpy as np
+import felupe as fem
+warnings.filterwarnings("ignore")
+R, H = 7.5, 0.5
+nr, nz = 40, 4
+sys.path.insert(0, sys.argv[1])
+"""
+    + FELUPE_PLATE
+    + r"""
 its = 0
 for p in np.loadtxt(sys.argv[2]):
     pressure.update(float(p))
@@ -77,6 +86,7 @@ for p in np.loadtxt(sys.argv[2]):
     its += int(res.iterations)
 print(f"FELUPE w {field[0].values[centre, 0]:.6f} iterations {its}")
 """
+)
 
 # the opening of the scripts run in a subprocess on a given source tree (argv[1]): the
 # imports (axiform sets no allocator option any more: solve/malloc.py is gone)

@@ -318,3 +318,47 @@ class PronySphere:
             atol=1e-14,
         )
         return np.array([self.bore(p, self._summed(h), bracket=bracket) for h in sol.y.T])
+
+
+def network_flow(mode: str, stretch, times, C1: float, C1n: float, flow, a_T: float = 1.0, kinks=()) -> np.ndarray:
+    """Nominal stress along the stretch (n,) at `times` (n,) of an incompressible homogeneous
+    test of a neo-Hooke equilibrium law (C1) and one neo-Hooke network (C1n) with Bergström and
+    Boyce's flow (flow.A, C, m, E; the rate divided by a_T), stretched as stretch(t) (a function,
+    stretch(0) = 1; `kinks`: the times where its rate jumps, integrated across apart).
+
+    The viscous stretch lam_v obeys one ordinary differential equation, integrated by scipy to
+    1e-10, no code of axiform used (l_e = lam / lam_v, the network's stress difference
+    s = 2 C1n f(l_e), q = |s|, eps_dot = A (lam_chain - 1 + E)^C q^m / a_T):
+    - uniaxial (lam along z): f(l) = l^2 - 1/l, d ln lam_v / dt = eps_dot sign(s),
+      lam_chain = sqrt((lam_v^2 + 2/lam_v) / 3);
+    - equibiaxial (lam along r and theta): f(l) = l^2 - l^-4, the flow direction (3/2) tau'/q
+      has the in-plane component 1/2: d ln lam_v / dt = eps_dot sign(s) / 2,
+      lam_chain = sqrt((2 lam_v^2 + lam_v^-4) / 3);
+    P = (2 C1 f(lam) + 2 C1n f(l_e)) / lam."""
+    from scipy.integrate import solve_ivp
+
+    uniaxial = mode == "uniaxial"
+    share = 1.0 if uniaxial else 0.5
+
+    def f(lam):
+        return lam * lam - (1.0 / lam if uniaxial else lam**-4)
+
+    def chain(lam_v):
+        return np.sqrt((lam_v**2 + 2.0 / lam_v) / 3.0 if uniaxial else (2.0 * lam_v**2 + lam_v**-4) / 3.0)
+
+    def rate(t, y):
+        lam_v = np.exp(y[0])
+        s = 2.0 * C1n * f(stretch(t) / lam_v)
+        eps = flow.A * (chain(lam_v) - 1.0 + flow.E) ** flow.C * abs(s) ** flow.m / a_T
+        return [share * eps * np.sign(s)]
+
+    times = np.asarray(times, float)
+    bounds = [0.0, *sorted(k for k in kinks if 0.0 < k < times[-1]), times[-1]]
+    y, start = np.zeros(times.shape), np.zeros(1)
+    for a, b in zip(bounds, bounds[1:], strict=False):
+        piece = solve_ivp(rate, (a, b), start, dense_output=True, method="LSODA", rtol=1e-10, atol=1e-12)
+        inside = (times >= a) & (times <= b)
+        y[inside] = piece.sol(times[inside])[0]
+        start = piece.y[:, -1]
+    lam = np.array([stretch(t) for t in times])
+    return (2.0 * C1 * f(lam) + 2.0 * C1n * f(lam / np.exp(y))) / lam

@@ -152,3 +152,15 @@ def test_the_checks_see_what_they_look_for(tmp_path):
     found = {m for m, _, _ in imports("axiform.io.results", PACKAGE / "io" / "results.py")}
     assert {"axiform.io.gid", "axiform.post.plots"} <= found
     assert layer("axiform.post.plots") < layer("axiform.io.results") < layer("axiform.app.run")
+
+
+def test_nothing_cites_a_document_outside_the_repository():
+    """The code, tests, scripts and documents speak of the repository alone: no design notes
+    or shared folders of the developers."""
+    root = Path(__file__).resolve().parents[1]
+    folders = ("src", "tests", "validation", "benchmarks", "docs", "examples")
+    files = [p for f in folders for p in (root / f).rglob("*") if p.suffix in {".py", ".md", ".toml"}]
+    files += [root / "README.md", root / "CHANGELOG.md"]
+    marks = ("DESIGN" + ".md", "DESIGN" + " §", "../" + "shared")
+    offenders = [str(p.relative_to(root)) for p in files if any(m in p.read_text(errors="ignore") for m in marks)]
+    assert not offenders, offenders

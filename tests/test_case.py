@@ -352,3 +352,58 @@ def test_invalid_contact_tables(tmp_path, capsys, name, old, new, message):
     assert old in text
     assert run(tmp_path, text.replace(old, new, 1)) == 2
     assert re.search(message, capsys.readouterr().err)
+
+
+LAMBDA = 1.2  # the stretch every node of the block below is moved to
+PRESCRIBED = f"""
+[mesh]
+kind = "rectangle"
+r = [0.0, 1.0]
+z = [0.0, 1.0]
+divisions = [1, 1]
+element = "q4"
+
+[material]
+model = "neo-hooke"
+C1 = 0.5
+kappa = 1.0e3
+
+[[fix]]
+at = {{ r = 0.0 }}
+dofs = ["ur"]
+
+[[fix]]
+at = {{ r = 1.0 }}
+dofs = ["ur"]
+value = {LAMBDA**-0.5 - 1.0}
+
+[[fix]]
+at = {{ z = 0.0 }}
+dofs = ["uz"]
+
+[[fix]]
+at = {{ z = 1.0 }}
+dofs = ["uz"]
+value = {LAMBDA - 1.0}
+
+[[monitor]]
+name = "force"
+reaction = {{ z = 1.0 }}
+dof = "uz"
+
+[solver]
+steps = 2
+"""
+
+
+def test_a_case_that_prescribes_every_dof_is_solved(tmp_path):
+    """Every dof of a block prescribed (an incompressible uniaxial stretch 1.2): nothing is left
+    to solve, the steps converge at once, and the end's reaction is the nominal stress of the
+    law times the reference area, (4 C1 / 3)(lam^2 - 1/lam)/lam pi (J = 1: no pressure)."""
+    case = tmp_path / "block.toml"
+    case.write_text(PRESCRIBED)
+    assert main(["run", str(case), "--out", str(tmp_path / "out"), "-q", "--set", "output.plots=false"]) == 0
+    with open(tmp_path / "out" / "history.csv", newline="") as f:
+        rows = [r for r in csv.DictReader(line for line in f if not line.startswith("#"))]
+    exact = 4.0 * 0.5 / 3.0 * (LAMBDA**2 - 1.0 / LAMBDA) / LAMBDA * np.pi
+    assert float(rows[-1]["force"]) == pytest.approx(exact, rel=1e-6)

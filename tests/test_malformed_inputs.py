@@ -195,9 +195,3 @@ def test_a_negative_load_target_is_refused(tmp_path):
     case = copy.deepcopy(BASE)
     case["solver"]["target"] = -1.0
     refused(["check", write_case(tmp_path, case)], "solver.target: -1 is before the start")
-
-
-def test_a_case_that_holds_every_dof_is_refused(tmp_path):
-    case = copy.deepcopy(BASE)
-    case["fix"] = [{"at": {"box": [[-1e3, -1e3], [1e3, 1e3]]}, "dofs": ["ur", "uz"]}]
-    refused(["check", write_case(tmp_path, case)], "fix: every dof of the mesh is held")

@@ -9,7 +9,7 @@ import re
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
+from oracles import network_flow
 from scipy.optimize import brentq
 
 from axiform import LoadControl, Model, NeoHooke, NewtonOptions, rectangle, select_nodes, solve
@@ -72,22 +72,9 @@ steps = 200
 
 
 def reference(times: np.ndarray) -> np.ndarray:
-    """Nominal stress (n) of the incompressible homogeneous bar stretched at RATE from t = 0, by
-    a fine integration of the viscous stretch lam_v of the network (the law's equations):
-    dln(lam_v)/dt = eps_dot sign(s), s = 2 C1N (l_e^2 - 1/l_e), l_e = lam / lam_v, q = |s|;
-    P = (2 C1 (lam^2 - 1/lam) + s) / lam."""
-
-    def flow_rate(t, y):
-        lam_v = np.exp(y[0])
-        le = (1.0 + RATE * t) / lam_v
-        s = 2.0 * C1N * (le * le - 1.0 / le)
-        chain = np.sqrt((lam_v**2 + 2.0 / lam_v) / 3.0)
-        return [FLOW.A * (chain - 1.0 + FLOW.E) ** FLOW.C * abs(s) ** FLOW.m * np.sign(s)]
-
-    sol = solve_ivp(flow_rate, (0.0, times[-1]), [0.0], t_eval=times, method="LSODA", rtol=1e-10, atol=1e-12)
-    lam = 1.0 + RATE * times
-    le = lam / np.exp(sol.y[0])
-    return (2.0 * C1 * (lam**2 - 1.0 / lam) + 2.0 * C1N * (le * le - 1.0 / le)) / lam
+    """Nominal stress (n) of the incompressible homogeneous bar stretched at RATE from t = 0
+    (oracles.network_flow: the flow of the network's viscous stretch integrated finely)."""
+    return network_flow("uniaxial", lambda t: 1.0 + RATE * t, times, C1, C1N, FLOW)
 
 
 def history(folder) -> dict[str, np.ndarray]:

@@ -6,7 +6,7 @@ objectivity in the meridian plane, parameter checks."""
 import network_reference as ref
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
+from oracles import network_flow
 
 from axiform import ArrudaBoyce, Gent, MooneyRivlin, NeoHooke, Ogden, Yeoh
 from axiform.materials.network import BergstromBoyce, Network, network_rows
@@ -150,21 +150,8 @@ def stretch_at_rate(law, rate, lam_end=2.5, steps=200):
 
 
 def reference(rate, stretches, C1=0.5, C1n=1.0, flow=FLOW):
-    """The same test, incompressible, by solve_ivp of the flow of the viscous stretch lam_v:
-    dln(lam_v)/dt = eps_dot sign(s), s = 2 C1n (l_e^2 - 1/l_e), l_e = lam / lam_v; nominal
-    stress (2 C1 (lam^2 - 1/lam) + s) / lam."""
-
-    def flow_rate(t, y):
-        lam_v = np.exp(y[0])
-        le = (1.0 + rate * t) / lam_v
-        s = 2.0 * C1n * (le * le - 1.0 / le)
-        chain = np.sqrt((lam_v**2 + 2.0 / lam_v) / 3.0)
-        return [flow.A * (chain - 1.0 + flow.E) ** flow.C * abs(s) ** flow.m * np.sign(s)]
-
-    t = (stretches - 1.0) / rate
-    sol = solve_ivp(flow_rate, (0.0, t[-1]), [0.0], t_eval=t, method="LSODA", rtol=1e-10, atol=1e-12)
-    le = stretches / np.exp(sol.y[0])
-    return (2.0 * C1 * (stretches**2 - 1.0 / stretches) + 2.0 * C1n * (le * le - 1.0 / le)) / stretches
+    """The same test, incompressible: oracles.network_flow at the stretches' times."""
+    return network_flow("uniaxial", lambda t: 1.0 + rate * t, (stretches - 1.0) / rate, C1, C1n, flow)
 
 
 def test_a_stretch_at_constant_rate_follows_the_flow_rule_and_stiffens_with_rate():

@@ -1,6 +1,6 @@
 #!/usr/bin/env python
 """The thermoformed cup on a cold mould, three ways of making the wall keep the shape it has
-when it touches (DESIGN § 14.3, § 14.6):
+when it touches:
 
 - sticky: `examples/cup_thermoforming.toml`, no heat, a node that touches the mould is tied;
 - table: `examples/cup_cold_mould.toml` without its frozen network, the plateau modulus a table

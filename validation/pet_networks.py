@@ -1,6 +1,6 @@
 #!/usr/bin/env python
-"""Stretch blow moulding of a PET preform with a Prony series and with networks in parallel
-(DESIGN § 14.2, § 14.6): `examples/stretch_blow_moulding.toml` (Mooney–Rivlin with a Prony
+"""Stretch blow moulding of a PET preform with a Prony series and with networks in parallel:
+`examples/stretch_blow_moulding.toml` (Mooney–Rivlin with a Prony
 series, linear viscoelastic) beside `examples/pet_stretch_blow.toml` (an Arruda–Boyce
 equilibrium network and a Bergström–Boyce viscous network: hardening whose onset moves with
 the rate), the same preform, rod, mould and air.

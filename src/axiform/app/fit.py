@@ -30,7 +30,7 @@ import csv
 import json
 import math
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -72,6 +72,31 @@ def read_text(path: Path) -> str:
         raise FitDataError(f"{path}: cannot read ({exc.strerror or exc})") from None
 
 
+def records(path: Path) -> Iterator[tuple[int, list[str], str]]:
+    """(line number, stripped cells, "PATH line N") of each row of a CSV data file that is
+    neither blank nor a comment (#); FitDataError where the file cannot be read."""
+    for number, row in enumerate(csv.reader(read_text(path).splitlines()), start=1):
+        cells = [c.strip() for c in row]
+        if any(cells) and not cells[0].startswith("#"):
+            yield number, cells, f"{path} line {number}"
+
+
+def data_number(cell: str, key: str, where: str) -> float:
+    """A finite number of axiform's magnitudes; FitDataError naming the line and column."""
+    try:
+        value = float(cell)
+    except ValueError:
+        raise FitDataError(f"{where}: {key} '{cell}' is not a number") from None
+    if not math.isfinite(value):
+        raise FitDataError(f"{where}: {key} must be finite, got {cell}")
+    if abs(value) > MAX_MAGNITUDE or 0 < abs(value) < MIN_MAGNITUDE:
+        raise FitDataError(
+            f"{where}: {key} {cell} is beyond the magnitude of a number of axiform "
+            f"(nonzero, {MIN_MAGNITUDE:g} to {MAX_MAGNITUDE:g})"
+        )
+    return value
+
+
 def read_data(paths: Sequence[str | Path]) -> Data:
     """Read CSV files with the header mode,stretch,stress; FitDataError names the line."""
     modes: list[int] = []
@@ -79,13 +104,8 @@ def read_data(paths: Sequence[str | Path]) -> Data:
     stresses: list[float] = []
     notes: list[str] = []
     for path in map(Path, paths):
-        text = read_text(path)
         header, rows = None, len(modes)
-        for number, row in enumerate(csv.reader(text.splitlines()), start=1):
-            cells = [c.strip() for c in row]
-            if not any(cells) or cells[0].startswith("#"):
-                continue
-            where = f"{path} line {number}"
+        for _, cells, where in records(path):
             if header is None:
                 if sorted(c.lower() for c in cells) != ["mode", "stress", "stretch"]:
                     raise FitDataError(f"{where}: the header must be mode,stretch,stress, got {','.join(cells)}")

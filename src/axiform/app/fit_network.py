@@ -19,7 +19,6 @@ curve in % of its peak stress) and DIR/fit_network_<mode>.png; exit 2 for bad da
 
 from __future__ import annotations
 
-import csv
 import json
 import math
 import sys
@@ -28,12 +27,11 @@ from pathlib import Path
 import numpy as np
 
 from ..case.material import MaterialSpec
-from ..case.schema import MAX_MAGNITUDE, MIN_MAGNITUDE
 from ..materials import LAWS
 from ..materials.network_fit import MODES, Curves, Layout, NetworkFit, fit_networks, model_stress, richardson
 from ..materials.network_fit import starts_and_bounds as initial
 from ..post.fit_network_plots import plot_mode
-from .fit import FitDataError, family, read_text
+from .fit import FitDataError, data_number, family, records
 from .run import prepare_folder
 
 COLUMNS = ("mode", "rate", "stretch", "stress")
@@ -43,36 +41,20 @@ STRETCH_LIMIT = 1e3  # beyond it the powers of the laws overflow
 GOOD_ENOUGH = 1e-3  # RMS error (of the peak) of every curve below which further starts are not tried
 
 
-def _number(cell: str, key: str, where: str) -> float:
-    """A finite number of axiform's magnitudes; FitDataError naming the line and column."""
-    try:
-        value = float(cell)
-    except ValueError:
-        raise FitDataError(f"{where}: {key} '{cell}' is not a number") from None
-    if not math.isfinite(value):
-        raise FitDataError(f"{where}: {key} must be finite, got {cell}")
-    if abs(value) > MAX_MAGNITUDE or 0 < abs(value) < MIN_MAGNITUDE:
-        raise FitDataError(
-            f"{where}: {key} {cell} is beyond the magnitude of a number of axiform "
-            f"(nonzero, {MIN_MAGNITUDE:g} to {MAX_MAGNITUDE:g})"
-        )
-    return value
-
-
 def _row(cells: list[str], header: list[str], where: str) -> tuple[int, float, float, float, float | None]:
     """(mode index, rate, stretch, stress, temperature or None) of one data row."""
     value = dict(zip(header, cells, strict=True))
     mode = value["mode"].lower()
     if mode not in MODES:
         raise FitDataError(f"{where}: mode '{value['mode']}' is not one of {', '.join(MODES)}")
-    rate, lam, stress = (_number(value[k], k, where) for k in ("rate", "stretch", "stress"))
+    rate, lam, stress = (data_number(value[k], k, where) for k in ("rate", "stretch", "stress"))
     if rate <= 0:
         raise FitDataError(f"{where}: rate must be > 0 (a stretch from 1 upward), got {value['rate']}")
     if not 1.0 <= lam <= STRETCH_LIMIT:
         raise FitDataError(
             f"{where}: stretch must lie in [1, {STRETCH_LIMIT:g}] (loading from 1), got {value['stretch']}"
         )
-    T = _number(value["temperature"], "temperature", where) if "temperature" in value else None
+    T = data_number(value["temperature"], "temperature", where) if "temperature" in value else None
     return MODES.index(mode), rate, lam, stress, T
 
 
@@ -83,11 +65,7 @@ def read_curves(path: str | Path) -> tuple[Curves, list[str]]:
     rows: list[tuple] = []
     lines: list[int] = []
     notes: list[str] = []
-    for number, row in enumerate(csv.reader(read_text(path).splitlines()), start=1):
-        cells = [c.strip() for c in row]
-        if not any(cells) or cells[0].startswith("#"):
-            continue
-        where = f"{path} line {number}"
+    for number, cells, where in records(path):
         if header is None:
             header = [c.lower() for c in cells]
             if sorted(header) not in (sorted(COLUMNS), sorted((*COLUMNS, "temperature"))):

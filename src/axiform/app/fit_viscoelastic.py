@@ -15,7 +15,6 @@ the data give no admissible constants, 0 otherwise.
 
 from __future__ import annotations
 
-import csv
 import json
 import math
 import sys
@@ -24,11 +23,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..case.schema import MAX_MAGNITUDE, MIN_MAGNITUDE
 from ..materials.prony import MAX_TERMS
 from ..materials.viscoelastic_fit import PronyFit, WLFFit, decades, fit_dynamic, fit_relaxation, fit_wlf, zero_crossing
 from ..post.fit_viscoelastic_plots import plot_dynamic, plot_relaxation, plot_wlf
-from .fit import FitDataError, read_text
+from .fit import FitDataError, data_number, records
 from .run import prepare_folder
 
 HEADERS = {
@@ -57,17 +55,12 @@ class Table:
 def read_table(path: str | Path, kinds: tuple[str, ...]) -> Table:
     """Read a CSV file whose header is one of HEADERS[kinds]; FitDataError names the line."""
     path = Path(path)
-    text = read_text(path)
     header: list[str] | None = None
     kind: str | None = None
     rows: list[list[float]] = []
     lines: list[int] = []
     wanted = " or ".join(",".join(HEADERS[k]) for k in kinds)
-    for number, row in enumerate(csv.reader(text.splitlines()), start=1):
-        cells = [c.strip() for c in row]
-        if not any(cells) or cells[0].startswith("#"):
-            continue
-        where = f"{path} line {number}"
+    for number, cells, where in records(path):
         if header is None:
             header = [c.lower() for c in cells]
             kind = next((k for k in kinds if sorted(header) == sorted(HEADERS[k])), None)
@@ -76,19 +69,7 @@ def read_table(path: str | Path, kinds: tuple[str, ...]) -> Table:
             continue
         if len(cells) != len(header):
             raise FitDataError(f"{where}: expected {len(header)} values ({','.join(header)}), got {len(cells)}")
-        values = []
-        for key, cell in zip(header, cells, strict=False):
-            try:
-                values.append(float(cell))
-            except ValueError:
-                raise FitDataError(f"{where}: {key} '{cell}' is not a number") from None
-            if not math.isfinite(values[-1]):
-                raise FitDataError(f"{where}: {key} must be finite, got {cell}")
-            if abs(values[-1]) > MAX_MAGNITUDE or 0 < abs(values[-1]) < MIN_MAGNITUDE:
-                raise FitDataError(
-                    f"{where}: {key} {cell} is beyond the magnitude of a number of axiform "
-                    f"(nonzero, {MIN_MAGNITUDE:g} to {MAX_MAGNITUDE:g})"
-                )
+        values = [data_number(cell, key, where) for key, cell in zip(header, cells, strict=False)]
         rows.append(values)
         lines.append(number)
     if header is None or kind is None:

@@ -398,8 +398,6 @@ def build(case: Case, base: str | Path = ".") -> Built:
         system = model.finalize()
     except ValueError as exc:  # a tied fibre rotation prescribed twice
         raise CaseError(f"fix: {exc}") from None
-    if system.n_free == 0:
-        raise CaseError("fix: every dof of the mesh is held: nothing is left to solve")
     try:
         monitors = build_monitors(system, mesh, case.monitor, cavities, case.mesh.element)
     except SelectorError as exc:

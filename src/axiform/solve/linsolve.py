@@ -140,8 +140,11 @@ class LinearSolver:
         self._superlu_pattern: tuple | None = None  # (indptr, indices, perm_c) of the last SuperLU ordering
 
     def factorize(self, K: sp.spmatrix) -> Factorization:
-        """K^-1 (dense LU up to DENSE_MAX unknowns, else PARDISO, else SuperLU)."""
+        """K^-1 (dense LU up to DENSE_MAX unknowns, else PARDISO, else SuperLU; nothing to
+        factorize where every dof is prescribed)."""
         n = K.shape[0]
+        if n == 0:
+            return Factorization(lambda b: np.zeros(np.shape(b)))
         if n <= DENSE_MAX:
             return Factorization(_factorize_dense(K))
         if K.format != "csr":
