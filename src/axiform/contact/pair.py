@@ -134,6 +134,7 @@ class ContactPair:
         local = np.full(mesh.n_nodes, -1)
         local[self.nodes] = np.arange(len(self.nodes))
         self.edges = local[edges]  # (m, k) edges in slave numbering
+        self.edge_ends = (self.edges[:, 0].copy(), self.edges[:, 1].copy())  # (m,) each: the corners of each edge
         n = len(self.nodes)
         self.area0 = np.bincount(self.edges.ravel(), parts.ravel(), n)
         # nodes on the axis have no ring area (the Q8 corner weight of an edge is 2 pi L r / 6)
@@ -148,6 +149,7 @@ class ContactPair:
         self.pole_corner = np.argmax(ends[self.pole_edge], axis=1)
         # a pole's force is its own (`_poles`): no thinning of its penalty by its area
         self.on_axis[self.edges[self.pole_edge, self.pole_corner]] = True
+        self.area0_safe = np.where(self.on_axis, 1.0, self.area0)  # the divisor of the thinning ratio
         self.mesh = mesh
         self.surface = surface
         self.X = mesh.points[self.nodes]
@@ -224,7 +226,7 @@ class ContactPair:
         the surface get the penalty in it, see the class).  guard_force: the mid-point guards'
         forces (m, 2) of the same state (`guard`), for the report; projection: the nodes'
         projection that `guard` found at the same u and state (None: projected here)."""
-        xa = self.X + u[self.nodes]
+        xa = self.X + u.take(self.nodes, axis=0)
         x = xa - self.surface.offset(lam)
         proj = projection if projection is not None else self.surface.local(x, state.x_prev, self.depth, self.search)
         if guard_force is None:
@@ -233,8 +235,11 @@ class ContactPair:
             return self._untouching(xa, x, proj, state, guard_force)
         parts, dparts = ring_areas(xa, self.edges, derivative=True)
         a = np.bincount(self.edges.ravel(), parts.ravel(), len(self.nodes))
-        # f = w(a) t: w = a (a / a0)^thinning, the area times the thinning of the penalty
-        ratio = np.where(self.on_axis, 1.0, a / np.where(self.on_axis, 1.0, self.area0)) ** self.thinning
+        # f = w(a) t: w = a (a / a0)^thinning, the area times the thinning of the penalty (x^0 = 1 for every x)
+        if self.thinning:
+            ratio = np.where(self.on_axis, 1.0, a / self.area0_safe) ** self.thinning
+        else:
+            ratio = np.ones(len(a))
         w, dw = a * ratio, np.where(self.on_axis, 1.0, (1.0 + self.thinning) * ratio)
         law = traction(self.law, x, proj, state, self._holds_resting(predicting))
         t, dt, status = law.t, law.dt, law.status
@@ -251,7 +256,7 @@ class ContactPair:
         e = self.edges
         m, k = e.shape
         # d f_i / d x_j through a_i: dw_i t_i (x) da_i/dx_j (m, k, 2, k, 2)
-        C = (dw[e][:, :, None] * t[e])[:, :, :, None, None] * dparts[:, :, None]
+        C = (dw.take(e)[:, :, None] * t.take(e, axis=0))[:, :, :, None, None] * dparts[:, :, None]
         pole_rate = self._poles(xa, t, dt, f, C) if self.pole_edge.size else None
         seen = ContactSeen(x, proj, f, status, a, ratio[:, None] * t, guard_force)
         return ContactTrial(f, K, C.reshape(m, 2 * k, 2 * k), pole_rate, self._next(state, seen, law, lam, work))
@@ -331,15 +336,15 @@ class ContactPair:
         with velocity (2,) (the force depends on x_m - offset(lam)), and the force on each
         mid-point (m, 2); F, K and the rate are None where no guard acts; and the slave
         nodes' projection, found in the same pass (for `evaluate` at the same u and state)."""
-        e = self.edges
+        e0, e1 = self.edge_ends
         dpn = u.shape[1]
-        un = u[self.nodes]
+        un = u.take(self.nodes, axis=0)
         xa = self.X + un[:, :2]
         offset = self.surface.offset(lam)
-        mid = 0.5 * (xa[e[:, 0]] + xa[e[:, 1]]) - offset
+        mid = 0.5 * (xa.take(e0, axis=0) + xa.take(e1, axis=0)) - offset
         if dpn == 3:
-            mid += (un[e[:, 0], 2] - un[e[:, 1], 2])[:, None] * self.guard_arm
-        mid_prev = 0.5 * (state.x_prev[e[:, 0]] + state.x_prev[e[:, 1]])
+            mid += (un[:, 2].take(e0) - un[:, 2].take(e1))[:, None] * self.guard_arm
+        mid_prev = 0.5 * (state.x_prev.take(e0, axis=0) + state.x_prev.take(e1, axis=0))
         x = xa - offset  # the nodes, projected in the same pass for `evaluate`
         nodes, proj = self.surface.local_sets(
             [(x, state.x_prev, self.depth), (mid, mid_prev, self.depth + self.guard_allowance.max())], self.search

@@ -36,6 +36,7 @@ class Pieces:
     _any_arc: bool
     _par: np.ndarray
     _cavity: np.ndarray
+    _any_cavity: bool
     _vertex_n: np.ndarray
 
     def _build_pieces(self, P: np.ndarray, centers: list, ccw: list) -> None:
@@ -98,6 +99,7 @@ class Pieces:
             nv = np.array([-t1[1], t1[0]]) + np.array([-t2[1], t2[0]])
             norm = np.linalg.norm(nv)
             self._vertex_n[j] = nv / norm if norm > 0 else nv
+        self._any_cavity = bool(self._cavity.any())
 
     def _arc_points(self, k: int, n: int) -> np.ndarray:
         phi = self.phi0[k] + self.dir[k] * np.linspace(0, self.sweep[k], n)
@@ -117,14 +119,14 @@ class Pieces:
         both the straight and the circular formula evaluated for every pair (the arc's only
         where a pair lies on an arc), the right one picked by np.where.  full=False: xi and g
         only (the last converged positions need no more)."""
-        P = self._par[k]  # (p, 13): one gather of every piece's constants
+        P = self._par.take(k, axis=0)  # (p, 13): one gather of every piece's constants (take: no fancy indexing)
         ar, az, tr, tz, L, cr, cz, R, phi0, sweep, sgn = P.T[:11]
         xr, xz = x[:, 0], x[:, 1]
         dx, dz = xr - ar, xz - az
         xi = (dx * tr + dz * tz) / L
         g = dx * -tz + dz * tr  # (x - a) . nor, nor = (-t_z, t_r)
-        arc = self.is_arc[k] if self._any_arc else NO_ARC
-        arcs = self._any_arc and bool(arc.any())  # the arc formulas only where a pair is on an arc
+        arc = self.is_arc.take(k) if self._any_arc else NO_ARC
+        arcs = self._any_arc and np.count_nonzero(arc) > 0  # the arc formulas only where a pair is on an arc
         if arcs:
             if subset and len(k) > ARC_SUBSET:
                 return self._project_subset(k, x, full, arc, xi, g, P)

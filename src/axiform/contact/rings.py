@@ -75,7 +75,7 @@ def _straight_ring_areas(x: np.ndarray, edges: np.ndarray, derivative: bool):
     """`ring_areas` of straight two-node edges in closed form (the rule is exact there):
     a_i = (pi / 3) l (2 r_i + r_j), d a_i / d x_j = (pi / 3) (1 + delta_ij) l e_r
     + (pi / 3) (2 r_i + r_j) dl/dx_j, dl/dx_1 = -dl/dx_0 = (x_1 - x_0) / l."""
-    X = x[edges]  # (m, 2, 2)
+    X = x.take(edges, axis=0)  # (m, 2, 2)
     d = X[:, 1] - X[:, 0]
     length = np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1])
     s = X[..., 0] @ _STRAIGHT  # (pi / 3) (2 r_i + r_j), (m, 2)

@@ -166,15 +166,19 @@ class Polyline(RigidSurface, Pieces):
         k), from `_project`; kept for the next call, which the iterations of a step make with
         the same x_prev and, mostly, the same pairs."""
         held = self._previous_held
+        # the same bytes: the same numbers (tobytes: far cheaper than np.array_equal on a few hundred)
         if (
             held is None
-            or len(held[1]) != len(i)
             or held[0].shape != x_prev.shape
-            or not np.array_equal(held[1], i)
-            or not np.array_equal(held[2], k)
-            or not np.array_equal(held[0], x_prev)
+            or held[1].shape != i.shape
+            or held[1].dtype != i.dtype
+            or held[2].dtype != k.dtype
+            or held[1].tobytes() != i.tobytes()
+            or held[2].tobytes() != k.tobytes()
+            or held[0].tobytes() != x_prev.tobytes()
         ):
-            held = self._previous_held = (x_prev.copy(), i, k) + self._project(k, x_prev[i], full=False)
+            xp = np.array(x_prev, float)
+            held = self._previous_held = (xp, i, k) + self._project(k, xp.take(i, axis=0), full=False)
         return held[3], held[4]
 
     def _dense_candidates(self, x: np.ndarray, widen):
@@ -184,7 +188,7 @@ class Polyline(RigidSurface, Pieces):
         xr, xz = x[:, 0, None], x[:, 1, None]
         inside = (xr >= self.lo[:, 0] - widen) & (xr <= self.hi[:, 0] + widen)
         inside &= (xz >= self.lo[:, 1] - widen) & (xz <= self.hi[:, 1] + widen)
-        return np.nonzero(inside)
+        return inside.nonzero()
 
     def _candidates(self, x: np.ndarray, x_prev: np.ndarray, depth: float, moved: float, method: str):
         """The (node, piece) pairs of the global search (boxes widened by depth + moved),
@@ -255,15 +259,16 @@ class Polyline(RigidSurface, Pieces):
         out = Projection.empty(nn)
         if len(i) == 0:
             return out
-        xi, g, n, t, kappa, m, point = self._project(k, x[i])
+        xi, g, n, t, kappa, m, point = self._project(k, x.take(i, axis=0))
         xi0, g0 = self._previous(x_prev, i, k)
         tol = 1e-9
         dg = g0 - g
         tau = np.divide(g0, dg, out=np.full(len(g), np.inf), where=dg > 0)  # where along the path it crosses
         crossed = (g0 >= 0) & (g < 0) & np.isfinite(tau)
-        if crossed.any():
+        if np.count_nonzero(crossed):
             ic = i[crossed]
-            xc = x_prev[ic] + np.minimum(tau[crossed], 1.0)[:, None] * (x[ic] - x_prev[ic])
+            xp = x_prev.take(ic, axis=0)
+            xc = xp + np.minimum(tau[crossed], 1.0)[:, None] * (x.take(ic, axis=0) - xp)
             xic = self._project(k[crossed], xc, full=False)[0]
             crossed[crossed] = (xic >= -tol) & (xic <= 1 + tol)
         # in front of the piece or less than depth behind it; or behind it now and near it at the
@@ -290,15 +295,16 @@ class Polyline(RigidSurface, Pieces):
             best = order[last]
         else:  # the same without the sort (the pairs come sorted by node): maxima per node
             best = best_per_node(i, score, gap_rank)
-        best = best[np.isfinite(score[best])]
-        bi, bk = i[best], k[best]
+        best = best.compress(np.isfinite(score.take(best)))
+        bi, bk = i.take(best), k.take(best)
+        s0, length = self.s0.take(bk), self.L.take(bk)
         out.active[bi] = True
-        out.g[bi], out.n[bi], out.t[bi] = g[best], n[best], t[best]
-        out.kappa[bi], out.m[bi], out.point[bi] = kappa[best], m[best], point[best]
-        out.s[bi] = self.s0[bk] + np.minimum(np.maximum(xi[best], 0.0), 1.0) * self.L[bk]
-        out.s_prev[bi] = self.s0[bk] + np.minimum(np.maximum(xi0[best], 0.0), 1.0) * self.L[bk]
-        out.kind[bi] = np.where(crossed[best], 3, 1)
-        if self._cavity.any() and len(bi) < nn:  # a node without a point, and a corner to find it
+        out.g[bi], out.n[bi], out.t[bi] = g.take(best), n.take(best, axis=0), t.take(best, axis=0)
+        out.kappa[bi], out.m[bi], out.point[bi] = kappa.take(best), m.take(best), point.take(best, axis=0)
+        out.s[bi] = s0 + np.minimum(np.maximum(xi.take(best), 0.0), 1.0) * length
+        out.s_prev[bi] = s0 + np.minimum(np.maximum(xi0.take(best), 0.0), 1.0) * length
+        out.kind[bi] = np.where(crossed.take(best), 3, 1)
+        if self._any_cavity and len(bi) < nn:  # a node without a point, and a corner to find it
             self._cavity_corners(out, x, i, k, g, xi, depth, tol)
         return out
 
