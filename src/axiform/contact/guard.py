@@ -32,7 +32,7 @@ def guard_forces(
     the rate are None where no guard acts."""
     m = len(allowance)
     g = proj.g + allowance
-    if not (proj.active & (g < 0.0)).any():  # no mid-point behind its allowance: no force
+    if not np.count_nonzero(proj.active & (g < 0.0)):  # no mid-point behind its allowance: no force
         return None, None, None, np.zeros((m, 2))
     fn, dfn = normal_law(g, proj.active, kn, d)
     force = (weight * fn)[:, None] * proj.n  # on the mid-point (m, 2)

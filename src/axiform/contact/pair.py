@@ -265,10 +265,10 @@ class ContactPair:
         """Whether the law gives no force and no stiffness at the projection `proj`: no node
         behind the surface shifted by its multiplier (nor resting on it, where the predicting
         tangent holds it), none tied, no stabilization."""
-        if self.stabilization or state.stuck.any():
+        if self.stabilization or np.count_nonzero(state.stuck):
             return False
         below = self.smoothing if self._holds_resting(predicting) else 0.0
-        return not (proj.active & (proj.g - state.multiplier / self.kn0 < below)).any()
+        return not np.count_nonzero(proj.active & (proj.g - state.multiplier / self.kn0 < below))
 
     def _holds_resting(self, predicting: bool) -> bool:
         """Whether the tangent holds the nodes resting on the surface (see the class): in a

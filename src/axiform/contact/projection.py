@@ -4,7 +4,7 @@ candidate pair per point (best_per_node)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -43,10 +43,18 @@ class Projection:
 
     def rows(self, sl: slice) -> Projection:
         """The projections of the rows sl (views)."""
-        return Projection(*(getattr(self, name)[sl] for name in PROJECTION_FIELDS))
-
-
-PROJECTION_FIELDS = tuple(f.name for f in fields(Projection))  # (dataclasses.fields is slow to ask)
+        return Projection(
+            self.active[sl],
+            self.g[sl],
+            self.n[sl],
+            self.t[sl],
+            self.s[sl],
+            self.kappa[sl],
+            self.m[sl],
+            self.point[sl],
+            self.s_prev[sl],
+            self.kind[sl],
+        )
 
 
 def best_per_node(i: np.ndarray, score: np.ndarray, rank: np.ndarray) -> np.ndarray:

@@ -226,26 +226,30 @@ class Polyline(RigidSurface, Pieces):
         if method not in ("buckets", "binary", "brute"):
             raise KeyError(method)
         sizes = [len(xs) for xs, _, _ in sets]
-        moved = []
-        for xs, xps, _ in sets:
-            dxp = xs - xps
-            moved.append(float(np.sqrt(dxp[:, 0] * dxp[:, 0] + dxp[:, 1] * dxp[:, 1]).max()) if len(xs) else 0.0)
+        bounds = [0]
+        for size in sizes:
+            bounds.append(bounds[-1] + size)
         x = np.concatenate([xs for xs, _, _ in sets]) if len(sets) > 1 else sets[0][0]
         x_prev = np.concatenate([xps for _, xps, _ in sets]) if len(sets) > 1 else sets[0][1]
-        depth = np.repeat([float(ds) for _, _, ds in sets], sizes)  # per point
+        dxp = x - x_prev
+        dist = np.sqrt(dxp[:, 0] * dxp[:, 0] + dxp[:, 1] * dxp[:, 1])
+        moved = [float(dist[a:b].max()) if b > a else 0.0 for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+        depth = np.empty(len(x))  # per point
+        for (_, _, ds), a, b in zip(sets, bounds[:-1], bounds[1:], strict=True):
+            depth[a:b] = float(ds)
         if len(x) * len(self.a) <= DENSE_PAIRS:  # every point against every widened box at once
-            widen = np.repeat([float(ds) + mv for (_, _, ds), mv in zip(sets, moved, strict=False)], sizes)[:, None]
+            widen = np.empty((len(x), 1))
+            for (_, _, ds), mv, a, b in zip(sets, moved, bounds[:-1], bounds[1:], strict=True):
+                widen[a:b] = float(ds) + mv
             i, k = self._dense_candidates(x, widen)
         else:
-            ii, kk, start = [], [], 0
-            for (xs, xps, ds), mv in zip(sets, moved, strict=False):
+            ii, kk = [], []
+            for (xs, xps, ds), mv, start in zip(sets, moved, bounds, strict=False):
                 i, k = self._candidates(xs, xps, ds, mv, method)
                 ii.append(i + start)
                 kk.append(k)
-                start += len(xs)
             i, k = np.concatenate(ii), np.concatenate(kk)
-        out = self._local_pairs(x, x_prev, i, k, depth[i])
-        bounds = np.cumsum([0] + sizes)
+        out = self._local_pairs(x, x_prev, i, k, depth.take(i))
         return (
             [out] if len(sets) == 1 else [out.rows(slice(a, b)) for a, b in zip(bounds[:-1], bounds[1:], strict=False)]
         )
@@ -284,7 +288,7 @@ class Polyline(RigidSurface, Pieces):
         single = np.empty(len(i), bool)  # whether each pair is the only one of its node
         np.not_equal(i[1:], i[:-1], out=single[1:])
         single[0] = True
-        if single.all():  # one pair per node (the common case): nothing to choose
+        if np.count_nonzero(single) == len(i):  # one pair per node (the common case): nothing to choose
             best = np.arange(len(i))
         elif len(i) <= pieces.ARC_SUBSET:
             order = np.lexsort((gap_rank, score, i))
@@ -327,7 +331,7 @@ class Polyline(RigidSurface, Pieces):
         behind = (g < 0) & (g > -depth) & free
         beyond = behind & (xi > 1 + tol)
         before = behind & (xi < -tol) & (k >= 1)
-        if not (beyond.any() and before.any()):
+        if not (np.count_nonzero(beyond) and np.count_nonzero(before)):
             return
         M = len(self.a)
         nb, sb = i[before], k[before]
