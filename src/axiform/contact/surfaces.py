@@ -164,21 +164,40 @@ class Polyline(RigidSurface, Pieces):
     def _previous(self, x_prev: np.ndarray, i: np.ndarray, k: np.ndarray):
         """xi and g of the last converged positions x_prev (n, 2) on the pairs (node i, piece
         k), from `_project`; kept for the next call, which the iterations of a step make with
-        the same x_prev and, mostly, the same pairs."""
+        the same x_prev.  For a few pairs in all (n M <= DENSE_PAIRS) every point is projected
+        onto every piece once per x_prev, and each call gathers its pairs (the candidates
+        change from one iteration to the next as the points move); else the pairs of the
+        last call are kept (the same numbers: `_project` works element by element)."""
         held = self._previous_held
+        M = len(self.a)
+        dense = len(x_prev) * M <= DENSE_PAIRS
         # the same bytes: the same numbers (tobytes: far cheaper than np.array_equal on a few hundred)
         if (
             held is None
             or held[0].shape != x_prev.shape
-            or held[1].shape != i.shape
-            or held[1].dtype != i.dtype
-            or held[2].dtype != k.dtype
-            or held[1].tobytes() != i.tobytes()
-            or held[2].tobytes() != k.tobytes()
             or held[0].tobytes() != x_prev.tobytes()
+            or (held[1] is None) != dense
+            or (
+                not dense
+                and (
+                    held[1].shape != i.shape
+                    or held[1].dtype != i.dtype
+                    or held[2].dtype != k.dtype
+                    or held[1].tobytes() != i.tobytes()
+                    or held[2].tobytes() != k.tobytes()
+                )
+            )
         ):
             xp = np.array(x_prev, float)
-            held = self._previous_held = (xp, i, k) + self._project(k, xp.take(i, axis=0), full=False)
+            if dense:  # every point on every piece, row by row
+                kk = np.tile(np.arange(M), len(xp))
+                held = (xp, None, None) + self._project(kk, xp.repeat(M, axis=0), full=False)
+            else:
+                held = (xp, i, k) + self._project(k, xp.take(i, axis=0), full=False)
+            self._previous_held = held
+        if held[1] is None:
+            flat = i * M + k
+            return held[3].take(flat), held[4].take(flat)
         return held[3], held[4]
 
     def _dense_candidates(self, x: np.ndarray, widen):
