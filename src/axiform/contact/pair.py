@@ -172,6 +172,7 @@ class ContactPair:
             self.guard_weight = (2.0 / 3.0) * parts.sum(axis=1)
             self.guard_kn = 0.5 * self.kn0[self.edges].sum(axis=1)
             self.guard_allowance = GUARD_ALLOWANCE * edge_heights(mesh, edges)
+            self.guard_reach = float(self.guard_allowance.max())  # how much deeper than a node a mid-point is searched
             chord = mesh.points[edges[:, 1]] - mesh.points[edges[:, 0]]
             self.guard_arm = 0.25 * np.column_stack([-chord[:, 1], chord[:, 0]])  # SFR: d x_m / d theta_a
         self.kt0 = self.kn0 if tangential_penalty is None else np.full(len(self.nodes), float(tangential_penalty))
@@ -347,7 +348,7 @@ class ContactPair:
         mid_prev = 0.5 * (state.x_prev.take(e0, axis=0) + state.x_prev.take(e1, axis=0))
         x = xa - offset  # the nodes, projected in the same pass for `evaluate`
         nodes, proj = self.surface.local_sets(
-            [(x, state.x_prev, self.depth), (mid, mid_prev, self.depth + self.guard_allowance.max())], self.search
+            [(x, state.x_prev, self.depth), (mid, mid_prev, self.depth + self.guard_reach)], self.search
         )
         return *guard_forces(
             proj, self.guard_allowance, self.guard_kn, self.guard_weight, self.smoothing, velocity, self.guard_arm, dpn

@@ -10,6 +10,8 @@ import numpy as np
 # array operations), beyond on the arcs' pairs only (less arithmetic)
 ARC_SUBSET = 4096
 NO_ARC = np.zeros(0, bool)  # `_project`'s arc flags of a chain without arcs (never read)
+TURN = np.array([-1.0, 1.0])  # a tangent reversed, times this: turned by +90 degrees
+TURN.flags.writeable = False
 
 
 class Pieces:
@@ -156,7 +158,7 @@ class Pieces:
             sc[:, 1] = cos
             ta = sgn[:, None] * sc  # sgn (-sin, cos)
             t = np.where(isarc, ta, t)
-            n = np.where(isarc, ta[:, ::-1] * [-1.0, 1.0], n)
+            n = np.where(isarc, ta[:, ::-1] * TURN, n)
             kappa = np.where(arc, -sgn / rho, 0.0)  # ccw: the body inside the arc
             m = np.where(arc, R / rho, 1.0)
             ph = phi0 + sgn * xic * sweep
