@@ -225,6 +225,22 @@ def test_large_problems_reuse_the_search_and_agree(monkeypatch):
         same(surf.local(x, x_prev, 0.05), ref.local(surf, x, x_prev, 0.05))
 
 
+def test_calls_of_a_step_agree_with_a_surface_that_saw_none(monkeypatch):
+    """Calls of steps on one surface (one x_prev a step, the candidates changing as x moves;
+    its projections kept once a step for every piece, or per pairs above DENSE_PAIRS) give
+    the very projections of a new surface, and those of the per-piece reference."""
+    rng = np.random.default_rng(8)
+    surf = random_polyline(rng, 6)
+    for dense in (1 << 16, 0, 1 << 16):
+        monkeypatch.setattr(surfaces, "DENSE_PAIRS", dense)
+        x_prev = near_points(rng, surf, 300, 0.2)
+        for size in (0.0, 0.01, 0.2, 0.02, 0.0):
+            x = x_prev + rng.normal(0, size, x_prev.shape)
+            got = surf.local(x, x_prev, 0.05)
+            same(got, Polyline(points=surf.points, centers=surf.centers, ccw=surf.ccw).local(x, x_prev, 0.05))
+            same(got, ref.local(surf, x, x_prev, 0.05))
+
+
 @pytest.mark.parametrize("k", [2, 3])
 def test_edge_rule_is_the_gauss_rule_with_the_edge_shapes(k):
     s, w, N, dN = edge_rule(k, 3)
