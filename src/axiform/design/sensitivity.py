@@ -130,10 +130,8 @@ def sensitivity(
     differences: str = "central",
 ) -> Sensitivity:
     """Solve the model build(design) under load control and differentiate every converged
-    state with respect to the design variables (module docstring).  `differences`: "central"
-    (two shadow models a variable, the residual's derivative to O(h^2)) or "forward" (one,
-    against the base model itself, O(h): half the shadows' evaluations, for a Jacobian that a
-    Gauss-Newton method needs to a few digits only).
+    state with respect to the design variables (module docstring); `differences` "central"
+    (O(h^2)) or "forward" (O(h), half the evaluations: module docstring).
 
     build: design s (m,) -> an unsolved Model, or its System (Model.finalize), with the same mesh topology,
     supports and loads for every s, only the reference geometry (or constants) changed.
@@ -152,20 +150,10 @@ def sensitivity(
         raise ValueError(f'differences must be "central" or "forward", not {differences!r}')
     central = differences == "central"
     model = built(s)
-    shadows: list[tuple[System, ...]] = []  # per variable: the models at s + h (and s - h)
-    for k in range(m):
-        e = np.zeros(m)
-        e[k] = h[k]
-        pair = (built(s + e), built(s - e)) if central else (built(s + e),)
-        for shadow in pair:
-            _same_numbering(model, shadow, k)
-        shadows.append(pair)
+    shadows = _shadow_models(built, model, s, h, central)
     span = 2.0 * h if central else h  # the design step between the two residuals differenced
     dx_ds = np.stack(
-        [
-            (pair[0].mesh.points - (pair[1] if central else model).mesh.points) / hk
-            for pair, hk in zip(shadows, span, strict=True)
-        ],
+        [(p[0].mesh.points - (p[1] if central else model).mesh.points) / d for p, d in zip(shadows, span, strict=True)],
         axis=-1,
     )
     history = has_history(model)
@@ -211,6 +199,22 @@ def sensitivity(
         if out.thickness is not None:
             out.dthickness_ds = thickness_derivative(model, u2, out.dx_ds, out.du_final_ds())
     return out
+
+
+def _shadow_models(
+    built: Callable[[np.ndarray], System], model: System, s: np.ndarray, h: np.ndarray, central: bool
+) -> list[tuple[System, ...]]:
+    """Per design variable k: the models at s + h_k e_k and, for central differences, at
+    s - h_k e_k, each checked to number its dofs as the base model does."""
+    shadows: list[tuple[System, ...]] = []
+    for k in range(s.size):
+        e = np.zeros(s.size)
+        e[k] = h[k]
+        pair = (built(s + e), built(s - e)) if central else (built(s + e),)
+        for shadow in pair:
+            _same_numbering(model, shadow, k)
+        shadows.append(pair)
+    return shadows
 
 
 def _begin_shadow_steps(shadows: list, shadow_states: list, fraction: float) -> None:
