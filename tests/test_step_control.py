@@ -9,27 +9,15 @@ import dataclasses
 import re
 
 import pytest
+from test_restart import PUNCH as RESTART_PUNCH
 
 from axiform.case.base import CaseError
 from axiform.case.schema import build, parse
 from axiform.solve.solver import solve
 
-# a sticky punch pressed into a disc it touches at t = 0: the disc is unloaded at the first step
-PUNCH = {
-    "title": "punch on a disc, sticky",
-    "mesh": {"kind": "rectangle", "r": [0.0, 10.0], "z": [0.0, 2.0], "divisions": [10, 2], "element": "q4"},
-    "material": {"model": "neo-hooke", "C1": 0.5, "kappa": 50.0},
-    "fix": [{"at": {"z": 0.0}, "dofs": ["uz"]}, {"at": {"r": 0.0}, "dofs": ["ur"]}],
-    "contact": [
-        {
-            "surface": {"circle": {"center": [0.0, 7.0], "radius": 5.0}},
-            "slaves": {"z": 2.0},
-            "sticky": True,
-            "motion": {"uz": -0.8},
-        }
-    ],
-    "solver": {"control": "load", "steps": 4},
-}
+# the sticky punch of test_restart (pressed into a disc it touches at t = 0: the disc is
+# unloaded at the first step), in 4 nominal steps
+PUNCH = {**RESTART_PUNCH, "solver": {"control": "load", "steps": 4}}
 
 
 def run(**solver):

@@ -44,9 +44,9 @@ INVERTING_FRACTION = 0.1
 # a mould faces away from its slaves where more than this fraction of the slave nodes that
 # project onto it lie behind it with its normal pointing the way their body's outward normal does
 WRONG_FACE_FRACTION = 0.5
-# a slave node faces the way the mould does where the angle between the body's outward normal
-# and the mould's is below 60 degrees: a node beside the segment it projects onto (the normals
-# at right angles, the side of a tube over a mould's floor) faces neither way
+# a slave node in front of a mould lies on the body's face away from it where the angle between
+# the body's outward normal and the mould's is below 60 degrees: a node beside the segment it
+# projects onto (the normals at right angles, the side of a tube over a mould's floor) does not
 FACING = 0.5
 
 
@@ -150,9 +150,10 @@ def mould_checks(built: Built) -> list[str]:
         on = proj.active & (proj.kind == 1)
         if not on.any():
             continue
-        alike = np.einsum("ij,ij->i", proj.n, body_normals(pair)) > FACING
+        cosine = np.einsum("ij,ij->i", proj.n, body_normals(pair))
+        alike = cosine > 0.0
         wrong = alike & (proj.g < pair.smoothing)  # behind it, and facing the way it faces
-        away = alike & ~wrong  # in front of it, but on the body's face away from it
+        away = (cosine > FACING) & ~wrong  # in front of it, on the body's face away from it (not beside it)
         where = _mould_name(built, i)
         if wrong[on].mean() > WRONG_FACE_FRACTION:
             if isinstance(pair.surface, Circle):

@@ -14,7 +14,8 @@ sum of its squared second differences relative to its initial mean.
 Methods:
 - "gradient": SciPy's bound-constrained trust-region reflective least squares
   (`scipy.optimize.least_squares`, method "trf") over ln t_k, with the Jacobian of the final
-  thickness to the design from direct differentiation along the load path (axiform.design.sensitivity): a
+  thickness to the design from direct differentiation along the load path (axiform.design.sensitivity,
+  forward differences of the residual): a
   Gauss-Newton method, which needs few forward solves because the whole Jacobian (stations x
   design) comes with each solve;
 - "fixed-point": the plain rule, each t_k scaled by target / achieved at its station s_k.
@@ -129,7 +130,7 @@ class Forward:
         design = self.design
         control = design.control if self.stops is None else replace(design.control, stops=self.stops)
         if gradient:
-            sens = sensitivity(design.model, x, control, design.built.options, keep_steps=False)
+            sens = sensitivity(design.model, x, control, design.built.options, keep_steps=False, differences="forward")
             self._keep_stops(sens.solve, sens.model)
             return sens.solve, sens.thickness, sens.dthickness_ds
         model = design.model(x)
