@@ -29,14 +29,15 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import resource
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path.insert(0, str(HERE))
+from speed import timed  # noqa: E402  (wall, CPU of the child, its output)
+
 OFF = ["--set", "output.plots=false", "--set", "output.vtu=false"]
 KINDS = {"off": OFF, "vtu": ["--set", "output.plots=false"], "default": []}
 IMPORTS = {
@@ -70,28 +71,18 @@ sys.exit(code)
 """
 
 
-def timed(args: list[str], env: dict[str, str]) -> tuple[float, float]:
-    """The wall and CPU time (user + system) in s of one child process."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    subprocess.run(args, env=env, cwd=ROOT, check=True, capture_output=True)
-    wall = time.perf_counter() - t0
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return wall, after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
-
-
 def measure(src: Path, case: Path, work: Path, kind: str) -> dict[str, float]:
     """One process of `kind` (floor, imports, mpl, off, vtu, default): its wall and CPU, and
     for a run its solve's wall and CPU."""
     env = dict(os.environ, PYTHONPATH=str(src))
     env.pop("PYTHONDONTWRITEBYTECODE", None)
     if kind in IMPORTS:
-        wall, cpu = timed([sys.executable, "-c", IMPORTS[kind]], env)
+        wall, cpu, _ = timed([sys.executable, "-c", IMPORTS[kind]], env, ROOT)
         return {"wall": wall, "cpu": cpu}
     spans = work / "solve.json"
     out = work / kind
     argv = ["run", str(case), "--out", str(out), "-q", *KINDS[kind]]
-    wall, cpu = timed([sys.executable, "-c", CHILD, str(spans), *argv], env)
+    wall, cpu, _ = timed([sys.executable, "-c", CHILD, str(spans), *argv], env, ROOT)
     timings = json.loads(spans.read_text())
     (solve_wall, solve_cpu), *_ = timings["solve"]
     out = {"wall": wall, "cpu": cpu, "solve_wall": solve_wall, "solve_cpu": solve_cpu}
