@@ -20,13 +20,14 @@ import argparse
 import filecmp
 import json
 import os
-import resource
-import subprocess
 import sys
-import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path.insert(0, str(HERE))
+from speed import timed  # noqa: E402  (wall, CPU of the child, its output)
+
 EXAMPLES = ("bottle_blow_moulding", "cup_thermoforming", "stretch_blow_moulding")
 TIMINGS = ("wall_time_s",)
 
@@ -46,12 +47,8 @@ def run(src: Path, example: str, out: Path, plots: bool) -> tuple[float, float]:
         str(out),
         "-q",
     ] + ([] if plots else ["--set", "output.plots=false"])
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    subprocess.run(args, env=env, cwd=ROOT, check=True, capture_output=True)
-    wall = time.perf_counter() - t0
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return wall, after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+    wall, cpu, _ = timed(args, env, ROOT)
+    return wall, cpu
 
 
 def differences(a: Path, b: Path) -> list[str]:
