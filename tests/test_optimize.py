@@ -247,7 +247,9 @@ def test_bottle_whole_wall_within_5_percent_in_fewer_forward_solves_than_the_rul
     """The bottle example on a coarser mesh (16 Q8 elements, 10 steps, a knot every 8 mm and at
     s = 68): the whole wall but the pinch-off's element, neck included, within 5 % of a uniform
     target of 1.1 (at 1.15 the rule hovers about 5 % since the bottle is blown to what its mould
-    holds); the gradient method needs 3 forward solves, the fixed-point rule 5."""
+    holds); the gradient method needs 3 forward solves, the fixed-point rule more (it dips
+    under 5 % where its hovering takes it: after 5 solves or 9 as the steps' line search
+    changed the walls by a fraction of a percent)."""
     from axiform.design.optimize import ThicknessDesign, optimize
 
     tree = tomllib.loads((EXAMPLES / "parison_bottle.toml").read_text())
@@ -267,7 +269,7 @@ def test_bottle_whole_wall_within_5_percent_in_fewer_forward_solves_than_the_rul
         wall = result.best.thickness["thickness"][1:]
         assert np.abs(wall / 1.1 - 1).max() == pytest.approx(result.best.deviation, rel=1e-12)
         assert result.best.deviation <= 0.05
-    assert (grad.forward_solves, rule.forward_solves) == (3, 5)
+    assert grad.forward_solves == 3 < rule.forward_solves
 
 
 def test_every_design_and_the_final_run_take_the_first_designs_steps(tmp_path):

@@ -100,8 +100,10 @@ def _newton_load_from(model, history, u_f, lam, opts, floor, linear):
     """Newton at fixed lambda from u_f.  With contact, a correction that raises the residual
     is shortened (halved up to three times): the active set and the stick/slip states change
     between iterations, and a full step can overshoot.  If no shortened step lowers the
-    residual either, the full step is taken: creeping by eighths of Newton steps stalled
-    sticky and frictional steps for 15 iterations at a residual that did not fall.  The
+    residual either, the one of the four with the least residual is taken: not always the
+    eighth (creeping by eighths stalled sticky and frictional steps for 15 iterations at a
+    residual that did not fall), nor always the whole (where a sheet peels off a tool, a whole
+    correction raised the residual a hundredfold, the iterates bounced and the step was cut).  The
     evaluation at the start is `predicting` (ContactPair.evaluate): with contact, nodes
     resting on a surface get the penalty in this tangent only, so that the first correction
     does not drive them through it.  The Evaluation returned is that of the u returned:
@@ -116,14 +118,15 @@ def _newton_load_from(model, history, u_f, lam, opts, floor, linear):
         du = -factorize_checked(ev.K, linear)(ev.r)
         trial = evaluate_checked(model, history, u_f + du, lam)
         if model.contacts and trial.force_norm > ev.force_norm:
-            full = (du, trial)
+            tried = [(du, trial)]
             for _ in range(3):
                 du = 0.5 * du
                 trial = evaluate_checked(model, history, u_f + du, lam)
+                tried.append((du, trial))
                 if trial.force_norm <= ev.force_norm:
                     break
             else:
-                du, trial = full
+                du, trial = min(tried, key=lambda t: t[1].force_norm)
         u_f, ev = u_f + du, trial
     raise StepFailed(f"no convergence in {opts.max_iterations} iterations")
 
