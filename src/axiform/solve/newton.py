@@ -85,6 +85,15 @@ def factorize_checked(K, linear: LinearSolver):
     return checked
 
 
+def still_descending(du: np.ndarray, r0: np.ndarray, r1: np.ndarray) -> bool:
+    """Whether the residual projected on the correction du, du . R, is still negative at its
+    full length (r1, the residual there) as at its start (r0): along du the potential still
+    falls at the full step, and no shorter step along it is better; a residual norm that
+    rose there (nodes that touch in the new state, a contact force that moved) is no reason
+    to shorten it."""
+    return float(du @ r0) < 0.0 and float(du @ r1) < 0.0
+
+
 def newton_load(model, history, u_f, lam, opts, floor, linear, guess=None):
     """Newton at fixed lambda from a predicted state `guess`, and if that fails (or the guess
     is not admissible) from the last converged state u_f."""
@@ -99,9 +108,11 @@ def newton_load(model, history, u_f, lam, opts, floor, linear, guess=None):
 def _newton_load_from(model, history, u_f, lam, opts, floor, linear):
     """Newton at fixed lambda from u_f.  With contact, a correction that raises the residual
     is shortened (halved up to three times): the active set and the stick/slip states change
-    between iterations, and a full step can overshoot.  If no shortened step lowers the
-    residual either, the full step is taken: creeping by eighths of Newton steps stalled
-    sticky and frictional steps for 15 iterations at a residual that did not fall.  The
+    between iterations, and a full step can overshoot; not where the residual projected on
+    the correction is still negative at its full length (`still_descending`).  If no
+    shortened step lowers the residual either, the full step is taken: creeping by eighths
+    of Newton steps stalled sticky and frictional steps for 15 iterations at a residual that
+    did not fall.  The
     evaluation at the start is `predicting` (ContactPair.evaluate): with contact, nodes
     resting on a surface get the penalty in this tangent only, so that the first correction
     does not drive them through it.  The Evaluation returned is that of the u returned:
@@ -115,7 +126,7 @@ def _newton_load_from(model, history, u_f, lam, opts, floor, linear):
             break
         du = -factorize_checked(ev.K, linear)(ev.r)
         trial = evaluate_checked(model, history, u_f + du, lam)
-        if model.contacts and trial.force_norm > ev.force_norm:
+        if model.contacts and trial.force_norm > ev.force_norm and not still_descending(du, ev.r, trial.r):
             full = (du, trial)
             for _ in range(3):
                 du = 0.5 * du
