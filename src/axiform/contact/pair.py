@@ -240,6 +240,9 @@ class ContactPair:
         a = np.bincount(self.edges.ravel(), parts.ravel(), len(self.nodes))
         # f = w(a) t: w = a (a / a0)^thinning, the area times the thinning of the penalty; without
         # thinning w = a and dw/da = 1 (a * 1 and 1 * 1: the same numbers)
+        ratio: np.ndarray | None
+        w: np.ndarray
+        dw: np.ndarray
         if self.thinning:
             ratio = np.where(self.on_axis, 1.0, a / self.area0_safe) ** self.thinning
             w, dw = a * ratio, np.where(self.on_axis, 1.0, (1.0 + self.thinning) * ratio)
