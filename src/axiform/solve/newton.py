@@ -112,11 +112,10 @@ def _newton_load_from(model, history, u_f, lam, opts, floor, linear):
     the correction is still negative at its full length (`still_descending`).  If no
     shortened step lowers the residual either, the full step is taken: creeping by eighths
     of Newton steps stalled sticky and frictional steps for 15 iterations at a residual that
-    did not fall.  The
-    evaluation at the start is `predicting` (ContactPair.evaluate): with contact, nodes
-    resting on a surface get the penalty in this tangent only, so that the first correction
-    does not drive them through it.  The Evaluation returned is that of the u returned:
-    its trial state is the one to commit."""
+    did not fall.  The evaluation at the start is `predicting` (ContactPair.evaluate): with
+    contact, nodes resting on a surface get the penalty in this tangent only, so that the
+    first correction does not drive them through it.  The Evaluation returned is that of the
+    u returned: its trial state is the one to commit."""
     residuals: list[float] = []
     ev = evaluate_checked(model, history, u_f, lam, predicting=True)
     for it in range(opts.max_iterations + 1):
