@@ -120,6 +120,21 @@ def test_the_projection_is_the_reference_on_every_pair():
         assert np.array_equal(a, b)
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_the_fraction_alone_is_that_of_the_projection(seed):
+    """The crossing test's xi (Pieces._fraction) is _project's, number for number, on lines and
+    arcs, and on a chain of lines only."""
+    rng = np.random.default_rng(40 + seed)
+    surf = random_polyline(rng, int(rng.integers(1, 9)))
+    x = near_points(rng, surf, 300, 1.0)
+    k = rng.integers(0, len(surf.a), len(x))
+    assert np.array_equal(surf._fraction(k, x), surf._project(k, x, full=False)[0])
+    lines = np.flatnonzero(~surf.is_arc)
+    if len(lines):
+        kl = rng.choice(lines, len(x))
+        assert np.array_equal(surf._fraction(kl, x), surf._project(kl, x, full=False)[0])
+
+
 def test_points_on_piece_ends_and_cavity_corners():
     """A cup-like cavity (line, cw arc, line, a sharp cavity corner, line): nodes on every
     vertex, nodes behind the sharp corner (vertex contact, kind 2), nodes crossing a face."""

@@ -77,10 +77,7 @@ def traction(law: Law, x: np.ndarray, proj, state: ContactState, resting: bool) 
     `state` (its multipliers shift the gap: g - lambda / kn).  resting: nodes resting on the
     surface (0 <= g - lambda / kn < d) get the penalty kn n n^T in the tangent, not in the
     force (ContactPair, the predicting tangent)."""
-    n = len(x)
-    f = np.zeros((n, 2))
-    K = np.zeros((n, 2, 2))  # d f / d x
-    status = np.zeros(n, np.int8)
+    status = np.zeros(len(x), np.int8)
     kn, d = law.kn, law.d
     g = proj.g - state.multiplier / kn  # the gap the penalty sees: lambda / kn in front of the surface
     stuck = state.stuck
@@ -90,11 +87,11 @@ def traction(law: Law, x: np.ndarray, proj, state: ContactState, resting: bool) 
     fn, dfn = normal_law(g, contact, kn, d)
     nv, tv = proj.n, proj.t
     nn, tt = outer(nv, nv), outer(tv, tv)
-    if resting:
+    f = fn[:, None] * nv
+    K = dfn[:, None, None] * nn  # d f / d x
+    if resting:  # (the held nodes have no force: dfn = 0 there, and the sum is that of -kn nn + dfn nn)
         on = proj.active & (g >= 0.0) & (g < d) & ~stuck
-        K -= (on * kn)[:, None, None] * nn
-    f += fn[:, None] * nv
-    K += dfn[:, None, None] * nn
+        K = -((on * kn)[:, None, None] * nn) + K
     K += (fn * proj.kappa)[:, None, None] * tt  # fn dn/dx
     status[contact] = 1
     slip_state = None

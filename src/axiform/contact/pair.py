@@ -166,6 +166,8 @@ class ContactPair:
         else:
             self.kn0 = np.full(len(self.nodes), float(penalty))
             self.thinning = 0.0
+        self.unit_rate = np.ones(len(self.nodes))  # dw/da without thinning (`evaluate`), read-only
+        self.unit_rate.flags.writeable = False
         # the mid-point guards of straight edges (reference weight, penalty and allowance)
         self.guarded = self.edges.shape[1] == 2
         if self.guarded:
@@ -236,12 +238,16 @@ class ContactPair:
             return self._untouching(xa, x, proj, state, guard_force)
         parts, dparts = ring_areas(xa, self.edges, derivative=True)
         a = np.bincount(self.edges.ravel(), parts.ravel(), len(self.nodes))
-        # f = w(a) t: w = a (a / a0)^thinning, the area times the thinning of the penalty (x^0 = 1 for every x)
+        # f = w(a) t: w = a (a / a0)^thinning, the area times the thinning of the penalty; without
+        # thinning w = a and dw/da = 1 (a * 1 and 1 * 1: the same numbers)
+        ratio: np.ndarray | None
+        w: np.ndarray
+        dw: np.ndarray
         if self.thinning:
             ratio = np.where(self.on_axis, 1.0, a / self.area0_safe) ** self.thinning
+            w, dw = a * ratio, np.where(self.on_axis, 1.0, (1.0 + self.thinning) * ratio)
         else:
-            ratio = np.ones(len(a))
-        w, dw = a * ratio, np.where(self.on_axis, 1.0, (1.0 + self.thinning) * ratio)
+            ratio, w, dw = None, a, self.unit_rate
         law = traction(self.law, x, proj, state, self._holds_resting(predicting))
         t, dt, status = law.t, law.dt, law.status
         work = state.damping_work
@@ -259,7 +265,7 @@ class ContactPair:
         # d f_i / d x_j through a_i: dw_i t_i (x) da_i/dx_j (m, k, 2, k, 2)
         C = (dw.take(e)[:, :, None] * t.take(e, axis=0))[:, :, :, None, None] * dparts[:, :, None]
         pole_rate = self._poles(xa, t, dt, f, C) if self.pole_edge.size else None
-        seen = ContactSeen(x, proj, f, status, a, ratio[:, None] * t, guard_force)
+        seen = ContactSeen(x, proj, f, status, a, t if ratio is None else ratio[:, None] * t, guard_force)
         return ContactTrial(f, K, C.reshape(m, 2 * k, 2 * k), pole_rate, self._next(state, seen, law, lam, work))
 
     def _idle(self, proj, state: ContactState, predicting: bool) -> bool:

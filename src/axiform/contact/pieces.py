@@ -169,6 +169,23 @@ class Pieces:
             kappa, m = np.zeros(len(k)), np.ones(len(k))
         return xi, g, n, t, kappa, m, point
 
+    def _fraction(self, k: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """xi of `_project` alone, for pairs (piece k (p,), point x (p, 2)): the fraction along
+        the piece (the crossing test needs no more), the same numbers with neither the gap
+        nor the arcs' radii."""
+        P = self._par.take(k, axis=0)
+        ar, az, tr, tz, L, cr, cz, _, phi0, sweep, sgn = P.T[:11]
+        xr, xz = x[:, 0], x[:, 1]
+        xi = ((xr - ar) * tr + (xz - az) * tz) / L
+        arc = self.is_arc.take(k) if self._any_arc else NO_ARC
+        if not (self._any_arc and np.count_nonzero(arc)):
+            return xi
+        alpha = ((np.arctan2(xz - cz, xr - cr) - phi0) * sgn) % (2 * np.pi)
+        after = alpha - sweep
+        before = 2 * np.pi - alpha
+        frac = np.where(alpha <= sweep, alpha / sweep, np.where(after < before, 1.0 + after / sweep, -before / sweep))
+        return np.where(arc, frac, xi)
+
     def _project_subset(self, k, x, full, arc, xi, g, P):
         """`_project` for many pairs: the arc formulas on the arcs' pairs only (the same
         numbers: every formula works element by element)."""

@@ -292,7 +292,7 @@ class Polyline(RigidSurface, Pieces):
             ic = i[crossed]
             xp = x_prev.take(ic, axis=0)
             xc = xp + np.minimum(tau[crossed], 1.0)[:, None] * (x.take(ic, axis=0) - xp)
-            xic = self._project(k[crossed], xc, full=False)[0]
+            xic = self._fraction(k[crossed], xc)
             crossed[crossed] = (xic >= -tol) & (xic <= 1 + tol)
         # in front of the piece or less than depth behind it; or behind it now and near it at the
         # last converged step (it went deeper during the increment: a Newton iterate may overshoot
