@@ -10,8 +10,8 @@ Each repeat runs, in turn (and for each source tree when --before is given):
 - off: `axiform run CASE -q` with output.vtu and output.plots off;
 - vtu: the same with the VTU series on (plots off);
 - default: the case's default outputs (VTU and the three pictures);
-- and, to read the others by: the imports of a run (`axiform.app.run`, the case schema, the
-  results writer, the solver) and matplotlib's (`matplotlib.figure`, its Agg canvas), each
+- and, to read the others by: the imports of a run (`axiform.app.run`, the case schema and
+  the plate's tables, the results writer, the solver) and matplotlib's (`matplotlib.figure`, its Agg canvas), each
   beside NumPy and scipy.sparse, less the floor.
 A run is `axiform.cli.main` in a fresh Python, as the `axiform` command calls it, whose `solve`
 is wrapped to record its wall and CPU time (the solve as summary.json's wall_time_s counts it:
@@ -44,8 +44,8 @@ OFF = ["--set", "output.plots=false", "--set", "output.vtu=false"]
 KINDS = {"off": OFF, "vtu": ["--set", "output.plots=false"], "default": []}
 IMPORTS = {
     "floor": "import numpy, scipy.sparse",
-    "imports": "import numpy, scipy.sparse, axiform.app.run, axiform.case.schema, axiform.io.results, "
-    "axiform.solve.solver",
+    "imports": "import numpy, scipy.sparse, axiform.app.run, axiform.case.schema, axiform.case.material, "
+    "axiform.case.monitor, axiform.io.results, axiform.solve.solver",
     "mpl": "import numpy, scipy.sparse, matplotlib.figure, matplotlib.backends.backend_agg",
 }
 
@@ -142,7 +142,7 @@ def table(results: dict[str, dict[str, float]]) -> str:
         "pictures": "**the three pictures** (the writer's plotting, timed in the run)",
         "difference": "the same as default minus vtu (two least values: noisier)",
         "default": "whole process, default outputs",
-        "imports": "a run's imports (app.run, case schema, writer, solver), less the floor",
+        "imports": "a run's imports (app.run, the plate's case tables, writer, solver), less the floor",
         "mpl": "matplotlib's imports (figure, Agg canvas), less the floor",
     }
     for key, name in names.items():
