@@ -68,3 +68,23 @@ def test_the_collector_is_resumed_even_where_the_set_up_fails():
         finally:
             setup.done()
     assert gc.isenabled() and gc.get_freeze_count() == 0
+
+
+def test_check_reads_and_builds_with_the_collector_paused(monkeypatch):
+    from axiform.app import check as app_check
+    from axiform.case import preflight
+
+    seen = []
+    checks = preflight.preflight
+
+    def checking(built):
+        seen.append(gc.isenabled())
+        return checks(built)
+
+    monkeypatch.setattr(preflight, "preflight", checking)
+    try:
+        assert app_check.check(str(PLATE), QUICK) == 0
+        assert seen == [False] and gc.isenabled() and gc.get_freeze_count() == 0
+    finally:
+        gc.unfreeze()
+        gc.enable()

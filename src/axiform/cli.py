@@ -280,7 +280,7 @@ def dispatch(args: argparse.Namespace, last: bool = False) -> int:
         return run(args.case, args.out, args.quiet, args.set, args.resume, stream=sys.stdout, last=last)
     from .app.check import check
 
-    return check(args.case, args.set, args.plot)
+    return check(args.case, args.set, args.plot, last)
 
 
 def _fitted_laws() -> list[str]:
