@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import sys
 import tempfile
@@ -145,9 +146,10 @@ def table(results: dict[str, dict[str, float]]) -> str:
         "imports": "a run's imports (app.run, the plate's case tables, writer, solver), less the floor",
         "mpl": "matplotlib's imports (figure, Agg canvas), less the floor",
     }
-    for key, name in names.items():
+    names = {k: v for k, v in names.items() if not all(math.isnan(results[lb][f"{k}_{c}"]) for lb, c in heads)}
+    for key, name in names.items():  # the rows of what was run
         lines.append(f"| {name} | " + " | ".join(f"{results[lb][f'{key}_{c}']:.3f}" for lb, c in heads) + " |")
-    for key in ("fixed", "pictures", "imports", "mpl"):
+    for key in [k for k in ("fixed", "pictures", "imports", "mpl") if k in names]:
         lines.append(
             f"| {key} / floor | "
             + " | ".join(f"**{results[lb][f'{key}_{c}'] / results[lb][f'floor_{c}']:.2f}**" for lb, c in heads)
