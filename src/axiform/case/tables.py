@@ -5,7 +5,9 @@ when a case holds the table: a case without contact, cavities, heat or gravity l
 their schemas, nor the model code behind them.  `validator(keys)` is the pydantic model of a
 case holding the top-level keys `keys` (cached per set of keys): every key of TABLES is a
 field of it, in the order of TABLES (the order its errors are listed in), a present table
-typed by its schema, an absent one by its default.  `Case` is what it validates into.
+typed by its schema, an absent one by its default.  `Case` is what it validates into.  A new
+top-level table: its key and shape in TABLES, its schema's import in `table_schema`, its field
+in `Case` (tests/test_case_tables.py holds the three together).
 """
 
 from __future__ import annotations
