@@ -88,3 +88,20 @@ def test_check_reads_and_builds_with_the_collector_paused(monkeypatch):
     finally:
         gc.unfreeze()
         gc.enable()
+
+
+def test_a_run_in_another_thread_leaves_the_collector_alone():
+    import threading
+
+    seen = []
+
+    def body():
+        with SetUp() as setup:
+            seen.append(gc.isenabled())
+            setup.done()
+            seen.append(gc.get_freeze_count())
+
+    worker = threading.Thread(target=body)
+    worker.start()
+    worker.join()
+    assert seen == [True, 0] and gc.isenabled()

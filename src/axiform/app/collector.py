@@ -11,6 +11,7 @@ run is set up, then freezes what exists out of its sight (gc.freeze) for the sol
 from __future__ import annotations
 
 import gc
+import threading
 from typing import Self
 
 
@@ -19,19 +20,25 @@ class SetUp:
     until then, and what exists then is frozen out of its sight.  At the end of the block the
     frozen objects are handed back to it (gc.unfreeze), unless `last`: the process ends with
     the run (the command line), and its interpreter's final collection would walk them again.
-    The collector is left enabled or disabled as it was found."""
+    The collector is left enabled or disabled as it was found.  Only in the main thread: the
+    collector is the process's, and runs in other threads (a Dask worker's) may overlap."""
 
     def __init__(self, last: bool = False):
         self.last = last
-        self.enabled = gc.isenabled()
+        self.active = threading.current_thread() is threading.main_thread()
+        self.enabled = False
         self.frozen = False
 
     def __enter__(self) -> Self:
-        gc.disable()
+        if self.active:
+            self.enabled = gc.isenabled()
+            gc.disable()
         return self
 
     def done(self) -> None:
         """The set-up is over: what exists now is frozen, the collector resumed."""
+        if not self.active:
+            return
         if not self.frozen:
             gc.freeze()
             self.frozen = True
