@@ -36,7 +36,7 @@ from ..model.system import System
 from ..post.thickness import default_wall
 from ..solve.solver import ArcLengthControl, DisplacementControl, LoadControl, NewtonOptions
 from .base import CaseError, CurveKnots, CurveMixin, DofName, PositiveFloat, Selector, Strict
-from .loads import apply_loads, prescribe_fixes
+from .loads import FixSpec, PointLoadSpec, PressureSpec, apply_loads, prescribe_fixes
 from .mesh import build_mesh
 from .output import MAX_REVOLVED_POINTS
 from .solver import build_control
@@ -45,7 +45,6 @@ from .tables import TABLES, Case, validator
 from .tree import key_path, not_numbers
 
 if TYPE_CHECKING:
-    from .loads import FixSpec, PointLoadSpec, PressureSpec
     from .monitor import Monitor
 
 __all__ = [
