@@ -4,7 +4,7 @@ Reading, validating and building a case imports NumPy, SciPy, pydantic and axifo
 the case's schemas and the model: some 1e5 objects that live as long as the run, next to no
 garbage among them (about 1,000 objects on the paper's plate).  Each full collection walks all
 of them: during the set-up, during the solve, and once more when the interpreter ends, some
-20 ms each on the plate (benchmarks/README.md § 7).  `SetUp` pauses the collector while the
+20 ms each on the plate (benchmarks/README.md § 7.1).  `SetUp` pauses the collector while the
 run is set up, then freezes what exists out of its sight (gc.freeze) for the solve.
 """
 
