@@ -3,31 +3,34 @@
 process, its solve, and its pictures, side by side in one run (the goals: the fixed cost at
 most 1.5x the floor, the pictures 1.5x more).
 
-    python benchmarks/fixed_cost.py [--repeat 5] [--before OLD/src] [--case CASE.toml]
+    python benchmarks/fixed_cost.py [--repeat 5] [--before OLD/src] [--case CASE.toml] [--fixed-only]
 
 Each repeat runs, in turn (and for each source tree when --before is given):
 - floor: `python -c "import numpy, scipy.sparse"`;
 - off: `axiform run CASE -q` with output.vtu and output.plots off;
 - vtu: the same with the VTU series on (plots off);
 - default: the case's default outputs (VTU and the three pictures);
-- and, to read the others by: the imports of a run (`axiform.app.run`, the case schema, the
-  results writer, the solver) and matplotlib's (`matplotlib.figure`, its Agg canvas), each
+- and, to read the others by: the imports of a run (`axiform.app.run`, the case schema and
+  the plate's tables, the results writer, the solver) and matplotlib's (`matplotlib.figure`, its Agg canvas), each
   beside NumPy and scipy.sparse, less the floor.
-A run is `axiform.cli.main` in a fresh Python whose `solve` is wrapped to record its wall and
-CPU time (the solve as summary.json's wall_time_s counts it: the steps and their per-step
-files), and the results writer's `_plot` (the three pictures, matplotlib's import included).
+A run is `axiform.cli.main` in a fresh Python, as the `axiform` command calls it, whose `solve`
+is wrapped to record its wall and CPU time (the solve as summary.json's wall_time_s counts it:
+the steps and their per-step files), and the results writer's `_plot` (the three pictures,
+matplotlib's import included).
 Wall time is measured from outside, CPU time is user + system of the child process.  The
 table gives the least of the repeats of each quantity: the fixed cost (whole process minus
 its solve, per run, then the least), the pictures (timed in the run; default minus vtu as a
 check) and the VTU series (vtu minus off), each also as a multiple of the floor.  The runs
 write their bytecode caches (PYTHONDONTWRITEBYTECODE is dropped), as an installed axiform has
-them; one unmeasured run of each tree comes first.
+them; one unmeasured run of each tree comes first.  --fixed-only: the floor, a run's imports
+and the run with outputs off alone (the fixed cost's rows of the table).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import sys
 import tempfile
@@ -42,8 +45,8 @@ OFF = ["--set", "output.plots=false", "--set", "output.vtu=false"]
 KINDS = {"off": OFF, "vtu": ["--set", "output.plots=false"], "default": []}
 IMPORTS = {
     "floor": "import numpy, scipy.sparse",
-    "imports": "import numpy, scipy.sparse, axiform.app.run, axiform.case.schema, axiform.io.results, "
-    "axiform.solve.solver",
+    "imports": "import numpy, scipy.sparse, axiform.app.run, axiform.case.schema, axiform.case.material, "
+    "axiform.case.monitor, axiform.io.results, axiform.solve.solver",
     "mpl": "import numpy, scipy.sparse, matplotlib.figure, matplotlib.backends.backend_agg",
 }
 
@@ -65,8 +68,11 @@ def timing(name, inner):
 s.solve = timing("solve", s.solve)
 r.ResultsWriter._plot = timing("pictures", r.ResultsWriter._plot)
 import axiform.cli
-code = axiform.cli.main(sys.argv[2:])
-open(sys.argv[1], "w").write(json.dumps(spans))
+last = {"last": True} if "last" in axiform.cli.main.__code__.co_varnames else {}  # as `axiform` calls it
+try:
+    code = axiform.cli.main(sys.argv[2:], **last)
+finally:
+    open(sys.argv[1], "w").write(json.dumps(spans))
 sys.exit(code)
 """
 
@@ -97,22 +103,24 @@ def least(runs: list[dict[str, float]], key) -> float:
 
 def summary(runs: dict[str, list[dict[str, float]]]) -> dict[str, float]:
     """The least of the repeats: floor, whole processes, solve, fixed cost, pictures, VTU, the
-    imports above the floor (wall and CPU)."""
+    imports above the floor (wall and CPU); NaN for what was not run."""
+    nan = float("nan")
     out = {}
     for clock in ("wall", "cpu"):
         floor = least(runs["floor"], lambda r, c=clock: r[c])
         for kind in ("imports", "mpl"):
-            out[f"{kind}_{clock}"] = least(runs[kind], lambda r, c=clock: r[c]) - floor
+            out[f"{kind}_{clock}"] = least(runs[kind], lambda r, c=clock: r[c]) - floor if runs[kind] else nan
         off = least(runs["off"], lambda r, c=clock: r[c])
-        vtu = least(runs["vtu"], lambda r, c=clock: r[c])
-        default = least(runs["default"], lambda r, c=clock: r[c])
+        vtu = least(runs["vtu"], lambda r, c=clock: r[c]) if runs["vtu"] else nan
+        default = least(runs["default"], lambda r, c=clock: r[c]) if runs["default"] else nan
+        pictures = least(runs["default"], lambda r, c=clock: r[f"pictures_{c}"]) if runs["default"] else nan
         out |= {
             f"floor_{clock}": floor,
             f"off_{clock}": off,
             f"solve_{clock}": least(runs["off"], lambda r, c=clock: r[f"solve_{c}"]),
             f"fixed_{clock}": least(runs["off"], lambda r, c=clock: r[c] - r[f"solve_{c}"]),
             f"vtu_{clock}": vtu - off,
-            f"pictures_{clock}": least(runs["default"], lambda r, c=clock: r[f"pictures_{c}"]),
+            f"pictures_{clock}": pictures,
             f"difference_{clock}": default - vtu,
             f"default_{clock}": default,
         }
@@ -135,12 +143,13 @@ def table(results: dict[str, dict[str, float]]) -> str:
         "pictures": "**the three pictures** (the writer's plotting, timed in the run)",
         "difference": "the same as default minus vtu (two least values: noisier)",
         "default": "whole process, default outputs",
-        "imports": "a run's imports (app.run, case schema, writer, solver), less the floor",
+        "imports": "a run's imports (app.run, the plate's case tables, writer, solver), less the floor",
         "mpl": "matplotlib's imports (figure, Agg canvas), less the floor",
     }
-    for key, name in names.items():
+    names = {k: v for k, v in names.items() if not all(math.isnan(results[lb][f"{k}_{c}"]) for lb, c in heads)}
+    for key, name in names.items():  # the rows of what was run
         lines.append(f"| {name} | " + " | ".join(f"{results[lb][f'{key}_{c}']:.3f}" for lb, c in heads) + " |")
-    for key in ("fixed", "pictures", "imports", "mpl"):
+    for key in [k for k in ("fixed", "pictures", "imports", "mpl") if k in names]:
         lines.append(
             f"| {key} / floor | "
             + " | ".join(f"**{results[lb][f'{key}_{c}'] / results[lb][f'floor_{c}']:.2f}**" for lb, c in heads)
@@ -155,18 +164,20 @@ def main() -> None:
     parser.add_argument("--before", type=Path, help="another source tree (its src/), run in turn with this one")
     parser.add_argument("--after", type=Path, default=ROOT / "src")
     parser.add_argument("--case", type=Path, default=ROOT / "examples" / "hughes_carnoy_plate.toml")
+    parser.add_argument("--fixed-only", action="store_true", help="the floor, the imports and the run with outputs off")
     args = parser.parse_args()
     trees = {"after": args.after.resolve()}
     if args.before is not None:
         trees = {"before": args.before.resolve(), **trees}
-    kinds = ("floor", "imports", "mpl", "off", "vtu", "default")
-    runs = {label: {kind: [] for kind in kinds} for label in trees}
+    everything = ("floor", "imports", "mpl", "off", "vtu", "default")
+    kinds = ("floor", "imports", "off") if args.fixed_only else everything
+    runs: dict[str, dict[str, list[dict[str, float]]]] = {label: {kind: [] for kind in everything} for label in trees}
     print(f"load average at start: {os.getloadavg()[0]:.2f}", flush=True)
     with tempfile.TemporaryDirectory(prefix="axiform-fixed-cost-") as tmp:
         work = {label: Path(tmp) / label for label in trees}
         for label, src in trees.items():  # bytecode caches written, nothing measured
             work[label].mkdir()
-            measure(src, args.case.resolve(), work[label], "default")
+            measure(src, args.case.resolve(), work[label], kinds[-1])
         for _ in range(args.repeat):
             for kind in kinds:
                 for label, src in trees.items():

@@ -52,7 +52,8 @@ ROOT = HERE.parent
 SRC = Path(sys.argv[sys.argv.index("--src") + 1]) if "--src" in sys.argv[:-1] else ROOT / "src"
 sys.path.insert(0, str(SRC.resolve()))
 
-from axiform.case.schema import build, load, youngs_modulus  # noqa: E402 (after the sys.path line)
+from axiform.case.contact import youngs_modulus  # noqa: E402 (after the sys.path line)
+from axiform.case.schema import build, load  # noqa: E402
 from axiform.solve.solver import solve  # noqa: E402
 
 sys.path.insert(0, str(HERE))

@@ -227,8 +227,9 @@ def _optimize_and_sweep(sub) -> None:
     p_sweep.add_argument("--workers", type=int, help="worker processes of the LocalCluster (default: the cores)")
 
 
-def dispatch(args: argparse.Namespace) -> int:
-    """Run the parsed command; returns its exit code."""
+def dispatch(args: argparse.Namespace, last: bool = False) -> int:
+    """Run the parsed command; returns its exit code.  last: the process ends with the command
+    (app.collector.SetUp)."""
     if args.command == "fit" and args.model == NETWORK_FIT:
         if args.terms is not None:
             print("axiform fit: --terms is for --model ogden or prony, not network", file=sys.stderr)
@@ -276,10 +277,10 @@ def dispatch(args: argparse.Namespace) -> int:
     if args.command == "run":
         from .app.run import run
 
-        return run(args.case, args.out, args.quiet, args.set, args.resume, stream=sys.stdout)
+        return run(args.case, args.out, args.quiet, args.set, args.resume, stream=sys.stdout, last=last)
     from .app.check import check
 
-    return check(args.case, args.set, args.plot)
+    return check(args.case, args.set, args.plot, last)
 
 
 def _fitted_laws() -> list[str]:
@@ -305,9 +306,10 @@ class _LawChoice(argparse.Action):
         setattr(namespace, self.dest, values)
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, last: bool = False) -> int:
     """The `axiform` command line; returns the exit code.  stdout and stderr are guarded while
-    it runs: a reader that closes them early (`| head`) costs the command nothing."""
+    it runs: a reader that closes them early (`| head`) costs the command nothing.  last: the
+    process ends when it returns (the `axiform` command; app.collector.SetUp)."""
     from .app.console import guarded_streams
 
     with guarded_streams():
@@ -318,7 +320,7 @@ def main(argv: list[str] | None = None) -> int:
             if args.model not in choices:
                 p_fit.error(f"argument --model: invalid choice: {args.model!r} (choose from {', '.join(choices)})")
         try:
-            return dispatch(args)
+            return dispatch(args, last)
         except KeyboardInterrupt:
             print("axiform: interrupted", file=sys.stderr)
             return 130
@@ -326,7 +328,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def entry() -> None:
     """The `axiform` command: exits with main()'s code."""
-    sys.exit(main())
+    sys.exit(main(last=True))
 
 
 if __name__ == "__main__":

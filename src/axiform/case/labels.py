@@ -21,15 +21,17 @@ memory): the pictures and the progress line then say t with the unit of [units] 
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .base import CurveMixin
-from .cavity import CavitySpec
-from .contact import ContactSpec
-from .monitor import MonitorSpec
-from .schema import Case
+
+if TYPE_CHECKING:
+    from .cavity import CavitySpec
+    from .contact import ContactSpec
+    from .monitor import MonitorSpec
+    from .tables import Case
 
 
 def case_labels(case: Case) -> dict[str, Any]:

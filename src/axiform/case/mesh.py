@@ -8,14 +8,16 @@ import io
 import itertools
 import os
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, Literal
 
 from pydantic import Field, model_validator
 
 from ..fem.mesh import Mesh, MeshError, layered, read_gmsh, rectangle
-from ..fem.profile import Arc, Line, Profile, ProfileError
 from ..io.text import check_regular
 from .base import CaseError, PositiveFloat, Strict
+
+if TYPE_CHECKING:  # the profile of a layered mesh: imported where a mesh is one
+    from ..fem.profile import Arc, Line, Profile
 
 
 class LinePiece(Strict):
@@ -43,6 +45,8 @@ class PieceSpec(Strict):
         return self
 
     def build(self) -> Line | Arc:
+        from ..fem.profile import Arc, Line
+
         if self.line is not None:
             return Line(self.line.to, self.line.divisions)
         assert self.arc is not None, "a piece is a line or an arc (_one)"
@@ -97,6 +101,8 @@ class MeshSpec(Strict):
         return self
 
     def build_profile(self) -> Profile:
+        from ..fem.profile import Profile
+
         assert self.start is not None and self.profile is not None, "a layered mesh has start and profile (_kind)"
         return Profile(self.start, tuple(p.build() for p in self.profile))
 
@@ -162,6 +168,8 @@ def build_mesh(spec: MeshSpec, base: Path) -> Mesh:
         )
         return rectangle(spec.r, spec.z, spec.divisions, spec.element, grading=spec.grading or (1.0, 1.0))
     if spec.kind == "layered":
+        from ..fem.profile import ProfileError
+
         assert spec.layers is not None, "a layered mesh has layers (_kind)"
         try:
             return layered(spec.build_profile(), spec.thickness, spec.layers, spec.element)

@@ -4,18 +4,20 @@ dof, a sum of reactions, a node's temperature, a quantity of a contact pair or o
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, Literal
 
 import numpy as np
 from pydantic import Field, field_validator, model_validator
 
-from ..contact.pair import ContactPair
-from ..fem.cavity import Cavity
 from ..fem.mesh import Mesh
 from ..fem.selectors import select_nodes
 from ..io.columns import HISTORY_COLUMNS
 from ..model.system import System
 from .base import CaseError, DofName, Selector, Strict, one_node
+
+if TYPE_CHECKING:
+    from ..contact.pair import ContactPair
+    from ..fem.cavity import Cavity
 
 # characters a monitor name may not hold (besides the unprintable ones): the CSV separators and quotes
 NOT_IN_NAMES = frozenset(',;"\t')

@@ -15,8 +15,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .temperature import boundary_temperatures, change_values
-
 # the stiffest shear modulus a hyperelastic law of axiform's stands for in MPa: a glassy polymer's
 # is about 1e3, a rubber's 0.1 to 10, a polymer melt's below 1
 MAX_MPA_MODULUS = 1.0e4
@@ -30,6 +28,8 @@ def reachable_range(built) -> tuple[float, float] | None:
     T = built.model.temperature
     if T is None:
         return None
+    from .temperature import boundary_temperatures, change_values
+
     values = [float(T.min()), float(T.max())]
     if built.case.thermal is not None:
         values += [v for _, v, _ in boundary_temperatures(built.case)]

@@ -27,7 +27,6 @@ import dataclasses
 
 import numpy as np
 
-from ..contact.surfaces import Circle
 from ..fem.curves import Curve
 from ..fem.elements import gradient_operator
 from ..fem.selectors import select_nodes
@@ -140,6 +139,10 @@ def body_normals(pair) -> np.ndarray:
 def mould_checks(built: Built) -> list[str]:
     """Moulds that face away from their slaves, and slave nodes inside a mould at t = 0."""
     model = built.model
+    if not model.contacts:
+        return []
+    from ..contact.surfaces import Circle
+
     span = float(np.ptp(model.mesh.points, axis=0).max())
     out = []
     for i, pair in enumerate(model.contacts):

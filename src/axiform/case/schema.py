@@ -1,10 +1,13 @@
 """The TOML case file: schema (every key validated), and the model built from it.
 
 An invalid case raises CaseError naming the key path and the reason, before any work.
-Each table has a module beside this one, with its schema and what it builds: case_mesh,
-case_material, case_loads ([[fix]], [[pressure]], [[point_load]]), case_contact, case_cavity,
-case_monitor, case_solver, case_output ([output], [units], [restart]); case_base holds what
-they share.  This module holds the whole case: reading, validation and `build`.
+Each table has a module beside this one, with its schema and what it builds: case/mesh.py,
+material.py, loads.py ([[fix]], [[pressure]], [[point_load]]), contact.py, cavity.py,
+monitor.py, solver.py, output.py ([output], [units], [restart]), temperature.py, thermal.py
+([thermal], [[convection]]), gravity.py; base.py holds what they share, tables.py the list
+of tables and the validated Case.  A table's module (and the model code behind it) is
+imported where a case holds the table.  This module holds the whole case: reading,
+validation and `build`.
 """
 
 from __future__ import annotations
@@ -17,13 +20,14 @@ import tomllib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from pydantic import ValidationError
 
 from ..fem.mesh import MeshError
 from ..fem.selectors import SelectorError
+from ..io.columns import HISTORY_COLUMNS
 from ..io.text import MAX_CASE_BYTES, FileTooLarge, read_text
 from ..materials import LAWS
 from ..model.guards import boundary_crossing, free_to_slide
@@ -32,30 +36,16 @@ from ..model.system import System
 from ..post.thickness import default_wall
 from ..solve.solver import ArcLengthControl, DisplacementControl, LoadControl, NewtonOptions
 from .base import CaseError, CurveKnots, CurveMixin, DofName, PositiveFloat, Selector, Strict
-from .cavity import CavitySpec, build_cavities
-from .contact import (
-    CircleSpec,
-    ContactSpec,
-    MotionSpec,
-    ProfileSurfaceSpec,
-    SurfaceArc,
-    SurfaceLine,
-    SurfacePiece,
-    SurfaceSpec,
-    contact_pair,
-    youngs_modulus,
-)
-from .gravity import GravitySpec, build_gravity
 from .loads import FixSpec, PointLoadSpec, PressureSpec, apply_loads, prescribe_fixes
-from .material import MaterialSpec
-from .mesh import ArcPiece, LinePiece, MeshSpec, PieceSpec, build_mesh
-from .monitor import HISTORY_COLUMNS, Monitor, MonitorSpec, build_monitors
-from .output import MAX_REVOLVED_POINTS, OutputSpec, RestartSpec, Unit, UnitsSpec
-from .solver import DofRef, SolverSpec, StopSpec, build_control
+from .mesh import build_mesh
+from .output import MAX_REVOLVED_POINTS
+from .solver import build_control
 from .suggest import did_you_mean
-from .temperature import TemperatureSpec, give_temperature
-from .thermal import ConvectionSpec, ThermalSpec, build_conduction
+from .tables import TABLES, Case, validator
 from .tree import key_path, not_numbers
+
+if TYPE_CHECKING:
+    from .monitor import Monitor
 
 __all__ = [
     "CaseError",
@@ -65,34 +55,8 @@ __all__ = [
     "PositiveFloat",
     "CurveKnots",
     "CurveMixin",
-    "LinePiece",
-    "ArcPiece",
-    "PieceSpec",
-    "MeshSpec",
-    "MaterialSpec",
-    "FixSpec",
-    "PressureSpec",
-    "PointLoadSpec",
-    "CircleSpec",
-    "SurfaceLine",
-    "SurfaceArc",
-    "SurfacePiece",
-    "ProfileSurfaceSpec",
-    "SurfaceSpec",
-    "MotionSpec",
-    "ContactSpec",
-    "youngs_modulus",
-    "CavitySpec",
     "HISTORY_COLUMNS",
-    "MonitorSpec",
-    "Monitor",
-    "DofRef",
-    "StopSpec",
-    "SolverSpec",
-    "OutputSpec",
-    "Unit",
-    "UnitsSpec",
-    "RestartSpec",
+    "TABLES",
     "Case",
     "parse",
     "override",
@@ -102,26 +66,6 @@ __all__ = [
     "Built",
     "build",
 ]
-
-
-class Case(Strict):
-    title: str = ""
-    mesh: MeshSpec
-    material: MaterialSpec
-    fix: list[FixSpec] = []
-    pressure: list[PressureSpec] = []
-    point_load: list[PointLoadSpec] = []
-    monitor: list[MonitorSpec] = []
-    contact: list[ContactSpec] = []
-    cavity: list[CavitySpec] = []
-    solver: SolverSpec = SolverSpec()
-    output: OutputSpec = OutputSpec()
-    restart: RestartSpec = RestartSpec()
-    units: UnitsSpec = UnitsSpec()
-    temperature: TemperatureSpec | None = None
-    thermal: ThermalSpec | None = None
-    convection: list[ConvectionSpec] = []
-    gravity: GravitySpec | None = None
 
 
 # the names pydantic gives the members of a union in an error's location: not keys
@@ -231,16 +175,18 @@ def parse(data: dict[str, Any]) -> Case:
     bad = not_numbers(data) or not_table_numbers(data) or out_of_range(data)
     if bad:
         raise CaseError("\n".join(bad))
+    root = validator(frozenset(data.keys() & TABLES.keys()))
     try:
-        return Case.model_validate_json(json.dumps(data), strict=True)
+        checked = root.model_validate_json(json.dumps(data), strict=True)
     except ValidationError as exc:
         lines = []
         for err in exc.errors():
             msg = err["msg"].removeprefix("Value error, ")
             if err["type"] == "extra_forbidden":
                 msg = "unknown key"
-            lines.append(f"{_loc(err['loc'])}: {msg}{did_you_mean(Case, dict(err), law_keys(data))}")
+            lines.append(f"{_loc(err['loc'])}: {msg}{did_you_mean(root, dict(err), law_keys(data))}")
         raise CaseError("\n".join(dict.fromkeys(lines))) from None
+    return Case(**dict(checked))
 
 
 def override(data: dict[str, Any], assignment: str) -> None:
@@ -335,6 +281,35 @@ def _loaded(case: Case) -> bool:
     return any(item.value for item in loads) or moving or gas or heated or weight
 
 
+def _loads_and_moulds(case: Case, model: Model, mesh, base: Path) -> tuple[dict, list]:
+    """Give the model the loads, cavities, moulds, heat conduction and weight of the case;
+    the cavities by name and the contact pairs.  The modules of the tables the case lacks are
+    not imported."""
+    prescribe_fixes(model, mesh, case.fix)
+    apply_loads(model, mesh, case.pressure, case.point_load)
+    cavities: dict = {}
+    if case.cavity:
+        from .cavity import build_cavities
+
+        cavities = build_cavities(model, mesh, case.cavity)
+    pairs = []
+    if case.contact:
+        from .contact import contact_pair
+
+        pairs = [contact_pair(mesh, model, c, base, f"contact[{i}]") for i, c in enumerate(case.contact)]
+        for pair in pairs:
+            model.contact(pair)
+    if case.thermal is not None or case.convection or case.contact:
+        from .thermal import build_conduction
+
+        build_conduction(model, mesh, case.thermal, case.convection, case.contact, case.material.density)
+    if case.gravity is not None:
+        from .gravity import build_gravity
+
+        build_gravity(model, mesh, case.gravity, case.material.density)
+    return cavities, pairs
+
+
 def build(case: Case, base: str | Path = ".") -> Built:
     """Turn a validated case into a finalized model; errors name the key at fault."""
     base = Path(base)
@@ -358,6 +333,8 @@ def build(case: Case, base: str | Path = ".") -> Built:
     except MeshError as exc:
         raise CaseError(f"mesh: {exc}") from None
     if heat is not None:
+        from .temperature import give_temperature
+
         give_temperature(model, mesh, case)
     crossing = boundary_crossing(mesh.points, mesh.boundary_edges)
     if crossing is not None:
@@ -367,14 +344,7 @@ def build(case: Case, base: str | Path = ".") -> Built:
             f"(a profile that crosses itself, or overlapping elements)"
         )
     try:
-        prescribe_fixes(model, mesh, case.fix)
-        apply_loads(model, mesh, case.pressure, case.point_load)
-        cavities = build_cavities(model, mesh, case.cavity)
-        pairs = [contact_pair(mesh, model, c, base, f"contact[{i}]") for i, c in enumerate(case.contact)]
-        for pair in pairs:
-            model.contact(pair)
-        build_conduction(model, mesh, case.thermal, case.convection, case.contact, case.material.density)
-        build_gravity(model, mesh, case.gravity, case.material.density)
+        cavities, pairs = _loads_and_moulds(case, model, mesh, base)
         control = build_control(model, mesh, case.solver)
         if not _loaded(case):
             raise CaseError(
@@ -398,10 +368,14 @@ def build(case: Case, base: str | Path = ".") -> Built:
         system = model.finalize()
     except ValueError as exc:  # a tied fibre rotation prescribed twice
         raise CaseError(f"fix: {exc}") from None
-    try:
-        monitors = build_monitors(system, mesh, case.monitor, cavities, case.mesh.element)
-    except SelectorError as exc:
-        raise CaseError(str(exc)) from None
+    monitors: list[Monitor] = []
+    if case.monitor:
+        from .monitor import build_monitors
+
+        try:
+            monitors = build_monitors(system, mesh, case.monitor, cavities, case.mesh.element)
+        except SelectorError as exc:
+            raise CaseError(str(exc)) from None
     s = case.solver
     options = NewtonOptions(
         tolerance=s.tolerance, max_iterations=s.max_iterations, min_step=s.min_step, growth=s.growth

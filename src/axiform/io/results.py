@@ -262,10 +262,10 @@ class ResultsWriter:
 
     def _write_contact(self) -> None:
         """contact.csv and surfaces.csv of the last recorded step, if not yet written."""
-        from ..contact.pair import STATUS
-
         if self._contact is None:
             return
+        from ..contact.pair import STATUS
+
         reports, x, lam = self._contact
         write_atomic(self.out / "contact.csv", contact_table(reports, x, STATUS))
         write_atomic(self.out / "surfaces.csv", mould_outlines(self.model.contacts, lam))

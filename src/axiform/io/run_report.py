@@ -11,13 +11,15 @@ thinnest element around it (its area over its longest side)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..contact.checks import PassedThrough, passed_through
-from ..contact.state import ContactState
 from ..post.labels import QUANTITY_UNIT
 from ..post.thickness import nodal_thickness, thinnest_free
+
+if TYPE_CHECKING:
+    from ..contact.checks import PassedThrough
 
 PENETRATION_LIMIT = 0.01  # of the local wall thickness: the default contact law's target
 STABILIZATION_LIMIT = 0.01  # of the strain energy at the end
@@ -122,6 +124,8 @@ class RunRecord:
 
     def _through(self, k: int, step) -> PassedThrough | None:
         """The nodes of the body behind contact pair k at the end of the step (contact.checks)."""
+        from ..contact.checks import passed_through
+
         model = self.model
         x = model.mesh.points + step.u.reshape(-1, model.dpn)[:, :2]
         return passed_through(model.contacts[k], x, step.lam)
@@ -131,6 +135,8 @@ class RunRecord:
         where it has one): a pair that never touched, a penetration above PENETRATION_LIMIT
         of the wall, slave nodes that passed through the mould (contact.checks), stabilization
         work above STABILIZATION_LIMIT of the strain energy."""
+        from ..contact.state import ContactState
+
         lines = []
         for k, (rec, held) in enumerate(zip(self.pairs, self.model.contact_states(step.state), strict=False)):
             name = pair_label(k, rec.name)

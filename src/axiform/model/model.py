@@ -7,12 +7,10 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..contact.pair import ContactPair
-from ..contact.state import ContactState
 from ..fem.assembly import SolidAssembly
 from ..fem.cavity import Cavity
 from ..fem.constraints import BorderedPattern, DofMap, SparsePattern
@@ -24,6 +22,10 @@ from .numbering import prescribed_curves, rigid_translations, sfr_constraints, s
 from .protocol import Term
 from .system import DOF_NAMES, System, ring_size
 from .terms import CavityTerm, ContactTerm, PointLoadTerm, PressureTerm, SolidTerm
+
+if TYPE_CHECKING:
+    from ..contact.pair import ContactPair
+    from ..contact.state import ContactState
 
 SFR_EDGE_RULES = ("tie", "fix", "free")
 FORMULATIONS = ("mixed", "displacement")

@@ -8,16 +8,19 @@ from __future__ import annotations
 
 import copy
 from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
 
-from ..contact.pair import STABILIZATION, ContactPair
 from ..fem.constraints import DofMap
 from ..fem.curves import PROPORTIONAL, Curve
 from ..fem.graphs import connected_components
 from ..fem.mesh import Mesh
 from .guards import bodies, free_to_slide
+
+if TYPE_CHECKING:
+    from ..contact.pair import ContactPair
 
 
 def sfr_constraints(mesh: Mesh, dpn: int, fixed: dict[int, float], rule: str) -> list[np.ndarray]:
@@ -71,6 +74,8 @@ def stabilized(mesh: Mesh, dpn: int, fixed: Mapping[int, float], pairs: Sequence
     out = []
     for pair in pairs:
         if pair.stabilization is None:
+            from ..contact.pair import STABILIZATION
+
             on_free = body is not None and bool(set(body[pair.nodes].tolist()) & free)
             pair = copy.copy(pair)
             pair.stabilization = STABILIZATION if on_free else 0.0

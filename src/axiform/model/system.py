@@ -12,13 +12,11 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import scipy.sparse as sp
 
-from ..contact.pair import ContactPair
-from ..contact.state import ContactState
 from ..fem.cavity import Cavity
 from ..fem.constraints import BorderedPattern, DofMap, SparsePattern
 from ..fem.curves import Curve
@@ -28,6 +26,10 @@ from .evaluation import Evaluation
 from .protocol import Constraint, EvaluationContext, Term
 from .state import CavityState, ModelState
 from .terms import SolidTerm
+
+if TYPE_CHECKING:
+    from ..contact.pair import ContactPair
+    from ..contact.state import ContactState
 
 DOF_NAMES = {"ur": 0, "uz": 1, "rot": 2}
 

@@ -7,17 +7,19 @@ Arrays: u (n_full,) all dofs of the mesh, node by node.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..contact.pair import ContactPair
-from ..contact.state import ContactState
 from ..fem.cavity import Cavity
 from ..fem.curves import PROPORTIONAL, Curve
 from ..fem.loads import FollowerPressure
 from .protocol import Constraint, Contribution, EvaluationContext, assemble, stateless
 from .state import CavityState
+
+if TYPE_CHECKING:
+    from ..contact.pair import ContactPair
+    from ..contact.state import ContactState
 
 
 class SolidTerm:
