@@ -13,7 +13,7 @@ Each repeat runs, in turn (and for each source tree when --before is given):
 - and, to read the others by: the imports of a run (`axiform.app.run`, the case schema and
   the plate's tables, the results writer, the solver) and matplotlib's (`matplotlib.figure`, its Agg canvas), each
   beside NumPy and scipy.sparse, less the floor.
-A run is `axiform.cli.main` in a fresh Python, as the `axiform` command calls it, whose `solve`
+A run is `axiform.cli.main` in a fresh Python, whose `solve`
 is wrapped to record its wall and CPU time (the solve as summary.json's wall_time_s counts it:
 the steps and their per-step files), and the results writer's `_plot` (the three pictures,
 matplotlib's import included).
@@ -68,9 +68,8 @@ def timing(name, inner):
 s.solve = timing("solve", s.solve)
 r.ResultsWriter._plot = timing("pictures", r.ResultsWriter._plot)
 import axiform.cli
-last = {"last": True} if "last" in axiform.cli.main.__code__.co_varnames else {}  # as `axiform` calls it
 try:
-    code = axiform.cli.main(sys.argv[2:], **last)
+    code = axiform.cli.main(sys.argv[2:])
 finally:
     open(sys.argv[1], "w").write(json.dumps(spans))
 sys.exit(code)

@@ -227,9 +227,8 @@ def _optimize_and_sweep(sub) -> None:
     p_sweep.add_argument("--workers", type=int, help="worker processes of the LocalCluster (default: the cores)")
 
 
-def dispatch(args: argparse.Namespace, last: bool = False) -> int:
-    """Run the parsed command; returns its exit code.  last: the process ends with the command
-    (app.collector.SetUp)."""
+def dispatch(args: argparse.Namespace) -> int:
+    """Run the parsed command; returns its exit code."""
     if args.command == "fit" and args.model == NETWORK_FIT:
         if args.terms is not None:
             print("axiform fit: --terms is for --model ogden or prony, not network", file=sys.stderr)
@@ -277,10 +276,10 @@ def dispatch(args: argparse.Namespace, last: bool = False) -> int:
     if args.command == "run":
         from .app.run import run
 
-        return run(args.case, args.out, args.quiet, args.set, args.resume, stream=sys.stdout, last=last)
+        return run(args.case, args.out, args.quiet, args.set, args.resume, stream=sys.stdout)
     from .app.check import check
 
-    return check(args.case, args.set, args.plot, last)
+    return check(args.case, args.set, args.plot)
 
 
 def _fitted_laws() -> list[str]:
@@ -306,10 +305,9 @@ class _LawChoice(argparse.Action):
         setattr(namespace, self.dest, values)
 
 
-def main(argv: list[str] | None = None, last: bool = False) -> int:
+def main(argv: list[str] | None = None) -> int:
     """The `axiform` command line; returns the exit code.  stdout and stderr are guarded while
-    it runs: a reader that closes them early (`| head`) costs the command nothing.  last: the
-    process ends when it returns (the `axiform` command; app.collector.SetUp)."""
+    it runs: a reader that closes them early (`| head`) costs the command nothing."""
     from .app.console import guarded_streams
 
     with guarded_streams():
@@ -320,7 +318,7 @@ def main(argv: list[str] | None = None, last: bool = False) -> int:
             if args.model not in choices:
                 p_fit.error(f"argument --model: invalid choice: {args.model!r} (choose from {', '.join(choices)})")
         try:
-            return dispatch(args, last)
+            return dispatch(args)
         except KeyboardInterrupt:
             print("axiform: interrupted", file=sys.stderr)
             return 130
@@ -328,7 +326,7 @@ def main(argv: list[str] | None = None, last: bool = False) -> int:
 
 def entry() -> None:
     """The `axiform` command: exits with main()'s code."""
-    sys.exit(main(last=True))
+    sys.exit(main())
 
 
 if __name__ == "__main__":

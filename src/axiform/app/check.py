@@ -9,23 +9,16 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-from .collector import SetUp
 from .console import failed, invalid, say, tell, warn
 
 
-def check(case_path: str, overrides: Sequence[str] = (), plot: str | None = None, last: bool = False) -> int:
+def check(case_path: str, overrides: Sequence[str] = (), plot: str | None = None) -> int:
     """Validate a case and build its model, without solving; returns the exit code (0 valid,
-    2 invalid, 3 an unexpected error).  plot: the PNG to draw the case in, or None.  last: the
-    process ends with the command (collector.SetUp: the collector paused while the case is
-    read, built and checked)."""
-    with SetUp(last) as setup:
-        return _check(Path(case_path), overrides, plot, setup)
-
-
-def _check(case_file: Path, overrides: Sequence[str], plot: str | None, setup: SetUp) -> int:
+    2 invalid, 3 an unexpected error).  plot: the PNG to draw the case in, or None."""
     from ..case.preflight import preflight
     from ..case.schema import CaseError, build, parse, read
 
+    case_file = Path(case_path)
     png = None
     if plot is not None:
         from ..post.check_plot import png_path
@@ -37,19 +30,16 @@ def _check(case_file: Path, overrides: Sequence[str], plot: str | None, setup: S
             return 2
     try:
         built = build(parse(read(case_file, list(overrides))), case_file.parent)
-        warnings = preflight(built)
     except CaseError as exc:
         return invalid(case_file, exc)
     except Exception as exc:  # noqa: BLE001 - a fault of axiform's, not of the case: exit 3
         return failed(exc, f"failed while building the model of {case_file}")
-    finally:
-        setup.done()
     m = built.model
     tell(
         f"{case_file}: valid; {m.mesh.n_cells} {m.mesh.element.name} elements, {m.mesh.n_nodes} nodes, "
         f"{m.n_free} free dofs"
     )
-    warn(*warnings)
+    warn(*preflight(built))
     if png is not None:
         from ..post.check_plot import plot_check
 

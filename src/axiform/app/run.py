@@ -27,7 +27,6 @@ from pathlib import Path
 from typing import Any, Self
 
 from .. import __version__
-from .collector import SetUp
 from .console import COLUMNS, ProgressLine, failed, invalid, say, tell, trace, warn
 
 EXIT = {"finished": 0, "stopped": 1, "failed": 3}
@@ -228,29 +227,20 @@ def run(
     overrides: Sequence[str] = (),
     resume: str | None = None,
     stream=None,
-    last: bool = False,
 ) -> int:
     """Read, check, solve and write a case (or resume a run in its folder); returns the exit code.
     stream: where the header, the progress and the status line go (the command line gives
-    sys.stdout); None: sys.stderr, as for a caller that captures stderr (a sweep's worker).
-    last: the process ends with the run (the command line; collector.SetUp)."""
-    with Stops() as stops, SetUp(last) as setup:
+    sys.stdout); None: sys.stderr, as for a caller that captures stderr (a sweep's worker)."""
+    with Stops() as stops:
         try:
-            return _run(Path(case_path), out, quiet, list(overrides), stops, resume, stream or sys.stderr, setup)
+            return _run(Path(case_path), out, quiet, list(overrides), stops, resume, stream or sys.stderr)
         except Interrupted as exc:  # before the results folder was there
             say(f"axiform: {exc} before the first step")
             return 128 + exc.signum
 
 
 def _run(
-    case_file: Path,
-    out: str | None,
-    quiet: bool,
-    overrides: list[str],
-    stops: Stops,
-    resume: str | None,
-    stream,
-    setup: SetUp,
+    case_file: Path, out: str | None, quiet: bool, overrides: list[str], stops: Stops, resume: str | None, stream
 ) -> int:
     from ..case.schema import CaseError
     from ..io.lock import FolderLock, FolderLocked
@@ -261,8 +251,6 @@ def _run(
         return invalid(case_file, exc)
     except Exception as exc:  # noqa: BLE001 - a fault of axiform's, not of the case: exit 3
         return failed(exc, f"failed while building the model of {case_file}")
-    finally:
-        setup.done()
     out_dir, note = job.folder()
     problem = prepare_folder(out_dir)
     if problem:
