@@ -60,3 +60,35 @@ def test_tangent_not_deferred_where_a_prescribed_dof_moves():
     ev = system.evaluate(u_f, 0.5, deferred=True)
     assert not ev.deferred and ev.K is not None
     assert np.array_equal(ev.dr_dlam, system.evaluate(u_f, 0.5).dr_dlam)
+
+
+def test_newton_defers_the_tangent_of_its_last_check(monkeypatch):
+    """Newton under displacement control evaluates an iteration expected to converge without
+    its tangent: tangents never made, and the same steps, iterations and numbers as with every
+    tangent made."""
+    from axiform import DisplacementControl, solve
+    from axiform.model.system import System
+    from axiform.solve import newton
+
+    system, _ = plate()
+    centre = system.dof(select_nodes(system.mesh, {"r": 0.0, "z": 0.2}), "uz")[0]
+    path = DisplacementControl(int(centre), 0.3, 4)
+    made = []
+    original = System.evaluate
+
+    def counted(self, *args, **kw):
+        ev = original(self, *args, **kw)
+        made.append(ev)
+        return ev
+
+    monkeypatch.setattr(System, "evaluate", counted)
+    lazy = solve(system, path)
+    skipped = sum(ev.deferred for ev in made)  # tangents deferred and never read
+    monkeypatch.setattr(newton, "hopeful", lambda *args: False)
+    made.clear()
+    eager = solve(system, path)
+    assert skipped > 0 and not any(ev.deferred for ev in made)
+    assert lazy.n_steps == eager.n_steps == 4
+    for a, b in zip(lazy.steps, eager.steps, strict=True):
+        assert a.iterations == b.iterations and a.residuals == b.residuals and a.lam == b.lam
+        assert np.array_equal(a.u_f, b.u_f) and np.array_equal(a.r_full, b.r_full)
