@@ -92,3 +92,20 @@ def test_newton_defers_the_tangent_of_its_last_check(monkeypatch):
     for a, b in zip(lazy.steps, eager.steps, strict=True):
         assert a.iterations == b.iterations and a.residuals == b.residuals and a.lam == b.lam
         assert np.array_equal(a.u_f, b.u_f) and np.array_equal(a.r_full, b.r_full)
+
+
+def test_a_small_term_accumulates_as_a_whole_array_would():
+    """SparsePattern.accumulate sums a term of few entries (the pressure) over its own
+    positions: the data array is the one a bincount over the whole pattern gives, number for
+    number, and the distinct positions are found once per positions array."""
+    system, u_f = plate()
+    pattern = system.pattern
+    (solid,), (pressure,) = system.positions
+    assert 4 * pressure.size < len(pattern.keys) <= 4 * solid.size
+    rng = np.random.default_rng(2)
+    a, b = rng.standard_normal(solid.size), rng.standard_normal(pressure.size)
+    data = pattern.accumulate(solid, a)
+    expected = data + np.bincount(pressure, weights=b, minlength=len(pattern.keys))
+    assert np.array_equal(pattern.accumulate(pressure, b, data), expected)
+    first = pattern._distinct(pressure)
+    assert pattern._distinct(pressure)[0] is first[0]
