@@ -19,7 +19,11 @@ CPU time of a single-threaded computation is steadier than its wall time). All o
 thread (OMP/MKL/OpenBLAS_NUM_THREADS=1). axiform runs `--repeat` times and FElupe
 `--felupe-repeat` times, interleaved; the minimum CPU and wall time of each is reported, the
 ratios and exponents of the CPU times first.  `--felupe-from RESULTS.json` takes FElupe's
-runs from an earlier run's results instead of running it again.
+runs from an earlier run's results instead of running it again.  `--inside` times the parts
+of axiform's solve instead (a fresh Python per tree, mesh and repeat, interleaved): the CPU
+time of its factorizations (with the symmetry check), of its solves with them and of its
+evaluations (a deferred tangent counted with the evaluation that reads it), and how many
+evaluations and tangents it made (the least of the repeats).
 Growth: the exponent a of t ~ n^a from one mesh to the next and over all of them (a
 least-squares line through log t against log n).
 
@@ -88,6 +92,75 @@ print("SOLVE " + json.dumps({"cpu": time.process_time() - c, "wall": time.perf_c
 """
 
 
+INSIDE_SCRIPT = r"""
+import json, sys, time
+from pathlib import Path
+sys.path.insert(0, sys.argv[1])
+import axiform.solve.linsolve as ls
+from axiform.case.schema import build, load
+from axiform.model.system import System
+from axiform.solve.solver import solve
+cpu = {"factorize": 0.0, "solve": 0.0, "evaluate": 0.0, "factorizations": 0, "evaluations": 0, "tangents": 0}
+factorize, evaluate, depth = ls.LinearSolver.factorize, System.evaluate, [0]
+def timed_factorize(self, K):
+    c = time.process_time()
+    f = factorize(self, K)
+    cpu["factorize"] += time.process_time() - c
+    cpu["factorizations"] += 1
+    def timed_solve(b):
+        c = time.process_time()
+        x = f(b)
+        cpu["solve"] += time.process_time() - c
+        return x
+    return timed_solve
+def timed_evaluate(self, *args, **kw):
+    depth[0] += 1
+    c = time.process_time()
+    try:
+        ev = evaluate(self, *args, **kw)
+    finally:
+        depth[0] -= 1
+    if depth[0] == 0:
+        cpu["evaluate"] += time.process_time() - c
+        cpu["evaluations"] += 1
+    tangent = kw.get("tangent", args[3] if len(args) > 3 else True)
+    cpu["tangents"] += bool(tangent and not kw.get("deferred"))
+    return ev
+ls.LinearSolver.factorize, System.evaluate = timed_factorize, timed_evaluate
+case = Path(sys.argv[2])
+built = build(load(case, json.loads(sys.argv[3])), case.parent)
+c = time.process_time()
+solve(built.model, built.control, built.options)
+print("INSIDE " + json.dumps(cpu | {"total": time.process_time() - c}))
+"""
+
+
+def inside(meshes: list[str], trees: dict, repeat: int, tmp: Path) -> str:
+    """The table of `--inside`: per mesh and tree the least CPU time of the whole solve, of its
+    factorizations, solves and evaluations over the repeats, and its counts."""
+    script = tmp / "inside.py"
+    script.write_text(INSIDE_SCRIPT)
+    best: dict[tuple[str, str], dict] = {}
+    for mesh in meshes:
+        nr, nz = parse_mesh(mesh)
+        sets = [f"mesh.element={json.dumps('q8')}", f"mesh.divisions=[{nr},{nz}]"]
+        for _ in range(repeat):
+            for name, src in trees.items():
+                _, _, out = timed([sys.executable, str(script), str(src), str(PLATE), json.dumps(sets)], env_for(src))
+                run = json.loads(out[out.index("INSIDE ") + 7 :].split("\n")[0])
+                held = best.setdefault((mesh, name), run)
+                best[mesh, name] = {k: min(v, held[k]) for k, v in run.items()}
+            print(f"{mesh}: " + ", ".join(f"{n} {best[mesh, n]['total']:.2f} s" for n in trees), flush=True)
+    parts = ("total", "factorize", "solve", "evaluate")
+    header = ["mesh", "tree"] + [f"{k} s (CPU)" for k in parts] + ["factorizations", "evaluations", "tangents"]
+    rows = [
+        [m, n] + [f"{best[m, n][k]:.3f}" for k in parts] + [best[m, n][k] for k in header[6:]]
+        for m in meshes
+        for n in trees
+    ]
+    return md_table(header, rows)
+
+
 def parse_mesh(name: str) -> tuple[int, int]:
     """'4x40' (through the thickness x along the radius) -> (nr, nz) = (40, 4)."""
     nz, nr = (int(v) for v in name.lower().split("x"))
@@ -145,6 +218,7 @@ def main(argv=None) -> int:
     ap.add_argument("--after", type=Path, default=ROOT / "src", help="the source tree timed (default: this one)")
     ap.add_argument("--felupe-from", type=Path, help="FElupe's results of an earlier run (its .json): not run again")
     ap.add_argument("--no-felupe", action="store_true")
+    ap.add_argument("--inside", action="store_true", help="time the parts of axiform's solve (no FElupe)")
     ap.add_argument("--out", default="plate_scaling", help="results file name (default plate_scaling)")
     args = ap.parse_args(argv)
     trees = {"this tree": args.after.resolve()} | ({"before": args.before.resolve()} if args.before else {})
@@ -159,6 +233,14 @@ def main(argv=None) -> int:
             print("FElupe is not installed (pip install -e '.[bench]'): axiform alone")
     t_start = time.perf_counter()
     tmp = Path(tempfile.mkdtemp(prefix="plate_scaling_"))
+    if args.inside:
+        report = inside(meshes, trees, args.repeat, tmp)
+        path = HERE / "results" / f"{args.out}.md"
+        command = " ".join(argv or sys.argv[1:])
+        head = f"# Where the plate's solve goes\n\nWritten by `benchmarks/plate_scaling.py {command}`"
+        path.write_text(f"{head} on {time.strftime('%Y-%m-%d %H:%M')}; {machine()}.\n\n{report}\n")
+        print(report)
+        return 0
     script, solve_script = tmp / "felupe_plate.py", tmp / "solve.py"
     script.write_text(FELUPE_SCRIPT)
     solve_script.write_text(SOLVE_SCRIPT)

@@ -223,23 +223,24 @@ def _symmetric_tangent(divisions=(7, 6), seed: int = 0):
     return ev.K.tocsr(), np.column_stack([-ev.r, -ev.dr_dlam])
 
 
-def _types(monkeypatch) -> list[bool]:
-    """The matrix types (symmetric or not) of PARDISO's analyses from now on."""
-    kinds: list[bool] = []
+def _types(monkeypatch) -> list[str]:
+    """The matrix types of PARDISO's analyses from now on: "definite" (Cholesky), "symmetric"
+    (indefinite) or "general" (LU)."""
+    kinds: list[str] = []
     original = pd.Pardiso.analyse
 
     def analyse(self, *args):
-        kinds.append(args[3])
         original(self, *args)
+        kinds.append({2: "definite", -2: "symmetric", 11: "general"}[self.mtype.value])
 
     monkeypatch.setattr(pd.Pardiso, "analyse", analyse)
     return kinds
 
 
 def test_symmetric_tangent_factorized_as_symmetric(monkeypatch):
-    """A K symmetric to round-off goes to PARDISO's symmetric indefinite type (one analysis
-    of its upper triangle), a K of the same pattern with a real asymmetry to the LU; both
-    solved as spsolve solves them."""
+    """A K symmetric to round-off (and positive definite) goes to PARDISO's Cholesky (one
+    analysis of its upper triangle), a K of the same pattern with a real asymmetry to the LU;
+    both solved as spsolve solves them."""
     _backend(monkeypatch, "pardiso")
     K, B = _symmetric_tangent()
     asymmetry = abs(K - K.T).max() / abs(K).max()
@@ -252,7 +253,31 @@ def test_symmetric_tangent_factorized_as_symmetric(monkeypatch):
         x = solver.factorize(M)(B)
         ref = spsolve(M.tocsc(), B)
         assert np.abs(x - ref).max() <= 1e-10 * np.abs(ref).max()
-    assert kinds == [True, False]  # each pattern and type analysed once
+    assert kinds == ["definite", "general"]  # each pattern and type analysed once
+
+
+def test_cholesky_while_definite(monkeypatch):
+    """A symmetric K that is not positive definite stops the Cholesky factorization and goes
+    to the symmetric indefinite one; the pattern's next K goes there directly, and after one
+    with no negative pivot Cholesky is tried again.  Every answer as spsolve's."""
+    _backend(monkeypatch, "pardiso")
+    K, B = _symmetric_tangent()
+    indefinite = (K - 0.05 * abs(K).max() * sp.eye(K.shape[0], format="csr")).tocsr()
+    indefinite.sort_indices()
+    assert ls.Pattern(indefinite).matches(K)  # the same pattern, other values
+    kinds = _types(monkeypatch)
+    factors = []
+    original = pd.Pardiso.factor
+    monkeypatch.setattr(
+        pd.Pardiso, "factor", lambda self, data: factors.append(self.mtype.value) or original(self, data)
+    )
+    solver = ls.LinearSolver()
+    for M in (K, indefinite, indefinite, K, K):
+        x = solver.factorize(M)(B)
+        ref = spsolve(M.tocsc(), B)
+        assert np.abs(x - ref).max() <= 1e-10 * np.abs(ref).max()
+    assert factors == [2, 2, -2, -2, -2, 2]
+    assert kinds == ["definite", "symmetric"]
 
 
 def test_symmetric_pattern_needs_its_diagonal(monkeypatch):
@@ -273,12 +298,13 @@ def test_symmetric_pattern_needs_its_diagonal(monkeypatch):
     for M in (A, C):
         x = ls.factorize(M)(B)
         assert np.abs(M @ x - B).max() <= 1e-9 * np.abs(B).max()
-    assert kinds == [False, False]
+    assert kinds == ["general", "general"]
 
 
 def test_symmetric_singular_goes_on_to_lu_and_superlu(monkeypatch):
-    """A symmetric K with a zero row and column (stored zeros: the pattern is kept) has a
-    perturbed pivot in the symmetric factorization, then in the LU, and SuperLU raises."""
+    """A symmetric K with a zero row and column (stored zeros: the pattern is kept) stops
+    Cholesky, has a perturbed pivot in the symmetric indefinite factorization, then in the LU,
+    and SuperLU raises."""
     _backend(monkeypatch, "pardiso")
     K, B = _symmetric_tangent(seed=3)
     rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
@@ -286,4 +312,4 @@ def test_symmetric_singular_goes_on_to_lu_and_superlu(monkeypatch):
     kinds = _types(monkeypatch)
     with pytest.raises(ls.SingularTangentError):
         ls.factorize(K)(B)
-    assert kinds == [True, False]
+    assert kinds == ["definite", "symmetric", "general"]

@@ -241,19 +241,33 @@ class System:
 
     # ---- evaluation ----------------------------------------------------------------------------
     def evaluate(
-        self, u_f: np.ndarray, t: float, state: ModelState | None = None, tangent: bool = True, predicting: bool = False
+        self,
+        u_f: np.ndarray,
+        t: float,
+        state: ModelState | None = None,
+        tangent: bool = True,
+        predicting: bool = False,
+        deferred: bool = False,
     ) -> Evaluation:
         """Residual R = f_int - f_ext(t) - f_contact - sum p g (cavities) on the free
         equations, then the terms' constraints; dR/dt; the (bordered) tangent: the sum of the
         terms' contributions at u_f (n_free,) and time t, from the committed history `state`
         (default: the initial state), whose trial successor the Evaluation carries (`trial`).
         Nothing is kept in the system.  predicting: the tangent of a step's first iteration
-        (contact.pair.ContactPair.evaluate)."""
+        (contact.pair.ContactPair.evaluate).  deferred: the tangent made only when the
+        Evaluation's K is first read (by another evaluation at the same u_f, t and state: a
+        check of convergence that passes needs none), where dR/dt does not need it (no
+        prescribed dof moves) and no rigid mode is to be checked against it."""
         if state is None:
             state = self.initial_state()
         dm = self.dofmap
         nf = dm.nf
         presc, presc_rate = self.prescribed(t)
+        if tangent and deferred and not self.rigid_modes.shape[1] and not (dm.np and presc_rate.any()):
+            ev = self.evaluate(u_f, t, state, False, predicting)
+            held = u_f.copy()  # the caller may move its u_f before K is read
+            ev.tangent = lambda: self.evaluate(held, t, state, True, predicting).K
+            return ev
         u = dm.expand(u_f, presc)
         temperature = self.temperature_at(state, t)
         base = EvaluationContext(tangent, predicting, temperature)

@@ -5,10 +5,12 @@ The solver is chosen by the size n of K (benchmarks/README.md § 3.2 measured ea
 
 - n <= DENSE_MAX: dense LAPACK LU (getrf / getrs), where the sparse solvers' fixed costs
   exceed the whole dense work;
-- larger: MKL PARDISO (pardiso.py), the symmetric indefinite factorization of the upper
-  triangle where K is symmetric to round-off (|K - K^T| <= SYMMETRY |K| entry by entry,
-  checked on every K: 0.45 to 0.65 of the time of an LU, benchmarks/README.md § 8), else
-  the non-symmetric LU with weighted matching; the ordering (minimum degree below
+- larger: MKL PARDISO (pardiso.py), a symmetric factorization of the upper triangle where
+  K is symmetric to round-off (|K - K^T| <= SYMMETRY |K| entry by entry, checked on every
+  K: 0.45 to 0.65 of the time of an LU, benchmarks/README.md § 8): Cholesky while the
+  tangents of its pattern are positive definite (a stable solid: 10 to 20 % less than the
+  indefinite one), else the symmetric indefinite one; otherwise the non-symmetric LU with
+  weighted matching; the ordering (minimum degree below
   pardiso.MINIMUM_DEGREE_MAX unknowns, METIS nested dissection above) and the symbolic
   factorization once for each pattern and matrix type;
 - without MKL (not x86-64): SciPy's SuperLU with the column ordering minimum degree on
@@ -17,8 +19,12 @@ The solver is chosen by the size n of K (benchmarks/README.md § 3.2 measured ea
   minimum degree on K^T + K assumes diagonal pivots and on some tangents the fill grew 3x
   (Q4) to 12x (SFR) (benchmarks/README.md).
 
-PARDISO does not fail on a zero pivot: it replaces pivots below 1e-13 |K| and counts them.
-A symmetric K with such a pivot goes to the LU with matching; a K whose LU still has one is
+A Cholesky factorization that meets a pivot that is not positive stops there, and K goes to
+the symmetric indefinite one; the pattern's later tangents go there directly until one of
+them has no negative pivot (then Cholesky again: the type follows the path, with no more
+than one failed Cholesky in a row).  PARDISO's other types do not fail on a zero pivot: they
+replace pivots below 1e-13 |K| and count them.  A symmetric K with such a pivot goes to the
+LU with matching; a K whose LU still has one is
 singular: it goes to SuperLU, which raises on an exact zero pivot or answers (b in the range
 of K: an unloaded rigid mode, harmless), as dense LU does.
 
@@ -67,7 +73,9 @@ class Pattern:
     once: its int32 arrays for PARDISO and, where the pattern is symmetric (every stored entry
     has its mirror stored, every diagonal entry is stored), the positions of the entries on
     and above the diagonal (`upper`, in K.data), of their mirrors (`mirror`) and the upper
-    triangle's int32 CSR arrays."""
+    triangle's int32 CSR arrays, and whether its next symmetric K is tried by Cholesky
+    (`definite`: until a K of the pattern is not positive definite, then again after one
+    factorized with no negative pivot)."""
 
     def __init__(self, K: sp.csr_matrix):
         n = K.shape[0]
@@ -83,6 +91,7 @@ class Pattern:
             and np.array_equal(rows[by_column], K.indices)
             and np.count_nonzero(K.indices == rows) == n  # PARDISO's symmetric types need every diagonal entry
         )
+        self.definite = True
         if self.symmetric:
             self.upper = np.flatnonzero(K.indices >= rows)
             self.mirror = by_column[self.upper]  # K^T's entry at the place of each upper one
@@ -170,13 +179,13 @@ class LinearSolver:
             self._patterns = [pattern, *self._patterns[: PATTERNS_KEPT - 1]]
         return pattern
 
-    def _take(self, pattern: Pattern, symmetric: bool, lib) -> Pardiso:
-        """An idle handle: one analysed for this pattern and type, else the one left longest
-        of those whose pattern is no longer kept (analysed anew), else a new one (a K that
-        goes from symmetric to not and back keeps both analyses)."""
+    def _take(self, pattern: Pattern, kind: tuple[bool, bool], lib) -> Pardiso:
+        """An idle handle: one analysed for this pattern and kind (symmetric, definite), else
+        the one left longest of those whose pattern is no longer kept (analysed anew), else a
+        new one (a K that goes from symmetric to not and back keeps both analyses)."""
         with self._lock:
             for k, s in enumerate(self._idle):
-                if s.key is pattern and s.symmetric == symmetric:
+                if s.key is pattern and (s.symmetric, s.definite) == kind:
                     return self._idle.pop(k)
             for k, s in enumerate(self._idle):
                 if not any(s.key is kept for kept in self._patterns):
@@ -188,32 +197,44 @@ class LinearSolver:
             self._idle.append(handle)
 
     def _pardiso(self, K: sp.csr_matrix, lib) -> Factorization:
-        """The symmetric factorization where K is symmetric to round-off and its pivots are
-        found, else the LU with matching, else (a perturbed pivot: K singular) SuperLU."""
+        """Where K is symmetric to round-off: Cholesky while its pattern's tangents are
+        positive definite, else (or where it meets a pivot that is not positive) the symmetric
+        indefinite factorization if its pivots are found; else the LU with matching, else (a
+        perturbed pivot: K singular) SuperLU."""
         pattern = self._pattern(K)
         data = np.ascontiguousarray(K.data, dtype=float)
         upper = pattern.symmetric_values(data)
         if upper is not None:
-            out = self._factor(pattern, True, upper, lib)
+            if pattern.definite:
+                out = self._factor(pattern, (True, True), upper, lib)
+                if out is not None:
+                    return out
+                pattern.definite = False
+            out = self._factor(pattern, (True, False), upper, lib)
             if out is not None:
                 return out
-        out = self._factor(pattern, False, data, lib)
+        out = self._factor(pattern, (False, False), data, lib)
         return out if out is not None else Factorization(self._superlu(K))
 
-    def _factor(self, pattern: Pattern, symmetric: bool, data: np.ndarray, lib) -> Factorization | None:
+    def _factor(self, pattern: Pattern, kind: tuple[bool, bool], data: np.ndarray, lib) -> Factorization | None:
         """PARDISO's factorization of the values data in the pattern (its upper triangle where
-        symmetric); None where a pivot was perturbed."""
-        s = self._take(pattern, symmetric, lib)
+        symmetric) of the kind (symmetric, definite); None where a pivot was perturbed or,
+        definite, not positive.  A symmetric indefinite one with no negative pivot sends the
+        pattern's next K to Cholesky."""
+        symmetric, definite = kind
+        s = self._take(pattern, kind, lib)
         try:
-            if s.key is not pattern or s.symmetric != symmetric:
-                s.analyse(*(pattern.triangle if symmetric else pattern.full), data, symmetric, pattern)
-            s.factor(data)
+            if s.key is not pattern or (s.symmetric, s.definite) != kind:
+                s.analyse(*(pattern.triangle if symmetric else pattern.full), data, symmetric, pattern, None, definite)
+            factorized = s.factor(data)
         except BaseException:
             self._give_back(s)
             raise
-        if s.perturbed:
+        if not factorized or s.perturbed:
             self._give_back(s)
             return None
+        if symmetric and not definite and not s.negative:
+            pattern.definite = True
 
         def solve(b: np.ndarray) -> np.ndarray:
             return _check(s.solve(data, np.asarray(b, dtype=float)))

@@ -51,17 +51,28 @@ def converged(ev: Evaluation, lam: float, opts: NewtonOptions, floor: float, res
     return (norm <= opts.tolerance * ref or norm <= ev.noise) and ev.constraint_error <= opts.tolerance
 
 
-def evaluate_checked(model: System, history: ModelState, u_f, lam, predicting: bool = False) -> Evaluation:
+def hopeful(ev: Evaluation, lam: float, opts: NewtonOptions, floor: float) -> bool:
+    """Whether the next iteration is expected to converge: a residual within sqrt(tolerance)
+    of the reference, which a quadratic step takes below the tolerance (its evaluation
+    then defers its tangent, needed only where it does not).  Under displacement control
+    alone: a load path's predictor reads the tangent of the converged state."""
+    return ev.force_norm <= np.sqrt(opts.tolerance) * reference_force(ev, lam, floor)
+
+
+def evaluate_checked(
+    model: System, history: ModelState, u_f, lam, predicting: bool = False, deferred: bool = False
+) -> Evaluation:
     """model.evaluate from the committed history, failing the step on an inverted element, a residual that is not finite
     or a tangent with a free rigid translation (guards.evaluation_fault); ending the path (PathEnded) where a
-    temperature left the domain of the shift of the relaxation times."""
+    temperature left the domain of the shift of the relaxation times.  deferred: the tangent made when first read
+    (System.evaluate)."""
     try:
-        ev = model.evaluate(u_f, lam, history, predicting=predicting)
+        ev = model.evaluate(u_f, lam, history, predicting=predicting, deferred=deferred)
     except (InvertedElementError, LocalUpdateError) as exc:
         raise StepFailed(str(exc)) from exc
     except TemperatureDomainError as exc:  # a temperature beyond the shift's pole: no step size helps
         raise PathEnded(f"the material left the domain of its shift: {exc}") from exc
-    fault = evaluation_fault(model, ev.r_full, ev.K)
+    fault = evaluation_fault(model, ev.r_full, None if ev.deferred else ev.K)  # deferred: no rigid mode
     if fault:
         raise StepFailed(fault)
     return ev
@@ -145,8 +156,9 @@ def newton_displacement(model, history, u_f, lam, c, target, opts, floor, linear
 
 def _newton_displacement_from(model, history, u_f, lam, c, target, opts, floor, linear):
     residuals: list[float] = []
+    deferred = False
     for it in range(opts.max_iterations + 1):
-        ev = evaluate_checked(model, history, u_f, lam)
+        ev = evaluate_checked(model, history, u_f, lam, deferred=deferred)
         if it > 0 and converged(ev, lam, opts, floor, residuals):
             return u_f, lam, it, residuals, ev
         if it == 0:
@@ -158,6 +170,7 @@ def _newton_displacement_from(model, history, u_f, lam, c, target, opts, floor, 
         if abs(b[c]) < 1e-300:
             raise StepFailed("the driven dof does not respond to the load")
         dlam = (target - u_f[c] - a[c]) / b[c]
+        deferred = hopeful(ev, lam, opts, floor)
         u_f += a + dlam * b
         lam += dlam
     raise StepFailed(f"no convergence in {opts.max_iterations} iterations")

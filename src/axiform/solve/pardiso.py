@@ -2,13 +2,18 @@
 sparsity pattern, phase 11 (ordering and symbolic factorization) once for each pattern, then
 phase 22 (numerical factorization) for each matrix and phase 33 for each solve.
 
-Two matrix types are used (benchmarks/README.md § 8 measured both on the same tangents):
+Three matrix types are used (benchmarks/README.md § 8 measured them on the same tangents):
 
+- real symmetric positive definite (mtype 2, Cholesky without pivoting) on the upper
+  triangle, for a tangent symmetric to round-off whose last symmetric factorization had no
+  negative pivot: 10 to 20 % less time than mtype -2 from 1e3 to 2e4 unknowns, its solves
+  15 to 25 % less.  A non-positive pivot stops it at once (error -4, `factor` answers
+  False) and the caller goes on to mtype -2;
 - real symmetric indefinite (mtype -2, Bunch-Kaufman pivots within the supernodes) on the
   upper triangle, for a tangent that is symmetric to round-off (a hyperelastic solid, mixed
   or not, a frictionless penalty contact, a pressure on a whole face between supports): its
   factors are half those of an LU, and it factorizes in 0.45 to 0.65 of the time of mtype 11
-  from 1e3 to 2e4 unknowns;
+  from 1e3 to 2e4 unknowns; it counts its negative pivots (`negative`);
 - real non-symmetric (mtype 11) with scaling and weighted matching, for the others.
   Structurally symmetric (mtype 1) and mtype 11 without matching factorize in the same time
   on the non-symmetric tangents measured (the matching costs the analysis, once a pattern),
@@ -99,9 +104,10 @@ def int32(a: np.ndarray, what: str) -> np.ndarray:
 class Pardiso:
     """One PARDISO handle (zero-based CSR): analyse() once per pattern and matrix type,
     factor() per matrix, solve() per set of right-hand sides, release() (phase -1).
-    `symmetric`: real symmetric indefinite on the upper triangle (mtype -2), else real
-    non-symmetric (mtype 11).  Below PARALLEL_MIN unknowns every phase runs on one thread
-    (MKL's threads gain nothing there: benchmarks/README.md § 3.2).  Pivots below 1e-13 |K|
+    `symmetric`: on the upper triangle, real symmetric indefinite (mtype -2) or, `definite`,
+    positive definite (mtype 2); else real non-symmetric (mtype 11).  Below PARALLEL_MIN
+    unknowns every phase runs on one thread (MKL's threads gain nothing there:
+    benchmarks/README.md § 3.2).  Pivots below 1e-13 |K|
     are perturbed and counted (`perturbed`): the caller then takes another solver.  The
     pointers to the scalars, the handle and the pattern are made once per pattern, those to
     the values and the right-hand sides per call (benchmarks/README.md § 3.6)."""
@@ -124,7 +130,7 @@ class Pardiso:
         self._dummy = np.zeros(1)
         self.threads = 0  # 0: MKL's own setting
         self.key: object = None  # what the analysis was made for (the caller's pattern), None: nothing
-        self.symmetric = False
+        self.symmetric = self.definite = False
 
     def _call(self, phase: int, data: np.ndarray, b: np.ndarray | None = None, x: np.ndarray | None = None) -> int:
         if self.threads:
@@ -165,16 +171,19 @@ class Pardiso:
         symmetric: bool,
         key,
         variant: tuple[int, int, int] | None = None,
+        definite: bool = False,
     ) -> None:
         """Phase 11: ordering and symbolic factorization of the CSR pattern (indptr, indices:
-        int32, sorted; the upper triangle where symmetric), made for `key`.  variant: (matrix
-        type, scaling and matching 0 / 1, ordering 0 minimum degree / 2 METIS) instead of
-        those chosen here (benchmarks/pardiso_types.py compares them)."""
+        int32, sorted; the upper triangle where symmetric), made for `key`; definite (with
+        symmetric): for the positive definite type.  variant: (matrix type, scaling and
+        matching 0 / 1, ordering 0 minimum degree / 2 METIS) instead of those chosen here
+        (benchmarks/pardiso_types.py compares them)."""
         self.release()
         n = len(indptr) - 1
         self.threads = 1 if n < PARALLEL_MIN else 0
         self.iparm[1] = 0 if n <= MINIMUM_DEGREE_MAX else 2
-        self.mtype.value = -2 if symmetric else 11
+        definite = definite and symmetric
+        self.mtype.value = (2 if definite else -2) if symmetric else 11
         self.iparm[10] = self.iparm[12] = 0 if symmetric else 1  # scaling and weighted matching: mtype 11
         if variant is not None:
             self.mtype.value, self.iparm[10], self.iparm[1] = variant
@@ -185,13 +194,24 @@ class Pardiso:
         error = self._call(11, data)
         if error:
             raise SingularTangentError(f"PARDISO analysis failed (error {error})")
-        self.key, self.symmetric = key, symmetric
+        self.key, self.symmetric, self.definite = key, symmetric, definite
 
-    def factor(self, data: np.ndarray) -> None:
-        """Phase 22: numerical factorization of the values data (in the analysed pattern)."""
+    def factor(self, data: np.ndarray) -> bool:
+        """Phase 22: numerical factorization of the values data (in the analysed pattern);
+        False where the positive definite type met a pivot that is not positive (the matrix
+        is not positive definite: nothing to solve with)."""
         error = self._call(22, data)
+        if error == -4 and self.definite:
+            return False
         if error:
             raise SingularTangentError(f"PARDISO factorization failed (error {error})")
+        return True
+
+    @property
+    def negative(self) -> int:
+        """The number of negative pivots of the last symmetric indefinite factorization (the
+        negative eigenvalues of the matrix)."""
+        return int(self.iparm[22])
 
     @property
     def perturbed(self) -> int:
