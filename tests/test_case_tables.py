@@ -12,7 +12,7 @@ import pytest
 from pydantic import BaseModel
 
 from axiform.case.schema import CaseError, parse
-from axiform.case.tables import TABLES, Case, table_schema, validator
+from axiform.case.tables import SCHEMAS, TABLES, Case, table_schema, validator
 
 PLATE = Path(__file__).resolve().parents[1] / "examples" / "hughes_carnoy_plate.toml"
 
@@ -23,6 +23,7 @@ def plate() -> dict:
 
 def test_every_table_is_a_field_of_the_case_in_the_same_order_with_a_schema():
     assert [f.name for f in dataclasses.fields(Case)] == list(TABLES)
+    assert SCHEMAS.keys() == TABLES.keys() - {"title"}
     for key, shape in TABLES.items():
         if shape != "title":
             assert issubclass(table_schema(key), BaseModel), key

@@ -6,14 +6,15 @@ their schemas, nor the model code behind them.  `validator(keys)` is the pydanti
 case holding the top-level keys `keys` (cached per set of keys): every key of TABLES is a
 field of it, in the order of TABLES (the order its errors are listed in), a present table
 typed by its schema, an absent one by its default.  `Case` is what it validates into.  A new
-top-level table: its key and shape in TABLES, its schema's import in `table_schema`, its field
-in `Case` (tests/test_case_tables.py holds the three together).
+top-level table: its key and shape in TABLES, its schema's module and class in SCHEMAS, its
+field in `Case` (tests/test_case_tables.py holds the three together).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cache
+from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
 from pydantic import BaseModel, create_model
@@ -57,56 +58,32 @@ TABLES = {
 }
 
 
+# the module (of this package) and class of each top-level key's table schema
+SCHEMAS = {
+    "mesh": ("mesh", "MeshSpec"),
+    "material": ("material", "MaterialSpec"),
+    "fix": ("loads", "FixSpec"),
+    "pressure": ("loads", "PressureSpec"),
+    "point_load": ("loads", "PointLoadSpec"),
+    "monitor": ("monitor", "MonitorSpec"),
+    "contact": ("contact", "ContactSpec"),
+    "cavity": ("cavity", "CavitySpec"),
+    "solver": ("solver", "SolverSpec"),
+    "output": ("output", "OutputSpec"),
+    "restart": ("output", "RestartSpec"),
+    "units": ("output", "UnitsSpec"),
+    "temperature": ("temperature", "TemperatureSpec"),
+    "thermal": ("thermal", "ThermalSpec"),
+    "convection": ("thermal", "ConvectionSpec"),
+    "gravity": ("gravity", "GravitySpec"),
+}
+
+
 def table_schema(key: str) -> type[BaseModel]:
     """The schema (a pydantic model) of one table of the top-level key `key` (of TABLES, not
     title), its module imported now."""
-    if key == "mesh":
-        from .mesh import MeshSpec
-
-        return MeshSpec
-    if key == "material":
-        from .material import MaterialSpec
-
-        return MaterialSpec
-    if key in ("fix", "pressure", "point_load"):
-        from .loads import FixSpec, PointLoadSpec, PressureSpec
-
-        loads: dict[str, type[BaseModel]] = {"fix": FixSpec, "pressure": PressureSpec, "point_load": PointLoadSpec}
-        return loads[key]
-    if key == "monitor":
-        from .monitor import MonitorSpec
-
-        return MonitorSpec
-    if key == "contact":
-        from .contact import ContactSpec
-
-        return ContactSpec
-    if key == "cavity":
-        from .cavity import CavitySpec
-
-        return CavitySpec
-    if key == "solver":
-        from .solver import SolverSpec
-
-        return SolverSpec
-    if key in ("output", "restart", "units"):
-        from .output import OutputSpec, RestartSpec, UnitsSpec
-
-        outputs: dict[str, type[BaseModel]] = {"output": OutputSpec, "restart": RestartSpec, "units": UnitsSpec}
-        return outputs[key]
-    if key == "temperature":
-        from .temperature import TemperatureSpec
-
-        return TemperatureSpec
-    if key in ("thermal", "convection"):
-        from .thermal import ConvectionSpec, ThermalSpec
-
-        return ThermalSpec if key == "thermal" else ConvectionSpec
-    if key == "gravity":
-        from .gravity import GravitySpec
-
-        return GravitySpec
-    raise KeyError(key)
+    module, name = SCHEMAS[key]
+    return getattr(import_module(f"{__package__}.{module}"), name)
 
 
 def _field(key: str, present: bool) -> tuple[Any, Any]:
