@@ -97,7 +97,7 @@ def test_newton_defers_the_tangent_of_its_last_check(monkeypatch):
 def test_a_small_term_accumulates_as_a_whole_array_would():
     """SparsePattern.accumulate sums a term of few entries (the pressure) over its own
     positions: the data array is the one a bincount over the whole pattern gives, number for
-    number, and the distinct positions are found once per positions array."""
+    number, over the distinct positions found when the positions were (SparsePattern.positions)."""
     system, u_f = plate()
     pattern = system.pattern
     (solid,), (pressure,) = system.positions
@@ -107,5 +107,6 @@ def test_a_small_term_accumulates_as_a_whole_array_would():
     data = pattern.accumulate(solid, a)
     expected = data + np.bincount(pressure, weights=b, minlength=len(pattern.keys))
     assert np.array_equal(pattern.accumulate(pressure, b, data), expected)
-    first = pattern._distinct(pressure)
-    assert pattern._distinct(pressure)[0] is first[0]
+    held, distinct, _ = pattern._few[id(pressure)]
+    assert held is pressure and np.array_equal(distinct, np.unique(pressure))
+    assert id(solid) not in pattern._few  # the solid's are summed over the whole pattern

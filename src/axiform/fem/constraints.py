@@ -88,7 +88,8 @@ class SparsePattern:
         self._ff_csr = self._sub(rows[ff], cols[ff], nf, nf)
         self._fp_csr = self._sub(rows[fp], cols[fp] - nf, nf, dofmap.np)
         self._fp_rows, self._fp_cols = rows[fp], cols[fp] - nf
-        self._distinct_of: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        # the terms of few entries: id of their positions -> (positions, distinct ones, inverse)
+        self._few: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
     def _keys(self, dofs: np.ndarray) -> np.ndarray:
         eq = self.dofmap.eq[dofs]  # (m, k)
@@ -100,33 +101,29 @@ class SparsePattern:
         return cols.astype(np.int32), indptr.astype(np.int32), (nr, nc)
 
     def positions(self, dofs: np.ndarray) -> np.ndarray:
-        """Positions in the data array of each entry (m, k, k) of blocks on these dofs."""
-        return self._slot[np.searchsorted(self.keys, self._keys(dofs)).ravel()]
+        """Positions in the data array of each entry (m, k, k) of blocks on these dofs.  For a
+        term with fewer entries than a quarter of the pattern's (a pressure, a contact pair)
+        its distinct positions and where each entry goes among them are kept with the array
+        (`accumulate` sums over them)."""
+        pos = self._slot[np.searchsorted(self.keys, self._keys(dofs)).ravel()]
+        if 4 * pos.size < len(self.keys):
+            distinct, inverse = np.unique(pos, return_inverse=True)
+            self._few[id(pos)] = (pos, distinct, inverse.ravel())  # the array held: its id is not reused
+        return pos
 
     def accumulate(self, positions: np.ndarray, values: np.ndarray, data: np.ndarray | None = None):
         """Add values (matching positions) into a data array of the pattern.  Into a data array
-        given, a term with fewer entries than a quarter of the pattern's (a pressure, a contact
-        pair) is summed over its own distinct positions and added there, not over a whole array
-        of the pattern (the same sums)."""
+        given, a term of few entries (`positions`) is summed over its own distinct positions
+        and added there, not over a whole array of the pattern (the same sums)."""
         if data is None:
             return np.bincount(positions, weights=values.ravel(), minlength=len(self.keys))
-        if 4 * positions.size < len(self.keys):
-            distinct, inverse = self._distinct(positions)
+        few = self._few.get(id(positions))
+        if few is not None and few[0] is positions:
+            distinct, inverse = few[1], few[2]
             data[distinct] += np.bincount(inverse, weights=values.ravel(), minlength=distinct.size)
             return data
         data += np.bincount(positions, weights=values.ravel(), minlength=len(self.keys))
         return data
-
-    def _distinct(self, positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The distinct positions of a term's (fixed) positions array and where each entry goes
-        among them, found once per array (kept with it, so that its id is not reused)."""
-        held = self._distinct_of.get(id(positions))
-        if held is None or held[0] is not positions:
-            if len(self._distinct_of) >= 64:  # arrays of the terms of a system: a few; others not kept
-                self._distinct_of.clear()
-            distinct, inverse = np.unique(positions, return_inverse=True)
-            held = self._distinct_of[id(positions)] = (positions, distinct, inverse.ravel())
-        return held[1], held[2]
 
     def free_block(self, data: np.ndarray) -> sp.csr_matrix:
         """K_ff (free rows and columns) as a CSR matrix on a view of data."""
