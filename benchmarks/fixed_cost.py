@@ -11,8 +11,9 @@ Each repeat runs, in turn (and for each source tree when --before is given):
 - vtu: the same with the VTU series on (plots off);
 - default: the case's default outputs (VTU and the three pictures);
 - and, to read the others by: the imports of a run (`axiform.app.run`, the case schema and
-  the plate's tables, the results writer, the solver) and matplotlib's (`matplotlib.figure`, its Agg canvas), each
-  beside NumPy and scipy.sparse, less the floor.
+  the plate's tables, the results writer, the solver), the schema library's own floor (pydantic
+  imported, one model made, one value validated) and matplotlib's imports (`matplotlib.figure`,
+  its Agg canvas), each beside NumPy and scipy.sparse, less the floor.
 A run is `axiform.cli.main` in a fresh Python, whose `solve`
 is wrapped to record its wall and CPU time (the solve as summary.json's wall_time_s counts it:
 the steps and their per-step files), and the results writer's `_plot` (the three pictures,
@@ -22,8 +23,8 @@ table gives the least of the repeats of each quantity: the fixed cost (whole pro
 its solve, per run, then the least), the pictures (timed in the run; default minus vtu as a
 check) and the VTU series (vtu minus off), each also as a multiple of the floor.  The runs
 write their bytecode caches (PYTHONDONTWRITEBYTECODE is dropped), as an installed axiform has
-them; one unmeasured run of each tree comes first.  --fixed-only: the floor, a run's imports
-and the run with outputs off alone (the fixed cost's rows of the table).
+them; one unmeasured run of each tree comes first.  --fixed-only: the floor, a run's imports,
+the schema library's floor and the run with outputs off alone (the fixed cost's rows of the table).
 """
 
 from __future__ import annotations
@@ -48,6 +49,9 @@ IMPORTS = {
     "imports": "import numpy, scipy.sparse, axiform.app.run, axiform.case.schema, axiform.case.material, "
     "axiform.case.monitor, axiform.io.results, axiform.solve.solver",
     "mpl": "import numpy, scipy.sparse, matplotlib.figure, matplotlib.backends.backend_agg",
+    # the schema library's own floor: pydantic imported, one model made and one value validated
+    "schema": "import numpy, scipy.sparse, pydantic\n"
+    "class A(pydantic.BaseModel):\n    x: float\nA.model_validate({'x': 1.0})",
 }
 
 # the child: axiform's command line, its solve and its pictures (the results writer's _plot)
@@ -107,7 +111,7 @@ def summary(runs: dict[str, list[dict[str, float]]]) -> dict[str, float]:
     out = {}
     for clock in ("wall", "cpu"):
         floor = least(runs["floor"], lambda r, c=clock: r[c])
-        for kind in ("imports", "mpl"):
+        for kind in ("imports", "schema", "mpl"):
             out[f"{kind}_{clock}"] = least(runs[kind], lambda r, c=clock: r[c]) - floor if runs[kind] else nan
         off = least(runs["off"], lambda r, c=clock: r[c])
         vtu = least(runs["vtu"], lambda r, c=clock: r[c]) if runs["vtu"] else nan
@@ -143,12 +147,13 @@ def table(results: dict[str, dict[str, float]]) -> str:
         "difference": "the same as default minus vtu (two least values: noisier)",
         "default": "whole process, default outputs",
         "imports": "a run's imports (app.run, the plate's case tables, writer, solver), less the floor",
+        "schema": "pydantic's import, one model and one validation, less the floor",
         "mpl": "matplotlib's imports (figure, Agg canvas), less the floor",
     }
     names = {k: v for k, v in names.items() if not all(math.isnan(results[lb][f"{k}_{c}"]) for lb, c in heads)}
     for key, name in names.items():  # the rows of what was run
         lines.append(f"| {name} | " + " | ".join(f"{results[lb][f'{key}_{c}']:.3f}" for lb, c in heads) + " |")
-    for key in [k for k in ("fixed", "pictures", "imports", "mpl") if k in names]:
+    for key in [k for k in ("fixed", "pictures", "imports", "schema", "mpl") if k in names]:
         lines.append(
             f"| {key} / floor | "
             + " | ".join(f"**{results[lb][f'{key}_{c}'] / results[lb][f'floor_{c}']:.2f}**" for lb, c in heads)
@@ -163,13 +168,13 @@ def main() -> None:
     parser.add_argument("--before", type=Path, help="another source tree (its src/), run in turn with this one")
     parser.add_argument("--after", type=Path, default=ROOT / "src")
     parser.add_argument("--case", type=Path, default=ROOT / "examples" / "hughes_carnoy_plate.toml")
-    parser.add_argument("--fixed-only", action="store_true", help="the floor, the imports and the run with outputs off")
+    parser.add_argument("--fixed-only", action="store_true", help="the fixed cost's rows alone")
     args = parser.parse_args()
     trees = {"after": args.after.resolve()}
     if args.before is not None:
         trees = {"before": args.before.resolve(), **trees}
-    everything = ("floor", "imports", "mpl", "off", "vtu", "default")
-    kinds = ("floor", "imports", "off") if args.fixed_only else everything
+    everything = ("floor", "imports", "schema", "mpl", "off", "vtu", "default")
+    kinds = ("floor", "imports", "schema", "off") if args.fixed_only else everything
     runs: dict[str, dict[str, list[dict[str, float]]]] = {label: {kind: [] for kind in everything} for label in trees}
     print(f"load average at start: {os.getloadavg()[0]:.2f}", flush=True)
     with tempfile.TemporaryDirectory(prefix="axiform-fixed-cost-") as tmp:

@@ -2,7 +2,8 @@
 cycle between modules (imports under TYPE_CHECKING and inside functions count), no import
 from a package to a package above it in LAYERS (the order axiform/__init__.py states), no
 module over MAX_MODULE_LINES lines, no function over MAX_FUNCTION_LINES, no private name
-(a leading underscore) imported from another module."""
+(a leading underscore) imported from another module; the benchmarks' scripts under
+MAX_BENCHMARK_LINES lines together."""
 
 from __future__ import annotations
 
@@ -18,6 +19,8 @@ PACKAGE = SRC / "axiform"
 LAYERS = ("axiform", "materials", "fem", "contact", "model", "solve", "post", "io", "case", "design", "app", "cli")
 MAX_MODULE_LINES = 450
 MAX_FUNCTION_LINES = 80
+BENCHMARKS = SRC.parent / "benchmarks"
+MAX_BENCHMARK_LINES = 4000  # the speed studies' Python, all together (a study run once goes to git history)
 
 
 def modules() -> dict[str, Path]:
@@ -115,6 +118,12 @@ def test_no_module_over_the_line_limit():
         if (n := len(path.read_text(encoding="utf-8").splitlines())) > MAX_MODULE_LINES
     }
     assert not long, f"modules over {MAX_MODULE_LINES} lines: {long}"
+
+
+def test_the_benchmarks_stay_under_their_line_budget():
+    lines = {path.name: len(path.read_text(encoding="utf-8").splitlines()) for path in BENCHMARKS.glob("*.py")}
+    assert lines, "the benchmarks' scripts are where this test looks for them"
+    assert sum(lines.values()) < MAX_BENCHMARK_LINES, f"benchmarks/*.py: {sum(lines.values())} lines: {lines}"
 
 
 def long_functions() -> dict[str, int]:
