@@ -14,7 +14,7 @@ whose settings changed with the study; the others from examples/).  Prints a mar
 
     python benchmarks/step_control.py --optimize [--before OLD/src] [--repeat 3]
 
-The heater example's optimize against plain runs of it (DESIGN.md § 17: at most 8 forward
+The heater example's optimize against plain runs of it (the goal: at most 8 forward
 runs' time): each repeat runs, for each tree in turn (the one of --before, if given, then
 --after), `axiform run examples/cup_heater_programming.toml` (its default outputs) and
 `axiform optimize` on it as docs/guide.md gives it (`--vary temperature`, the target

@@ -2,7 +2,8 @@
 
 It keeps its work as it goes: optimize.csv gets a row per iteration as the iteration is
 found, optimized.toml the best finished design so far (a case file that runs as it is); at
-the end optimize.json, optimize.png and the run of the best design in final/.  SIGINT or
+the end optimize.json, optimize.png and the results of the best design in final/ (written
+from its solve where the case allows: app/optimize_final.py).  SIGINT or
 SIGTERM, also during the final run, stops it with exit 130 or 143 and these files kept
 (optimize.json then says "interrupted").  Exit 0 finished, 1 stopped short, 2 invalid input.
 """
