@@ -33,6 +33,11 @@ Forward differences (`differences="forward"`: the shadow at s + h e_k against th
 itself) halve the evaluations; their error is O(h) (they differ from the central ones by
 6.4e-5 of the largest derivative of a sticky tube's wall), which a Gauss-Newton method does not
 notice: `axiform optimize` uses them.
+
+The steps are differentiated as they converge (`sensitivity`) or after the solve, from its
+kept steps (`differentiate`), to the same numbers: a caller that learns only after a solve
+whether it wants the derivatives (an optimizer that rejects the design) pays for them only
+when it does.
 """
 
 from __future__ import annotations
