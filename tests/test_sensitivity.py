@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from axiform.case.schema import build, parse
-from axiform.design.sensitivity import DesignError, sensitivity
+from axiform.design.sensitivity import DesignError, differentiate, sensitivity
 from axiform.post.thickness import thickness_table
 from axiform.solve.solver import ArcLengthControl, NewtonOptions, solve
 
@@ -185,3 +185,28 @@ def test_forward_differences_of_the_residual_agree_with_central_ones_to_what_opt
     assert np.abs(forward_.dx_ds - central.dx_ds).max() <= 1e-6 * np.abs(central.dx_ds).max()
     with pytest.raises(ValueError, match="differences must be"):
         sensitivity(builder(tree), x0, built.control, built.options, differences="backward")
+
+
+@pytest.mark.parametrize("differences", ["central", "forward"])
+def test_derivatives_after_the_solve_are_those_taken_during_it(differences):
+    """differentiate: a solve done first (every step kept), its steps differentiated after it,
+    gives the very derivatives of `sensitivity` (which differentiates each step as it
+    converges) on the sticky tube with cut steps, whose history counts; a solve that kept
+    only some of its steps is refused."""
+    tree = tube("mixed", contact={"sticky": True})
+    tree["solver"].update(max_iterations=6)
+    built = build(parse(tree))
+    x0 = np.array([row[1] for row in tree["mesh"]["thickness"]])
+    during = sensitivity(builder(tree), x0, built.control, built.options, differences=differences)
+    assert during.solve.cuts > 0
+    model = builder(tree)(x0).finalize()
+    result = solve(model, built.control, built.options)
+    after = differentiate(builder(tree), x0, model, result, differences=differences)
+    assert after.solve is result and len(after.du_ds) == len(during.du_ds) == result.n_steps
+    for a, b in zip(after.du_ds, during.du_ds, strict=True):
+        assert np.array_equal(a, b)
+    assert np.array_equal(after.dthickness_ds, during.dthickness_ds)
+    assert np.array_equal(after.thickness["thickness"], during.thickness["thickness"])
+    short = solve(builder(tree)(x0).finalize(), built.control, built.options, keep=1)
+    with pytest.raises(ValueError, match="all are needed"):
+        differentiate(builder(tree), x0, model, short)

@@ -2,18 +2,17 @@
 
 It keeps its work as it goes: optimize.csv gets a row per iteration as the iteration is
 found, optimized.toml the best finished design so far (a case file that runs as it is); at
-the end optimize.json, optimize.png and the run of the best design in final/.  SIGINT or
+the end optimize.json, optimize.png and the results of the best design in final/ (written
+from its solve where the case allows: app/optimize_final.py).  SIGINT or
 SIGTERM, also during the final run, stops it with exit 130 or 143 and these files kept
 (optimize.json then says "interrupted").  Exit 0 finished, 1 stopped short, 2 invalid input.
 """
 
 from __future__ import annotations
 
-import contextlib
 import csv
 import io
 import json
-import signal
 import time
 from pathlib import Path
 
@@ -25,9 +24,9 @@ from ..design.temperature_design import TemperatureDesign
 from ..io.files import write_atomic
 from ..post.optimize_plots import OptimizePicture, PictureRun, plot_optimization
 from .console import say
+from .optimize_final import INTERRUPTED, run_final
 from .run import Interrupted, Stops
 
-INTERRUPTED = (128 + signal.SIGINT, 128 + signal.SIGTERM)  # the exit codes 130, 143
 Target = tuple[np.ndarray, np.ndarray]  # the target wall: s (k,), thickness (k,)
 HEADER = ("iteration", "objective", "max_rel_deviation", "forward_solves")
 
@@ -166,29 +165,6 @@ def _invalid_option(max_iter: int, tolerance: float, smoothness: float) -> str |
         if not ok:
             return f"axiform: invalid option:\n{name}: {v!r} is out of range"
     return None
-
-
-def run_final(out_dir: Path, design: Design, result: OptimizeResult, quiet: bool) -> tuple[Path | None, int]:
-    """optimized.toml and its run in out_dir/final/ (as `axiform run`); the folder (None when
-    no design finished) and the run's exit code.  A final run that does not finish makes the
-    result "stopped"; one stopped by SIGINT or SIGTERM (exit 130 or 143) "interrupted"."""
-    from .run import run as run_case
-
-    if not result.best.finished:
-        return None, 0
-    case_out = out_dir / "optimized.toml"
-    write_atomic(case_out, case_text(design, result.best.design, result.best.stops))
-    final = out_dir / "final"
-    with contextlib.redirect_stderr(io.StringIO()) if quiet else contextlib.nullcontext():
-        code = run_case(str(case_out), str(final), quiet=True)
-    if code in INTERRUPTED:
-        result.status = "interrupted"
-        name = signal.Signals(code - 128).name
-        result.message += f"; the final run was interrupted by {name} (exit {code}), its converged steps are kept"
-    elif code != 0:
-        result.status = "stopped"
-        result.message += f"; the final run exited with {code}"
-    return final, code
 
 
 def read_bounds(bounds: str | None, vary: str) -> tuple[tuple[float, float] | None, str | None]:

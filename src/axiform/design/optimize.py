@@ -17,7 +17,10 @@ Methods:
   thickness to the design from direct differentiation along the load path (axiform.design.sensitivity,
   forward differences of the residual): a
   Gauss-Newton method, which needs few forward solves because the whole Jacobian (stations x
-  design) comes with each solve;
+  design) comes from the steps of each solve.  A solve keeps its steps, and they are
+  differentiated only where the optimizer asks for the Jacobian: not for a trial step it
+  rejects, nor for the iterate that ends the search (within the tolerance, or the last
+  iteration allowed);
 - "fixed-point": the plain rule, each t_k scaled by target / achieved at its station s_k.
 Both stop at the first design whose final wall is within `tolerance` (max relative
 deviation) of the target, or after max_iter iterations.  Knots whose interpolation reaches
@@ -28,17 +31,16 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
-from typing import Any
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..case.schema import CaseError
 from ..model.system import System
 from ..post.thickness import thickness_table
-from ..solve.solver import SolveResult, solve
+from ..solve.solver import LoadControl, NewtonOptions, SolveResult, solve
 from .problem import SMOOTHNESS, Objective, ThicknessDesign
-from .sensitivity import has_history, sensitivity
+from .sensitivity import differentiate, has_history, sensitivity
 from .temperature_design import TemperatureDesign
 
 Design = ThicknessDesign | TemperatureDesign
@@ -50,10 +52,23 @@ Row = tuple[int, float, float, int]  # a row of optimize.csv: iteration, objecti
 
 
 @dataclass
+class Solved:
+    """A forward solve kept with its iterate: the model solved (at its last state), the solve
+    with every converged step, and the load control and Newton options it followed."""
+
+    model: System
+    result: SolveResult
+    control: LoadControl
+    options: NewtonOptions
+
+
+@dataclass
 class Iterate:
     """One forward solve of the optimization: the design, its final thickness table, the
     objective and the max relative deviation, whether the solve finished, and the step ends
-    its path landed on besides the curves' knots (Forward: those of the first finished solve)."""
+    its path landed on besides the curves' knots (Forward: those of the first finished solve).
+    solved: the solve itself, kept by the best finished iterate only (Forward.keep): its
+    Jacobian and the final results are made from it."""
 
     design: np.ndarray
     thickness: dict[str, np.ndarray] | None
@@ -62,6 +77,7 @@ class Iterate:
     finished: bool
     message: str = ""
     stops: tuple[float, ...] = ()
+    solved: Solved | None = field(default=None, repr=False, compare=False)
 
 
 Report = Callable[[Row, Iterate], None]  # called with each row of optimize.csv and its iterate
@@ -92,7 +108,9 @@ class Forward:
     after the first that finished lands on that one's step ends too (LoadControl.stops): with
     sticky or frictional contact the wall depends on the steps as well as on the design, and
     designs that cut their steps at other places gave the method a map from design to wall
-    with a noise of about 1 % (a heater profile found 1.26 % off instead of 0.85 %)."""
+    with a noise of about 1 % (a heater profile found 1.26 % off instead of 0.85 %).  The
+    best finished iterate keeps its solve (`best.solved`): the Jacobian is differentiated
+    from its steps (`jacobian`), and the final results are written from them."""
 
     def __init__(self, design: Design, objective: Objective, report: Report | None = None):
         self.design = design
@@ -101,44 +119,83 @@ class Forward:
         self.solves = 0
         self.rows: list[Row] = []
         self.stops: tuple[float, ...] | None = None  # the step ends of the first finished solve
+        self.best: Iterate | None = None  # the best finished iterate, the one that keeps its solve
 
-    def __call__(self, x: np.ndarray, gradient: bool) -> tuple[Iterate, tuple | None]:
-        """Solve the case with the design x: the iterate, and (residuals, their Jacobian to
-        the design, None without gradient) when the solve finished, else None.  A design
-        outside the case's domain (design.outside: a temperature at or below the shift's
-        pole) is not solved: a failed trial, as a solve that stopped (the gradient method
-        rejects the step, the fixed-point rule stops at the best design so far)."""
+    def __call__(self, x: np.ndarray) -> Iterate:
+        """Solve the case with the design x: its iterate.  A design outside the case's domain
+        (design.outside: a temperature at or below the shift's pole) is not solved: a failed
+        trial, as a solve that stopped (the gradient method rejects the step, the fixed-point
+        rule stops at the best design so far)."""
         design = self.design
         problem = design.outside(x)
         if problem:
-            return Iterate(x.copy(), None, np.inf, np.inf, False, f"the design is not solved: {problem}"), None
+            return Iterate(x.copy(), None, np.inf, np.inf, False, f"the design is not solved: {problem}")
         self.solves += 1
         try:
-            result, table, jac = self.solve(x, gradient)
+            solved, table = self.solve(x)
         except CaseError as exc:  # a case the design makes invalid: a failed trial, named
-            return Iterate(x.copy(), None, np.inf, np.inf, False, f"the design makes the case invalid: {exc}"), None
+            return Iterate(x.copy(), None, np.inf, np.inf, False, f"the design makes the case invalid: {exc}")
+        result = solved.result
         if result.status != "finished" or table is None:
-            return Iterate(x.copy(), table, np.inf, np.inf, False, result.message), None
+            return Iterate(x.copy(), table, np.inf, np.inf, False, result.message)
         r = self.objective.residuals(table["thickness"], x)
         deviation = self.objective.max_rel_deviation(table["thickness"])
         it = Iterate(x.copy(), table, float(r @ r), deviation, True, stops=self.stops or ())
-        return it, (r, None if jac is None else self.objective.jacobian(table["thickness"], jac))
+        self.keep(it, solved)
+        return it
 
-    def solve(self, x: np.ndarray, gradient: bool) -> tuple[SolveResult, dict[str, np.ndarray] | None, Any]:
-        """The forward solve of the design x: its result, the final thickness table (None
-        without a converged step) and d thickness / d x (n, k) with gradient, else None."""
+    def control(self) -> LoadControl:
+        """The load control of the next solve: the case's, landing on the first finished
+        solve's step ends once there is one."""
+        control = self.design.control
+        return control if self.stops is None else replace(control, stops=self.stops)
+
+    def solve(self, x: np.ndarray) -> tuple[Solved, dict[str, np.ndarray] | None]:
+        """The forward solve of the design x, every step kept, and its final thickness table
+        (None without a converged step)."""
         design = self.design
-        control = design.control if self.stops is None else replace(design.control, stops=self.stops)
-        if gradient:
-            sens = sensitivity(design.model, x, control, design.built.options, keep_steps=False, differences="forward")
-            self._keep_stops(sens.solve, sens.model)
-            return sens.solve, sens.thickness, sens.dthickness_ds
         model = design.model(x)
-        result = solve(model, control, design.built.options)
+        control, options = self.control(), design.built.options
+        result = solve(model, control, options)
         self._keep_stops(result, model)
         last = result.last
-        table = None if last is None else thickness_table(model.mesh, last.u.reshape(-1, model.dpn)[:, :2])
-        return result, table, None
+        table = None
+        if last is not None:
+            u2 = last.u.reshape(-1, model.dpn)[:, :2]
+            table = thickness_table(model.mesh, u2, () if last.state is None else model.contact_states(last.state))
+        return Solved(model, result, control, options), table
+
+    def keep(self, it: Iterate, solved: Solved) -> None:
+        """Keep the solve with the iterate if it is the best finished one so far (the one
+        before lets its solve go): the memory of one solve's steps, not of every one."""
+        if self.best is not None and it.objective >= self.best.objective:
+            return
+        if self.best is not None:
+            self.best.solved = None
+        it.solved = solved
+        self.best = it
+
+    def jacobian(self, it: Iterate) -> np.ndarray:
+        """dr/dx (len(r), k): the derivative of the residuals of a finished iterate to its
+        design, from its kept solve's steps (sensitivity.differentiate, forward differences);
+        an iterate that kept none is solved again with its derivatives (one more forward solve,
+        on the path every design takes)."""
+        design = self.design
+        if it.thickness is None:
+            raise ValueError("an iterate without a wall has no Jacobian")
+        if it.solved is not None:
+            kept = it.solved
+            sens = differentiate(
+                design.model, it.design, kept.model, kept.result, keep_steps=False, differences="forward"
+            )
+        else:
+            self.solves += 1
+            sens = sensitivity(
+                design.model, it.design, self.control(), design.built.options, keep_steps=False, differences="forward"
+            )
+        if sens.dthickness_ds is None:
+            raise ValueError("the wall of the iterate has no derivative")
+        return self.objective.jacobian(it.thickness["thickness"], sens.dthickness_ds)
 
     def _keep_stops(self, result: SolveResult, model: System) -> None:
         """The step ends of the first solve that finished, for every later one; none where it
@@ -191,7 +248,7 @@ def fixed_point(forward: Forward, initial: Iterate, max_iter: int, tolerance: fl
             break
         ratio = np.interp(design.knots, _stations(design, t)[inside], objective.target[inside] / t["thickness"][inside])
         ratio[~active] = 1.0
-        current, _ = forward(np.clip(design.rule(current.design, ratio), lo, hi), False)
+        current = forward(np.clip(design.rule(current.design, ratio), lo, hi))
         if not current.finished:
             return best, f"the forward solve of iteration {len(forward.rows)} stopped: {current.message}"
         forward.record(current)
@@ -200,61 +257,70 @@ def fixed_point(forward: Forward, initial: Iterate, max_iter: int, tolerance: fl
     return best, ""
 
 
+class Enough(Exception):
+    """Raised by LeastSquares.jac at an accepted iterate that ends the search (within the
+    tolerance, or the last iteration allowed): its Jacobian is not wanted."""
+
+
 class LeastSquares:
     """The gradient method: SciPy's least_squares (trust-region reflective) over y = ln t_k
-    of the active knots, each forward solve done once (a cache by design); every accepted
-    iterate is a row, and the callback stops the search at the first one within the
-    tolerance or after max_iter iterations."""
+    of the active knots, each forward solve done once (a cache by design).  The optimizer
+    asks for the Jacobian only at an iterate it accepts: that is where the iterate becomes a
+    row, and where the search stops, before the Jacobian, at the first iterate within the
+    tolerance or after max_iter iterations (`Enough`)."""
 
-    def __init__(self, forward: Forward, initial: Iterate, first: tuple | None, max_iter: int, tolerance: float):
+    def __init__(self, forward: Forward, initial: Iterate, max_iter: int, tolerance: float):
         self.forward = forward
         self.active = active_knots(forward.design, forward.objective)
         self.x0 = initial.design
         self.y0 = forward.design.to_y(self.x0[self.active])
-        self.cache: dict[bytes, tuple[Iterate, Any]] = {self.y0.tobytes(): (initial, first)}
-        self.best = self.last = initial
+        self.cache: dict[bytes, Iterate] = {self.y0.tobytes(): initial}
+        self.last = initial
         self.max_iter = max_iter
         self.tolerance = tolerance
         self.reached = False
 
-    def evaluate(self, y) -> tuple[Iterate, Any]:
+    def evaluate(self, y) -> Iterate:
         y = np.asarray(y, float)
         key = y.tobytes()
         if key not in self.cache:
             x = self.x0.copy()
             x[self.active] = self.forward.design.from_y(y)
-            self.cache[key] = self.forward(x, True)
-            it = self.cache[key][0]
-            if it.finished and it.objective < self.best.objective:
-                self.best = it
+            self.cache[key] = self.forward(x)
         return self.cache[key]
 
+    @property
+    def best(self) -> Iterate:
+        """The best finished iterate (the initial one at least: optimize solves it first)."""
+        best = self.forward.best
+        if best is None:
+            raise ValueError("the optimization has no finished iterate")
+        return best
+
     def fun(self, y) -> np.ndarray:
-        it, rj = self.evaluate(y)
-        if rj is None:  # the solve stopped (a design too thin to blow): a step to reject
+        it = self.evaluate(y)
+        if it.thickness is None or not it.finished:  # the solve stopped (a design too thin to blow): a step to reject
             wall = self.best.thickness  # the best iterate finished (the initial one at least)
             if wall is None:
                 raise ValueError("the best iterate of the optimization has no wall")
             r_best = self.forward.objective.residuals(wall["thickness"], self.best.design)
             return 10.0 * np.abs(r_best) + 1.0
-        return rj[0]
+        return self.forward.objective.residuals(it.thickness["thickness"], it.design)
 
     def jac(self, y) -> np.ndarray:
-        it, rj = self.evaluate(y)
-        return rj[1][:, self.active] * self.forward.design.dx_dy(it.design[self.active])  # dr/dy = dr/dx dx/dy
-
-    def callback(self, intermediate_result) -> None:
-        """After each iteration of the optimizer: record the iterate it accepted (if new);
-        StopIteration when it is within the tolerance or the iterations are spent."""
-        it = self.evaluate(intermediate_result.x)[0]
+        """dr/dy at y; at an accepted iterate that is new, its row first, and Enough where it
+        ends the search."""
+        it = self.evaluate(y)
         if it is not self.last:
             self.forward.record(it)
             self.last = it
-        if it.finished and it.deviation <= self.tolerance:
-            self.reached = True
-            raise StopIteration
-        if len(self.forward.rows) > self.max_iter:
-            raise StopIteration
+            if it.finished and it.deviation <= self.tolerance:
+                self.reached = True
+                raise Enough
+            if len(self.forward.rows) > self.max_iter:
+                raise Enough
+        dr_dx = self.forward.jacobian(it)
+        return dr_dx[:, self.active] * self.forward.design.dx_dy(it.design[self.active])  # dr/dy = dr/dx dx/dy
 
     def run(self) -> tuple[Iterate, bool, str]:
         """The best iterate, whether the optimizer converged to a best fit (that misses the
@@ -263,23 +329,19 @@ class LeastSquares:
 
         lo, hi = self.forward.design.bounds()
         bounds = (self.forward.design.to_y(lo[self.active]), self.forward.design.to_y(hi[self.active]))
-        out = least_squares(
-            self.fun,
-            self.y0,
-            jac=self.jac,
-            bounds=bounds,
-            method="trf",
-            max_nfev=4 * self.max_iter + 4,
-            callback=self.callback,
-        )
-        converged = out.status > 0
-        if converged:
-            message = f"the optimizer converged to a best fit: {out.message}"
-        elif out.status == -2 and not self.reached:
-            message = f"the tolerance was not reached in {self.max_iter} iterations"
-        else:
-            message = "" if self.reached else out.message
-        return self.best, converged, message
+        try:
+            out = least_squares(
+                self.fun, self.y0, jac=self.jac, bounds=bounds, method="trf", max_nfev=4 * self.max_iter + 4
+            )
+        except Enough:
+            return (
+                self.best,
+                False,
+                "" if self.reached else f"the tolerance was not reached in {self.max_iter} iterations",
+            )
+        if out.status > 0:
+            return self.best, True, f"the optimizer converged to a best fit: {out.message}"
+        return self.best, False, out.message
 
 
 def optimize(
@@ -298,7 +360,7 @@ def optimize(
     t0 = time.perf_counter()
     objective = Objective(design.stations, *target, float(design.initial.mean()), smoothness)
     forward = Forward(design, objective, report)
-    initial, first = forward(design.initial.astype(float), method == "gradient")
+    initial = forward(design.initial.astype(float))
     forward.record(initial)
     if not initial.finished:
         return OptimizeResult(
@@ -317,7 +379,7 @@ def optimize(
     if method == "fixed-point":
         best, message = fixed_point(forward, initial, max_iter, tolerance)
     elif initial.deviation > tolerance:
-        best, converged, message = LeastSquares(forward, initial, first, max_iter, tolerance).run()
+        best, converged, message = LeastSquares(forward, initial, max_iter, tolerance).run()
     reached = best.deviation <= tolerance
     if reached:
         message = f"the final wall is within {tolerance:.3g} of the target"

@@ -33,6 +33,11 @@ Forward differences (`differences="forward"`: the shadow at s + h e_k against th
 itself) halve the evaluations; their error is O(h) (they differ from the central ones by
 6.4e-5 of the largest derivative of a sticky tube's wall), which a Gauss-Newton method does not
 notice: `axiform optimize` uses them.
+
+The steps are differentiated as they converge (`sensitivity`) or after the solve, from its
+kept steps (`differentiate`), to the same numbers: a caller that learns only after a solve
+whether it wants the derivatives (an optimizer that rejects the design) pays for them only
+when it does.
 """
 
 from __future__ import annotations
@@ -140,65 +145,124 @@ def sensitivity(
     if not isinstance(control, LoadControl):
         raise ValueError("sensitivities follow the load path under load control (LoadControl)")
     s = np.asarray(design, float).ravel()
-    m = s.size
-    h = relative_step * np.where(s != 0, np.abs(s), 1.0)
+    derivatives = Derivatives(build, build(s).finalize(), s, relative_step, differences, keep_steps, on_step)
+    derivatives.out.solve = solve(derivatives.model, control, options, on_step=derivatives.step)
+    derivatives.finish()
+    return derivatives.out
 
-    def built(x):
-        return build(x).finalize()  # a Model finalized, a System as it is
 
-    if differences not in ("central", "forward"):
-        raise ValueError(f'differences must be "central" or "forward", not {differences!r}')
-    central = differences == "central"
-    model = built(s)
-    shadows = _shadow_models(built, model, s, h, central)
-    span = 2.0 * h if central else h  # the design step between the two residuals differenced
-    dx_ds = np.stack(
-        [(p[0].mesh.points - (p[1] if central else model).mesh.points) / d for p, d in zip(shadows, span, strict=True)],
-        axis=-1,
-    )
-    history = has_history(model)
-    dm = model.dofmap
-    out = Sensitivity(SolveResult("running"), model, s, dx_ds)
+def differentiate(
+    build: Callable[[np.ndarray], Model | System],
+    design: np.ndarray,
+    model: System,
+    result: SolveResult,
+    keep_steps: bool = True,
+    relative_step: float = RELATIVE_STEP,
+    differences: str = "central",
+) -> Sensitivity:
+    """The sensitivities of a solve already done: `result` is the solve of `model` =
+    build(design) under load control with every converged step kept (solve's keep=None).
+    The same derivatives as `sensitivity` (the steps differentiated in their order, after
+    the solve instead of during it), for a caller that learns only after a solve whether it
+    wants them (the optimizer's rejected trials and its last iterate do not)."""
+    if len(result.steps) != result.n_steps:
+        raise ValueError(f"the solve kept {len(result.steps)} of its {result.n_steps} steps: all are needed")
+    s = np.asarray(design, float).ravel()
+    derivatives = Derivatives(build, model, s, relative_step, differences, keep_steps)
+    derivatives.out.solve = result
+    for step in result.steps:
+        derivatives.step(step)
+    derivatives.finish()
+    return derivatives.out
 
-    linear = LinearSolver()  # the analysis of the tangent's pattern, kept from step to step
-    lag_state = model.initial_state()  # the history h_{n-1}: the tangent K_n is taken with it
-    shadow_states = [[shadow.initial_state() for shadow in pair] for pair in shadows]
 
-    def differentiate(step: Step) -> None:
-        nonlocal lag_state
+class Derivatives:
+    """The derivatives of the converged steps of one solve of `model` = build(s), one step
+    at a time and in order (`step`, the solve's on_step, or called afterwards over its kept
+    steps), into `out` (a Sensitivity; `finish` adds the final wall's derivative).  The
+    shadows (the models at s + h e_k, and s - h e_k for central differences) carry their own
+    history along the steps (module docstring)."""
+
+    def __init__(
+        self,
+        build: Callable[[np.ndarray], Model | System],
+        model: System,
+        s: np.ndarray,
+        relative_step: float = RELATIVE_STEP,
+        differences: str = "central",
+        keep_steps: bool = True,
+        on_step: Callable[[Step, np.ndarray], None] | None = None,
+    ):
+        if differences not in ("central", "forward"):
+            raise ValueError(f'differences must be "central" or "forward", not {differences!r}')
+
+        def built(x):
+            return build(x).finalize()  # a Model finalized, a System as it is
+
+        self.model, self.keep_steps, self.on_step = model, keep_steps, on_step
+        self.central = central = differences == "central"
+        self.h = h = relative_step * np.where(s != 0, np.abs(s), 1.0)
+        self.shadows = shadows = _shadow_models(built, model, s, h, central)
+        self.span = 2.0 * h if central else h  # the design step between the two residuals differenced
+        dx_ds = np.stack(
+            [
+                (p[0].mesh.points - (p[1] if central else model).mesh.points) / d
+                for p, d in zip(shadows, self.span, strict=True)
+            ],
+            axis=-1,
+        )
+        self.history = has_history(model)
+        self.out = Sensitivity(SolveResult("running"), model, s, dx_ds)
+        self.linear = LinearSolver()  # the analysis of the tangent's pattern, kept from step to step
+        self.lag_state = model.initial_state()  # the history h_{n-1}: the tangent K_n is taken with it
+        self.shadow_states = [[shadow.initial_state() for shadow in pair] for pair in shadows]
+
+    def step(self, step: Step) -> None:
+        """Differentiate the converged step `step` (the one after the last differentiated)."""
+        model, out, central, span = self.model, self.out, self.central, self.span
+        m = span.size
         u_f, lam = step.u_f, step.lam
-        ev = model.evaluate(u_f, lam, model.begin_step(lag_state, step.fraction))
-        lag_state = step.state  # committed by the solver: h_n, the history of the next step's K
+        if step.state is None:
+            raise ValueError(f"step {step.number} holds no committed history: it cannot be differentiated")
+        ev = model.evaluate(u_f, lam, model.begin_step(self.lag_state, step.fraction))
+        self.lag_state = step.state  # committed by the solver: h_n, the history of the next step's K
         dR = np.empty((model.n_free, m))
-        _begin_shadow_steps(shadows, shadow_states, step.fraction)
-        for k, (pair, states) in enumerate(zip(shadows, shadow_states, strict=True)):
+        _begin_shadow_steps(self.shadows, self.shadow_states, step.fraction)
+        for k, (pair, states) in enumerate(zip(self.shadows, self.shadow_states, strict=True)):
             r = [shadow.evaluate(u_f, lam, held, tangent=False).r for shadow, held in zip(pair, states, strict=True)]
             dR[:, k] = (r[0] - (r[1] if central else ev.r)) / span[k]
-        du_f = -np.asarray(factorize(ev.K, linear)(dR)).reshape(model.n_free, m)
-        if history:
-            for k, (pair, states) in enumerate(zip(shadows, shadow_states, strict=False)):
-                for j, (shadow, sign) in enumerate(zip(pair, (1.0, -1.0), strict=False)):
-                    moved = u_f + sign * h[k] * du_f[:, k]
-                    trial = shadow.evaluate(moved, lam, states[j], tangent=False).trial
-                    assert trial is not None, "System.evaluate returns the trial state"
-                    states[j] = shadow.settle(states[j], trial, shadow.expand(moved, lam))
+        du_f = -np.asarray(factorize(ev.K, self.linear)(dR)).reshape(model.n_free, m)
+        if self.history:
+            self._settle_shadows(u_f, lam, du_f)
+        dm = _dofmap(model)
         du = np.concatenate([du_f[: dm.nf], np.zeros((dm.np, m))])[dm.eq]  # (n_full, m)
-        if not keep_steps:
+        if not self.keep_steps:
             out.du_ds.clear()
             out.dp_ds.clear()
         out.du_ds.append(du)
         out.dp_ds.append(du_f[dm.nf :])
-        if on_step is not None:
-            on_step(step, du)
+        if self.on_step is not None:
+            self.on_step(step, du)
 
-    out.solve = solve(model, control, options, on_step=differentiate)
-    last = out.solve.last
-    if last is not None:
-        u2 = last.u.reshape(-1, model.dpn)[:, :2]
-        out.thickness = thickness_table(model.mesh, u2, model.contact_states(last.state))
-        if out.thickness is not None:
-            out.dthickness_ds = thickness_derivative(model, u2, out.dx_ds, out.du_final_ds())
-    return out
+    def _settle_shadows(self, u_f: np.ndarray, lam: float, du_f: np.ndarray) -> None:
+        """Each shadow commits its history at the perturbed state u_f +- h_k du_f[:, k] (n_free, m)."""
+        for k, (pair, states) in enumerate(zip(self.shadows, self.shadow_states, strict=False)):
+            for j, (shadow, sign) in enumerate(zip(pair, (1.0, -1.0), strict=False)):
+                moved = u_f + sign * self.h[k] * du_f[:, k]
+                trial = shadow.evaluate(moved, lam, states[j], tangent=False).trial
+                assert trial is not None, "System.evaluate returns the trial state"
+                states[j] = shadow.settle(states[j], trial, shadow.expand(moved, lam))
+
+    def finish(self) -> None:
+        """The final wall and its derivative (out.thickness, out.dthickness_ds) from the last step."""
+        out, model = self.out, self.model
+        last = out.solve.last
+        if last is not None:
+            u2 = last.u.reshape(-1, model.dpn)[:, :2]
+            held = () if last.state is None else model.contact_states(last.state)
+            out.thickness = thickness_table(model.mesh, u2, held)
+            if out.thickness is not None:
+                out.dthickness_ds = thickness_derivative(model, u2, out.dx_ds, out.du_final_ds())
 
 
 def _shadow_models(
