@@ -224,3 +224,22 @@ def test_an_arc_length_run_resumed_to_a_later_stop_goes_on_to_it():
     rest = solve(model, control, options, resume=first.last.checkpoint)
     assert rest.status == "finished" and rest.last.number > first.last.number
     assert rest.last.u[control.stop_dof] == pytest.approx(8.0, rel=1e-10)
+
+
+def test_a_run_resumed_onto_a_new_knot_at_its_end_takes_the_steps_of_that_case():
+    """Load control to t = 1, resumed to t = 2 by a case whose pressure curve bends at t = 1
+    (the same up to it): the steps after t = 1 are those of that case run from the start (no
+    predictor carried across the knot)."""
+    bent = {
+        **LOADED_PLATE,
+        "pressure": [{"on": {"z": 0.0}, "value": 10.0, "curve": [[0.0, 0.0], [1.0, 1.0], [2.0, 1.2]]}],
+        "solver": {"control": "load", "target": 2.0, "steps": 8},
+    }
+    full = solve(*_model(bent))
+    first = solve(*_model(LOADED_PLATE))
+    rest = solve(*_model(bent), resume=first.last.checkpoint)
+    k = first.last.number
+    assert [(s.number, s.lam) for s in rest.steps] == [(s.number, s.lam) for s in full.steps[k:]]
+    for a, b in zip(rest.steps, full.steps[k:], strict=True):
+        assert a.iterations == b.iterations
+        np.testing.assert_allclose(a.u, b.u, rtol=1e-10, atol=1e-12 * np.abs(b.u).max())

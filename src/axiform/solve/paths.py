@@ -194,6 +194,16 @@ class LoadPath(PathFollowing):
     def done(self):
         return abs(self.target - self.lam) <= 1e-12 * abs(self.target)
 
+    def restore(self, state: dict) -> None:
+        """The checkpoint's path; where the resumed case has a knot at the checkpoint's time that
+        the run being resumed had not (a curve that bends there, the same before it), neither
+        the last increment nor the rate of before the knot is carried across it: the rate is
+        taken anew at the converged state, as in a run of that case from the start."""
+        super().restore(state)
+        on_knot = self.knots.size and np.abs(self.knots - self.lam).min() <= 1e-12 * abs(self.target)
+        if on_knot and self.previous is not None:
+            self.previous = self.rate = None
+
     def _next_stop(self) -> float:
         """The end of the interval being sub-stepped, or else the next knot or the end."""
         if self.goal is not None:
