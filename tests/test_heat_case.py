@@ -199,3 +199,24 @@ def test_a_conductance_needs_the_mould_temperature(tmp_path, capsys):
     case.write_text(tomli_w.dumps(data))
     assert main(["check", str(case)]) == 2
     assert "contact[0]: temperature (the mould's) and conductance go together" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("through", ["film", "contact"])
+def test_the_steps_land_on_the_knots_of_the_heat_curves(through):
+    """A film's ambient curve and a mould's temperature_curve are curves of the process like
+    any other: the steps of load control land on their knots (2.7 and 7.3 here, off the
+    nominal grid of 1.9)."""
+    data = tomllib.loads(CASE)
+    data["solver"] = {"target": 19.0, "steps": 10}
+    knots = [[0.0, 1.0], [2.7, 0.8], [7.3, 0.6]]
+    if through == "film":
+        data["convection"][0]["curve"] = knots
+    else:
+        del data["convection"]
+        data["contact"] = [MOULD | {"temperature_curve": knots}]
+    built = build(parse(data))
+    res = solve(built.model, built.control, built.options)
+    assert res.status == "finished", res.message
+    times = [s.lam for s in res.steps]
+    for t in (2.7, 7.3):
+        assert min(abs(lam - t) for lam in times) <= 1e-12 * 19.0

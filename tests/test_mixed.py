@@ -94,3 +94,51 @@ def test_pressure_field_of_a_uniform_compression(element, formulation):
     fields = point_fields(model, u.ravel())
     expected = -kappa * ((1 + a) ** 3 - 1)
     assert fields["hydrostatic_pressure"] == pytest.approx(np.full(mesh.n_nodes, expected), rel=1e-10)
+
+
+HYDROSTATIC_BLOCK = """
+[mesh]
+kind = "rectangle"
+r = [0.0, 1.0]
+z = [0.0, 1.0]
+divisions = [2, 2]
+element = "{element}"
+formulation = "{formulation}"
+[material]
+model = "mooney-rivlin"
+C1 = 1.0
+C2 = 0.5
+kappa = 100.0
+[[fix]]
+at = {{ r = 0.0 }}
+dofs = ["ur"]
+[[fix]]
+at = {{ z = 0.0 }}
+dofs = ["uz"]
+[[pressure]]
+on = {{ r = 1.0 }}
+value = 5.0
+[[pressure]]
+on = {{ z = 1.0 }}
+value = 5.0
+[solver]
+steps = 2
+[output]
+plots = false
+"""
+
+
+def test_the_vtu_files_hold_the_pressure_field(element, formulation, tmp_path):
+    """A block under the same follower pressure on every face: sigma = -5 I, so the VTU point
+    data `pressure` (the name the outputs' contract fixes, beside `hydrostatic_pressure`) is 5
+    at every node, for every element and formulation."""
+    import meshio
+
+    from axiform.cli import main
+
+    case = tmp_path / "block.toml"
+    case.write_text(HYDROSTATIC_BLOCK.format(element=element, formulation=formulation))
+    assert main(["run", str(case), "--out", str(tmp_path / "out"), "-q"]) == 0
+    data = meshio.read(sorted((tmp_path / "out" / "fields").glob("*.vtu"))[-1]).point_data
+    assert data["pressure"] == pytest.approx(np.full(len(data["pressure"]), 5.0), rel=1e-8)
+    assert np.array_equal(data["pressure"], data["hydrostatic_pressure"])

@@ -317,3 +317,23 @@ def test_check_frame_holds_a_long_plate_near_the_body():
     fig = check_figure(build(load(examples / "rubber_ring_plates.toml"), examples))
     low, high = fig.axes[0].get_ylim()
     assert low < 0.0 and high > 5.0
+
+
+def test_the_sweep_axis_says_the_unit_of_its_monitor(tmp_path, monkeypatch):
+    """sweep.png's monitor axis says the monitor's unit, as the cases' summary.json give it
+    (column_units of history.csv, from the case's [units])."""
+    import axiform.post.sweep_plots as sweep_plots
+    from axiform.app.sweep import Sweep
+
+    case = tmp_path / "c.toml"
+    case.write_text("[units]\nlength = 'in'\n")
+    sweep = Sweep(case, ["material.C1"], [{"material.C1": c} for c in (60.0, 80.0)], "w_center")
+    rows = [{"status": "finished", "monitors": {"w_center": w}, "extremes": {"w_center": (0.0, w)}} for w in (3.6, 3.3)]
+    for k in (1, 2):
+        folder = tmp_path / "cases" / f"{k:04d}"
+        folder.mkdir(parents=True)
+        (folder / "summary.json").write_text(json.dumps({"column_units": {"history.csv": {"w_center": "in"}}}))
+    saved = []
+    monkeypatch.setattr(sweep_plots, "save", lambda fig, path, **kw: saved.append(fig))
+    assert sweep_plots.plot_sweep(tmp_path / "sweep.png", sweep, rows)
+    assert saved[0].axes[0].get_ylabel() == "w_center (in): peak over the run"

@@ -188,3 +188,58 @@ def test_resume_refuses_another_model(tmp_path, capsys):
     assert cli.main(["run", str(path), "--resume", str(out), "--set", "solver.target=1.5", "-q"]) == 0
     rows = stress_rows(out)
     assert rows[-1][1] == pytest.approx(1.5) and [r[0] for r in rows] == list(range(len(rows)))
+
+
+LOADED_PLATE = {
+    **PLATE,
+    "mesh": {**PLATE["mesh"], "element": "q4"},
+    "fix": [{"at": {"r": 7.5}, "dofs": ["ur", "uz"]}, {"at": {"r": 0.0}, "dofs": ["ur"]}],
+    "pressure": [{"on": {"z": 0.0}, "value": 10.0}],
+    "solver": {"control": "load", "target": 1.0, "steps": 4},
+}
+
+
+def test_a_finished_run_resumed_to_a_later_target_takes_the_steps_of_the_longer_run():
+    """Load control to t = 1, resumed to t = 2: the steps after t = 1 are those of a run to
+    t = 2 from the start, Newton's iterations included (the end of the first run is no knot
+    of a curve: its last increment is kept for the next predictor)."""
+    longer = {**LOADED_PLATE, "solver": {"control": "load", "target": 2.0, "steps": 8}}
+    full = solve(*_model(longer))
+    first = solve(*_model(LOADED_PLATE))
+    assert full.status == first.status == "finished"
+    rest = solve(*_model(longer), resume=first.last.checkpoint)
+    k = first.last.number
+    assert [(s.number, s.lam) for s in rest.steps] == [(s.number, s.lam) for s in full.steps[k:]]
+    for a, b in zip(rest.steps, full.steps[k:], strict=True):
+        assert a.iterations == b.iterations
+        np.testing.assert_allclose(a.u, b.u, rtol=1e-10, atol=1e-12 * np.abs(b.u).max())
+
+
+def test_an_arc_length_run_resumed_to_a_later_stop_goes_on_to_it():
+    """Arc length stopped at w = 4, resumed with the stop at w = 8: the run goes on and lands on
+    the new stop (the checkpoint's end of the path is decided again for the resumed control)."""
+    first = solve(*_model({**ARC, "solver": {**ARC["solver"], "stop": {**ARC["solver"]["stop"], "value": 4.0}}}))
+    assert first.status == "finished"
+    model, control, options = _model(ARC)
+    rest = solve(model, control, options, resume=first.last.checkpoint)
+    assert rest.status == "finished" and rest.last.number > first.last.number
+    assert rest.last.u[control.stop_dof] == pytest.approx(8.0, rel=1e-10)
+
+
+def test_a_run_resumed_onto_a_new_knot_at_its_end_takes_the_steps_of_that_case():
+    """Load control to t = 1, resumed to t = 2 by a case whose pressure curve bends at t = 1
+    (the same up to it): the steps after t = 1 are those of that case run from the start (no
+    predictor carried across the knot)."""
+    bent = {
+        **LOADED_PLATE,
+        "pressure": [{"on": {"z": 0.0}, "value": 10.0, "curve": [[0.0, 0.0], [1.0, 1.0], [2.0, 1.2]]}],
+        "solver": {"control": "load", "target": 2.0, "steps": 8},
+    }
+    full = solve(*_model(bent))
+    first = solve(*_model(LOADED_PLATE))
+    rest = solve(*_model(bent), resume=first.last.checkpoint)
+    k = first.last.number
+    assert [(s.number, s.lam) for s in rest.steps] == [(s.number, s.lam) for s in full.steps[k:]]
+    for a, b in zip(rest.steps, full.steps[k:], strict=True):
+        assert a.iterations == b.iterations
+        np.testing.assert_allclose(a.u, b.u, rtol=1e-10, atol=1e-12 * np.abs(b.u).max())

@@ -274,3 +274,25 @@ def test_the_tangent_of_a_blown_tube_with_memory_tables_and_a_shift_matches_diff
     assert np.abs(K[:n, :n] - num[:n, :n]).max() < 1e-7 * np.abs(K[:n, :n]).max()
     assert np.abs(K[n:] - num[n:]).max() < 1e-7 * np.abs(K[n:]).max()
     assert np.abs(K[:, n:] - num[:, n:]).max() < 1e-7 * np.abs(K[:, n:]).max()
+
+
+@pytest.mark.parametrize("wall", [None, "r"])
+def test_a_table_along_s_of_a_tube_runs_along_its_wall(wall):
+    """A tube (r 1..2, z 0..0.2) loaded on its bore: its wall runs along z (thickness along r,
+    by default or as given), so a table along s = z - z0 gives each node T(z), the s of
+    thickness.csv, not T(r - r0)."""
+    from axiform.case.schema import build, parse
+
+    case = {
+        "mesh": {"kind": "rectangle", "r": [1.0, 2.0], "z": [0.0, 0.2], "divisions": [4, 2], "element": "q4"},
+        "material": {"model": "neo-hooke", "C1": 0.5, "kappa": 100.0},
+        "temperature": {"initial": {"along": "s", "table": [[0.0, 100.0], [0.2, 50.0]]}},
+        "fix": [{"at": {"z": 0.0}, "dofs": ["uz"]}, {"at": {"z": 0.2}, "dofs": ["uz"]}],
+        "pressure": [{"on": {"r": 1.0}, "value": 0.1}],
+    }
+    if wall is not None:
+        case["mesh"]["wall"] = wall
+    built = build(parse(case))
+    z = built.model.mesh.points[:, 1]
+    assert built.model.mesh.wall == "r"
+    np.testing.assert_allclose(built.model.temperature, 100.0 - 250.0 * z, rtol=1e-12)

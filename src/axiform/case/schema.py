@@ -364,6 +364,10 @@ def build(case: Case, base: str | Path = ".") -> Built:
     if case.mesh.kind == "rectangle":  # the wall is normal to the faces that carry the pressure
         loaded = model.pressures + getattr(model, "cavities", [])
         mesh.set_wall(case.mesh.wall or default_wall(mesh.points, [p.nodes for p in loaded]))
+        if heat is not None and getattr(heat.initial, "along", None) == "s":  # s runs along the wall just set
+            from .temperature import give_temperature
+
+            give_temperature(model, mesh, case)
     try:
         system = model.finalize()
     except ValueError as exc:  # a tied fibre rotation prescribed twice

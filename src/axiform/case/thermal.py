@@ -111,7 +111,12 @@ def build_conduction(
     if rho is None:
         raise CaseError("thermal.density: missing (give it here, or the material's: [material] density)")
     films = [
-        Film(select_edges(mesh, c.on.model_dump(), f"convection[{i}].on"), c.h, c.ambient_of_time())
+        Film(
+            select_edges(mesh, c.on.model_dump(), f"convection[{i}].on"),
+            c.h,
+            c.ambient_of_time(),
+            None if c.curve is None else Curve(c.curve),
+        )
         for i, c in enumerate(convection)
     ]
     conductances = []
@@ -125,6 +130,7 @@ def build_conduction(
                     f"{c.conductance_gap:g} or more, or a smaller gap"
                 )
             mould = _scaled(c.temperature, c.temperature_curve)
-            conductances.append(Conductance(c.conductance, mould, contact_conductance(k, c.conductance_gap)))
+            curve = None if c.temperature_curve is None else Curve(c.temperature_curve)
+            conductances.append(Conductance(c.conductance, mould, contact_conductance(k, c.conductance_gap), curve))
     conductivity, heat = _as_property(thermal.conductivity), _as_property(thermal.specific_heat)
     model.conduct(Conduction(mesh, conductivity, _as_property(rho), heat, films, conductances))

@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from .curves import Curve
 from .elements import Q4, QUAD_EDGES, edge_rule, gauss_quad, jacobian
 from .mesh import Mesh
 
@@ -64,11 +65,13 @@ def constant(value: float) -> Property:
 @dataclass
 class Film:
     """Convection on boundary edges (indices into mesh.boundary_edges): film coefficient h,
-    ambient temperature `ambient(t)` (a function of the time)."""
+    ambient temperature `ambient(t)` (a function of the time); `curve`: the load curve that
+    ambient follows, if any (its knots are times the steps land on)."""
 
     edges: np.ndarray
     h: float
     ambient: Callable[[float], float]
+    curve: Curve | None = None
 
 
 @dataclass
@@ -80,6 +83,7 @@ class Conductance:
     h: float
     mould: Callable[[float], float]
     contact: Callable[[object], tuple[np.ndarray, np.ndarray]]
+    curve: Curve | None = None  # the load curve the mould's temperature follows, if any
 
 
 def lumped_products(xi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -141,6 +145,12 @@ class Conduction:
         self.dV0 = 2.0 * np.pi * Xq[..., 0] * detJ * self.w  # (e, q)
         self._rows = np.repeat(self.cells, 4, axis=1).ravel()  # (e 16,) the element blocks' places
         self._cols = np.tile(self.cells, (1, 4)).ravel()
+
+    def curves(self) -> list[Curve]:
+        """The load curves of the films' ambient and the moulds' temperatures (their knots
+        are times at which the boundary temperatures change their rate)."""
+        curves = [f.curve for f in self.films] + [c.curve for c in self.conductances]
+        return [c for c in curves if c is not None]
 
     def _mid_sides(self, mesh: Mesh) -> sp.csr_matrix | None:
         """P (n, n): T_all = P T, the corners' values kept and each mid-side node the mean of

@@ -109,6 +109,8 @@ class System:
         """Every time at which some curve of the system changes its slope (sorted)."""
         curves = [c for term in self.terms for c in term.curves()] + list(self.prescribed_curves)
         curves += [self.change] if self.change is not None else []
+        # a conduction of one's own (Model.conduct) needs only `step`; fem.heat.Conduction has curves
+        curves += getattr(self.conduction, "curves", list)() if self.conduction is not None else []
         return np.unique(np.concatenate([np.empty(0)] + [c.knots() for c in curves]))
 
     def timed(self) -> bool:

@@ -88,9 +88,12 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
 
 
 def with_components(data: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-    """The point data for a VTU file: the fields, and the Cauchy stress's components besides
-    as the scalars cauchy_stress_rr, _zz, _tt, _rz (meshio writes no ComponentName attributes:
-    ParaView would call them 0..3)."""
+    """The point data for a VTU file: the fields, hydrostatic_pressure under the name
+    `pressure` too (the name readers of the VTU files rely on), and the Cauchy stress's
+    components besides as the scalars cauchy_stress_rr, _zz, _tt, _rz (meshio writes no
+    ComponentName attributes: ParaView would call them 0..3)."""
+    if "hydrostatic_pressure" in data:
+        data = data | {"pressure": data["hydrostatic_pressure"]}
     if "cauchy_stress" not in data:
         return data
     sig = data["cauchy_stress"]

@@ -126,14 +126,31 @@ def plot_sweep(path: Path, sweep: Sweep, rows: list[dict | None]) -> bool:
     """sweep.png (sweep_figure); False where the sweep reports no monitor or varies no key."""
     if sweep.report is None or not sweep.keys:
         return False
-    save(sweep_figure(sweep, rows), path, dpi=120, format="png")
+    save(sweep_figure(sweep, rows, report_unit(path.parent, sweep.report, rows)), path, dpi=120, format="png")
     return True
 
 
-def sweep_figure(sweep: Sweep, rows: list[dict | None]):
+def report_unit(root: Path, monitor: str, rows: list[dict | None]) -> str:
+    """The unit of `monitor` as the summary.json of the sweep's first finished case under root
+    (cases/NNNN/) gives it (column_units of history.csv, from the case's [units]); "" where
+    none says."""
+    for k, row in enumerate(rows):
+        if not row or row.get("status") != "finished":
+            continue
+        try:
+            summary = json.loads((root / "cases" / f"{k + 1:04d}" / "summary.json").read_text())
+        except (OSError, ValueError):
+            continue
+        units = (summary.get("column_units") or {}).get("history.csv") or {}
+        return str(units.get(monitor, "")) if isinstance(units, dict) else ""
+    return ""
+
+
+def sweep_figure(sweep: Sweep, rows: list[dict | None], unit: str = ""):
     """The report monitor's peak over the run (largest magnitude) against the first key that
     takes several values, one line for each combination of the other such keys, with its end
-    value dashed where that differs; cases that did not finish are left out (and counted)."""
+    value dashed where that differs; cases that did not finish are left out (and counted);
+    `unit`: the monitor's, on its axis."""
     first, xs, numeric, groups = sweep_points(sweep, rows)
     ends = any(not np.isclose(p[1], p[2], rtol=1e-9, atol=0.0) for points in groups.values() for p in points)
     fig = new_figure((6.4, 4.4))
@@ -157,7 +174,8 @@ def sweep_figure(sweep: Sweep, rows: list[dict | None]):
         ax.set_xticks(range(len(xs)), xs)
     finished = sum(1 for r in rows if r and r.get("status") == "finished")
     ax.set_xlabel(first)
-    ax.set_ylabel(f"{sweep.report}: peak over the run" + (" and at the end" if ends else ""))
+    name = f"{sweep.report} ({unit})" if unit else f"{sweep.report}"
+    ax.set_ylabel(f"{name}: peak over the run" + (" and at the end" if ends else ""))
     ax.set_title(
         wrapped(f"{sweep.report} against {first}: {finished} of {len(rows)} cases finished", 6.0, 10), fontsize=10
     )

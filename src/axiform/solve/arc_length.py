@@ -82,6 +82,23 @@ class ArcLengthPath(PathFollowing):
     def done(self):
         return self.finished
 
+    def restore(self, state: dict) -> None:
+        """The checkpoint's path; a path that had reached its end goes on where the resumed
+        control's end lies further (a later target or stop value), its progress measured anew."""
+        super().restore(state)
+        if self.finished and not self._at_end():
+            self.finished = False
+            self.progress = self._fraction(self.u_f, self.lam)
+
+    def _at_end(self) -> bool:
+        """Whether the converged state is on the control's target or on its stop value."""
+        c = self.control
+        if abs(self.lam - c.target) <= 1e-12 * abs(c.target):
+            return True
+        if self.stop is None or c.stop_value is None:
+            return False
+        return abs(self.u_f[self.stop] - c.stop_value) <= 1e-12 * max(abs(c.stop_value), 1e-300)
+
     def _crossed(self, old, new, goal):
         return goal is not None and (old - goal) * (new - goal) <= 0 and new != old
 

@@ -182,7 +182,9 @@ class LoadPath(PathFollowing):
             self.nominal = float(np.copysign(min(abs(self.nominal), control.max_dt), self.nominal))
         lo, hi = sorted((0.0, self.target))
         k = model.knots()
-        self.knots = np.append(k[(k > lo) & (k < hi)], self.target)  # where the loads' rates jump
+        # where the loads' rates jump: the curves' knots, not the target (a run resumed to a later
+        # target goes on from it with the rate unchanged, as a run to that target from the start)
+        self.knots = k
         k = np.unique(np.concatenate([k, np.asarray(control.stops, float)]))
         self.stops = np.append(k[(k > lo) & (k < hi)][:: 1 if self.target > 0 else -1], self.target)
         self.rate = None  # du_f/dlambda at the last converged state (None: not yet computed)
@@ -191,6 +193,16 @@ class LoadPath(PathFollowing):
 
     def done(self):
         return abs(self.target - self.lam) <= 1e-12 * abs(self.target)
+
+    def restore(self, state: dict) -> None:
+        """The checkpoint's path; where the resumed case has a knot at the checkpoint's time that
+        the run being resumed had not (a curve that bends there, the same before it), neither
+        the last increment nor the rate of before the knot is carried across it: the rate is
+        taken anew at the converged state, as in a run of that case from the start."""
+        super().restore(state)
+        on_knot = self.knots.size and np.abs(self.knots - self.lam).min() <= 1e-12 * abs(self.target)
+        if on_knot and self.previous is not None:
+            self.previous = self.rate = None
 
     def _next_stop(self) -> float:
         """The end of the interval being sub-stepped, or else the next knot or the end."""
@@ -250,7 +262,7 @@ class LoadPath(PathFollowing):
         # the last increment, none across a knot (the rate jumps there); the rate at the new state
         # from the tangent of the step's converged evaluation (whose history is that of the step's
         # start: a node that stuck in the step is not yet tied in it)
-        knot = np.abs(self.knots - lam).min() <= 1e-12 * abs(self.target)
+        knot = self.knots.size > 0 and np.abs(self.knots - lam).min() <= 1e-12 * abs(self.target)
         self.previous = None if knot else (u_f - self.u_f, lam - self.lam)
         self.rate = self._tangent_rate(self.converged, u_f, lam)
         self.converged = None
