@@ -1,0 +1,34 @@
+"""A table of T out of reach of every temperature a case reaches is warned about (a kelvin /
+Celsius mix-up) whichever table of the law it is: the modulus G_f(T) of [material.freeze]
+too, which out of reach would freeze nothing, silently."""
+
+from __future__ import annotations
+
+import re
+
+from test_temperature_domain import case_with, check
+
+FROZEN = {"modulus": [[100.0, 20.0], [150.0, 0.0]]}  # Celsius
+
+
+def freezing(initial: float):
+    """The slab of test_heat_case with a frozen network tabled in Celsius, at `initial` and a
+    film 20 below it."""
+
+    def edit(d):
+        d["material"]["freeze"] = dict(FROZEN)
+        d["temperature"]["initial"] = initial
+        d["convection"][0]["ambient"] = initial - 20.0
+
+    return edit
+
+
+def test_a_freeze_modulus_out_of_reach_is_warned(tmp_path, capsys):
+    code, err = check(capsys, case_with(tmp_path, freezing(423.15)))
+    assert code == 0, err
+    assert re.search(r"warning: material\.freeze\.modulus: the table's temperatures \(100 to 150\) lie outside", err)
+
+
+def test_a_freeze_modulus_in_reach_is_not_warned(tmp_path, capsys):
+    code, err = check(capsys, case_with(tmp_path, freezing(150.0)))
+    assert code == 0 and "material.freeze" not in err, err
