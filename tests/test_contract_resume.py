@@ -1,0 +1,72 @@
+"""`axiform run --resume` refuses every change of the physics already run through, beyond
+the tables of test_resume_frozen: the body's weight ([gravity], a load: its g, and its curve
+up to the resume time) and the temperature unit an Arrhenius shift turns into kelvin ([units]
+temperature).  A gravity curve changed after the resume time only is allowed."""
+
+from __future__ import annotations
+
+import copy
+import shutil
+
+import pytest
+from test_fuzz import toml
+from test_fuzz_files import call
+from test_resume_frozen import HEATED_PUNCH
+
+WEIGHED = copy.deepcopy(HEATED_PUNCH)
+WEIGHED["material"]["density"] = 1.0e-9
+WEIGHED["gravity"] = {"g": -9810.0, "curve": [[0.0, 0.0], [1.0, 1.0], [2.0, 1.0]]}
+WEIGHED["temperature"].update(reference=100.0, shift={"arrhenius": {"activation": 8.0e3}})
+WEIGHED["material"]["viscoelastic"] = {"g": [0.5], "tau": [1.0]}
+WEIGHED["units"] = {"temperature": "C"}
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    """The case file and the folder of its finished run (to t = 1)."""
+    d = tmp_path_factory.mktemp("weighed")
+    case = d / "case.toml"
+    case.write_text(toml(WEIGHED))
+    code, out, err = call(["run", str(case), "--out", str(d / "run"), "-q"], 120.0)
+    assert code == 0, err
+    return case, d / "run"
+
+
+def resumed(case, folder, *sets: str) -> tuple[int, str]:
+    argv = ["run", str(case), "--resume", str(folder), "-q", "--set", "solver.target=1.5"]
+    for s in sets:
+        argv += ["--set", s]
+    code, out, err = call(argv, 120.0)
+    assert "Traceback" not in out + err
+    return code, err
+
+
+@pytest.mark.parametrize(
+    "change, said",
+    [
+        ("gravity.g=-1000.0", "gravity: differs from the run being resumed (at gravity.g): [gravity] cannot change"),
+        ("gravity.curve=[[0.0, 0.0], [0.5, 0.0], [1.0, 1.0]]", "gravity: the curve differs before the resume time 1"),
+        ("units.temperature='K'", "units: differs from the run being resumed (at units.temperature)"),
+    ],
+)
+def test_a_change_of_the_weight_or_of_the_temperature_unit_is_refused(finished, change, said):
+    case, folder = finished
+    before = (folder / "history.csv").read_text()
+    code, err = resumed(case, folder, change)
+    assert code == 2 and said in err, err
+    assert (folder / "history.csv").read_text() == before
+
+
+def test_a_dropped_weight_is_refused(tmp_path, finished):
+    case = copy.deepcopy(WEIGHED)
+    del case["gravity"]
+    (tmp_path / "case.toml").write_text(toml(case))
+    code, err = resumed(tmp_path / "case.toml", finished[1])
+    assert code == 2 and "gravity: " in err and "[gravity] cannot change" in err, err
+
+
+def test_a_gravity_curve_changed_after_the_resume_time_is_allowed(tmp_path, finished):
+    folder = tmp_path / "run"
+    shutil.copytree(finished[1], folder)
+    code, err = resumed(finished[0], folder, "gravity.curve=[[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]")
+    assert code == 0, err
