@@ -70,3 +70,24 @@ def test_a_gravity_curve_changed_after_the_resume_time_is_allowed(tmp_path, fini
     shutil.copytree(finished[1], folder)
     code, err = resumed(finished[0], folder, "gravity.curve=[[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]")
     assert code == 0, err
+
+
+@pytest.mark.parametrize("edited", ["mould.csv", "other"])
+def test_a_mould_file_changed_since_the_run_is_refused(tmp_path, edited):
+    """The contact's geometry read from a file: the file moved by 0.5 between the run and its
+    resume is refused naming the key that names it; an unrelated file changed is not."""
+    case = copy.deepcopy(HEATED_PUNCH)
+    case["contact"][0]["surface"] = {"file": "mould.csv"}
+    (tmp_path / "mould.csv").write_text("12.0,2.0\n-1.0,2.0\n")
+    (tmp_path / "other").write_text("1\n")
+    (tmp_path / "case.toml").write_text(toml(case))
+    folder = tmp_path / "run"
+    code, out, err = call(["run", str(tmp_path / "case.toml"), "--out", str(folder), "-q"], 120.0)
+    assert code == 0, err
+    (tmp_path / edited).write_text("12.0,1.5\n-1.0,1.5\n")
+    code, err = resumed(tmp_path / "case.toml", folder)
+    if edited == "other":
+        assert code == 0, err
+    else:
+        assert code == 2 and "contact: the file mould.csv changed since the run being resumed" in err, err
+        assert "(at contact[0].surface.file)" in err, err

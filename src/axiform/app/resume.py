@@ -17,6 +17,7 @@ and [material]) is checked on those two.
 
 from __future__ import annotations
 
+import hashlib
 import json
 from pathlib import Path
 from typing import Any
@@ -52,11 +53,43 @@ def _physics(data: dict[str, Any]) -> dict[str, Any]:
     return _plain(physics | {"units": {"temperature": unit}})
 
 
-def frozen_meta(data: dict[str, Any]) -> dict[str, Any]:
+def _named_files(data: dict[str, Any]) -> list[tuple[str, str]]:
+    """(key path, file name) of the files the frozen tables read: the gmsh mesh, the moulds'
+    outlines and drawings."""
+    out = []
+    mesh = data.get("mesh")
+    if isinstance(mesh, dict) and isinstance(mesh.get("file"), str):
+        out.append(("mesh.file", mesh["file"]))
+    contacts = data.get("contact")
+    for k, c in enumerate(contacts if isinstance(contacts, list) else []):
+        surface = c.get("surface") if isinstance(c, dict) else None
+        for key in ("file", "dxf"):
+            if isinstance(surface, dict) and isinstance(surface.get(key), str):
+                out.append((f"contact[{k}].surface.{key}", surface[key]))
+    return out
+
+
+def _file_digests(data: dict[str, Any], base: Path) -> dict[str, str]:
+    """key path -> the SHA-256 of the file it names (relative names from the folder `base`,
+    the case file's), "" where it cannot be read: the geometry the frozen tables stand for."""
+    from ..io.text import read_bytes
+
+    out = {}
+    for key, name in _named_files(data):
+        try:
+            out[key] = hashlib.sha256(read_bytes(base / name)).hexdigest()
+        except OSError:
+            out[key] = ""
+    return out
+
+
+def frozen_meta(data: dict[str, Any], base: Path) -> dict[str, Any]:
     """What a checkpoint keeps of the case (its meta): the fingerprints of FINGERPRINTED and,
     under `physics`, the frozen tables, the [[contact]], the load tables and the temperature
-    unit as the case has them."""
-    return {key: fingerprint(data.get(key, {})) for key in FINGERPRINTED} | {"physics": _physics(data)}
+    unit as the case has them, and the digests of the files they read (`base`: the case
+    file's folder)."""
+    physics = _physics(data) | {"files": _file_digests(data, base)}
+    return {key: fingerprint(data.get(key, {})) for key in FINGERPRINTED} | {"physics": physics}
 
 
 def _first_difference(a: Any, b: Any, where: str) -> str | None:
@@ -117,9 +150,10 @@ def _check_load(table: str, where: str, old: dict, new: dict, reached: float) ->
         raise _refuse(table, found)
 
 
-def check_frozen(meta: dict[str, Any], data: dict[str, Any], reached: float) -> None:
+def check_frozen(meta: dict[str, Any], data: dict[str, Any], reached: float, base: Path) -> None:
     """CaseError naming the table (and the key) where the case of a resumed run changes the
-    physics of the run its checkpoint (meta) was made by, up to the load factor `reached`."""
+    physics of the run its checkpoint (meta) was made by, up to the load factor `reached`
+    (`base`: the case file's folder, where its files are read from)."""
     physics = meta.get("physics")
     if not isinstance(physics, dict):  # a checkpoint of before the physics in its meta
         for key in FINGERPRINTED:
@@ -141,11 +175,24 @@ def check_frozen(meta: dict[str, Any], data: dict[str, Any], reached: float) -> 
             raise _refuse(key, key, "added since the run being resumed" if old_load is None else "dropped")
         if isinstance(old_load, dict) and isinstance(new_load, dict):
             _check_load(key, key, old_load, new_load, reached)
+    _check_files(physics.get("files"), _file_digests(data, base), dict(_named_files(data)))
 
 
-def resume_state(folder: Path, data: dict) -> dict:
-    """The checkpoint of a results folder to resume, after checking that the case changes
-    nothing frozen (check_frozen); CaseError (exit 2) otherwise."""
+def _check_files(old: Any, new: dict[str, str], names: dict[str, str]) -> None:
+    """The files the frozen tables read, by their digests (`old` None: a checkpoint of before them)."""
+    if not isinstance(old, dict):
+        return
+    for key, digest in new.items():
+        if key in old and old[key] != digest:
+            raise _refuse(
+                key.split(".")[0].split("[")[0], key, f"the file {names[key]} changed since the run being resumed"
+            )
+
+
+def resume_state(folder: Path, data: dict, base: Path) -> dict:
+    """The checkpoint of a results folder to resume, after checking that the case (its files
+    read from the folder `base`) changes nothing frozen (check_frozen); CaseError (exit 2)
+    otherwise."""
     from ..io.checkpoint import load as load_checkpoint
 
     try:
@@ -160,7 +207,7 @@ def resume_state(folder: Path, data: dict) -> dict:
         raise CaseError(f"--resume: {exc}") from None
     path = state.get("path")
     reached = path.get("lam", 0.0) if isinstance(path, dict) else 0.0
-    check_frozen(meta, data, float(reached) if isinstance(reached, int | float) else 0.0)
+    check_frozen(meta, data, float(reached) if isinstance(reached, int | float) else 0.0, base)
     return state
 
 
