@@ -32,3 +32,19 @@ def test_a_freeze_modulus_out_of_reach_is_warned(tmp_path, capsys):
 def test_a_freeze_modulus_in_reach_is_not_warned(tmp_path, capsys):
     code, err = check(capsys, case_with(tmp_path, freezing(150.0)))
     assert code == 0 and "material.freeze" not in err, err
+
+
+def test_a_freeze_modulus_in_pa_in_an_mpa_case_is_warned(tmp_path, capsys):
+    """G_f(T) is a shear modulus as the law's: 2e7 (Pa typed for 20 MPa) is warned, naming the key."""
+
+    def pascal(d):
+        freezing(150.0)(d)
+        d["material"]["freeze"] = {"modulus": [[100.0, 2.0e7], [150.0, 0.0]]}
+        d["units"] = {"pressure": "MPa"}
+
+    code, err = check(capsys, case_with(tmp_path, pascal))
+    assert code == 0 and re.search(
+        r"warning: material\.freeze\.modulus: a shear modulus of 2e\+07 MPa is above 10000 MPa", err
+    ), err
+    code, err = check(capsys, case_with(tmp_path, lambda d: (freezing(150.0)(d), d.update(units={"pressure": "MPa"}))))
+    assert code == 0 and "shear modulus" not in err, err
