@@ -2,7 +2,8 @@
 meant, found without solving.  Each warning is one line that begins with the table and key at
 fault.
 
-- a load curve (fix, pressure, point load, mould motion, cavity) that still changes after
+- a curve (of a fix, pressure, point load, cavity, the weight, a mould's motion or temperature,
+  a film's ambient, the prescribed change of temperature) that still changes after
   [solver] target: the run ends at target, the rest of the process is cut off;
 - slave nodes inside a mould at t = 0 (deeper than the contact smoothing);
 - a mould that faces away from its slaves (a polyline walked the wrong way, a circle with the
@@ -80,6 +81,15 @@ def _curves(built: Built):
     for i, c in enumerate(case.contact):
         if c.motion.curve is not None:
             yield f"contact[{i}].motion.curve", c.motion.curve
+        if c.temperature_curve is not None:
+            yield f"contact[{i}].temperature_curve", c.temperature_curve
+    for i, film in enumerate(case.convection):
+        if film.curve is not None:
+            yield f"convection[{i}].curve", film.curve
+    if case.gravity is not None and case.gravity.curve is not None:
+        yield "gravity.curve", case.gravity.curve
+    if case.temperature is not None and case.temperature.change is not None:
+        yield "temperature.change", case.temperature.change
 
 
 def _end_time(built: Built) -> float | None:
