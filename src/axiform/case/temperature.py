@@ -231,8 +231,11 @@ def check_boundary_temperatures(case, shift: Shift | None) -> None:
 
 
 def _end_time(case) -> float | None:
-    """The run's end time ([solver] target under load control), None where not known."""
-    return float(case.solver.target) if case.solver.control == "load" and case.solver.target is not None else None
+    """The run's end time under load control ([solver] target, 1 by default), None where not
+    known (the load factor an unknown)."""
+    if case.solver.control != "load":
+        return None
+    return 1.0 if case.solver.target is None else float(case.solver.target)
 
 
 def change_values(case) -> list[tuple[float, str]]:
