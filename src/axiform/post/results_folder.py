@@ -38,10 +38,17 @@ class FolderInfo:
 
     @classmethod
     def read(cls, folder: Path) -> FolderInfo:
+        """What the folder's summary.json says (nothing where there is none); ValueError naming
+        the file where it is not a JSON object."""
         path = Path(folder) / "summary.json"
         if not path.exists():
             return cls()
-        s = json.loads(path.read_text())
+        try:
+            s = json.loads(path.read_text())
+        except ValueError as exc:  # JSONDecodeError, UnicodeDecodeError
+            raise ValueError(f"{path}: not JSON ({exc})") from None
+        if not isinstance(s, dict):
+            raise ValueError(f"{path}: not a JSON object")
         contacts = [c.get("name", f"contact[{k}]") for k, c in enumerate(s.get("contact") or [])]
         return cls(
             s.get("title", ""),

@@ -25,7 +25,7 @@ def _read_thickness(path: Path) -> tuple[dict[str, np.ndarray], int]:
     else:
         try:
             step = int(json.loads((path.parent / "summary.json").read_text())["steps"])
-        except (OSError, ValueError, KeyError):
+        except (OSError, ValueError, KeyError, TypeError):
             step = 0
     data = np.genfromtxt(path, delimiter=",", names=True, ndmin=1)
     names = data.dtype.names or ()
