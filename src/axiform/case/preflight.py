@@ -11,11 +11,12 @@ fault.
   own outward normal does, not against it, the slaves behind it; or slaves on the face of
   the body away from the mould (the same normals, the slaves in front of it: the body would
   pass through the mould);
-- a load that inverts elements within one nominal step, in one linear solve of the reference
-  tangent (no contact) for the largest increment its curve makes over one nominal step
-  (INVERTING_FRACTION of it): a value typed in other units (a pressure in Pa in an mm / MPa
-  case); under displacement control (the load factor an unknown), the driven dof's step
-  target / steps instead.  Not for cavities under volume or gas control;
+- a load (the weight too) that inverts elements within one nominal step, in one linear
+  solve of the reference tangent (no contact) for the largest increment its curve makes
+  over one nominal step (INVERTING_FRACTION of it): a value typed in other units (a
+  pressure in Pa in an mm / MPa case, a density in kg/m^3 in a t/mm^3 one); under
+  displacement control (the load factor an unknown), the driven dof's step target / steps
+  instead.  Not for cavities under volume or gas control;
 - the units' plausibility (case.plausible): tables of T out of reach of every temperature
   of the case, a modulus in Pa in an MPa case.
 
@@ -31,6 +32,7 @@ import numpy as np
 from ..fem.curves import Curve
 from ..fem.elements import gradient_operator
 from ..fem.selectors import select_nodes
+from ..model.gravity import GravityTerm
 from ..solve.linsolve import SingularTangentError, factorize
 from ..solve.solver import DisplacementControl
 from .plausible import modulus_units, tables_out_of_reach
@@ -310,6 +312,12 @@ def inverting_loads(built: Built) -> list[str]:
             _, ge, _ = cav.evaluate(zero, tangent=False)
             f = np.bincount(cav.dofs.ravel(), ge.ravel(), body.n_full) * step
             loads.append((f"cavity[{i}].pressure", gas.pressure, units.pressure, f, None))
+    for weight in (t for t in body.terms if isinstance(t, GravityTerm)):
+        assert case.gravity is not None, "a weight comes from [gravity]"
+        step = _step_increment(weight.curve, t_end, steps)
+        if step:
+            density = f"(material.density {case.material.density:g})"
+            loads.append(("gravity.g", case.gravity.g, density, weight.force * step, None))
     for i, fix in enumerate(case.fix):
         if not fix.value:
             continue
