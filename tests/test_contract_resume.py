@@ -91,3 +91,28 @@ def test_a_mould_file_changed_since_the_run_is_refused(tmp_path, edited):
     else:
         assert code == 2 and "contact: the file mould.csv changed since the run being resumed" in err, err
         assert "(at contact[0].surface.file)" in err, err
+
+
+def test_an_arc_length_run_resumed_to_a_later_stop_goes_on_to_it(tmp_path):
+    """The plate under arc length stopped at w = 5, resumed with the stop at w = 8: it goes on
+    to 8 (it said "finished" at 5 without a step, the path's end restored with its state)."""
+    from pathlib import Path
+
+    plate = Path(__file__).resolve().parents[1] / "examples" / "plate_arc_length.toml"
+    folder = tmp_path / "run"
+    sets = ["restart.every=1", "solver.steps=5", "output.vtu=false", "output.plots=false"]
+    argv = ["run", str(plate), "--out", str(folder), "-q"]
+    for s in [*sets, "solver.stop.value=5.0"]:
+        argv += ["--set", s]
+    code, out, err = call(argv, 120.0)
+    assert code == 0, err
+    rows = (folder / "history.csv").read_text().splitlines()
+    argv = ["run", str(plate), "--resume", str(folder), "-q"]
+    for s in [*sets, "solver.stop.value=8.0"]:
+        argv += ["--set", s]
+    code, out, err = call(argv, 120.0)
+    assert code == 0, err
+    after = (folder / "history.csv").read_text().splitlines()
+    assert after[: len(rows)] == rows and len(after) > len(rows)
+    w = after[0].split(",").index("w_center")
+    assert float(after[-1].split(",")[w]) == pytest.approx(8.0, rel=1e-9)

@@ -82,6 +82,15 @@ class ArcLengthPath(PathFollowing):
     def done(self):
         return self.finished
 
+    def restore(self, state: dict) -> None:
+        """The path's state of a checkpoint; resumed with a later end (target, stop value) than
+        the run had reached, the path is not finished: it goes on to that end."""
+        super().restore(state)
+        reached = self._fraction(self.u_f, self.lam)
+        if self.finished and reached < 1.0 - 1e-9:
+            self.finished = False
+            self.progress = reached
+
     def _crossed(self, old, new, goal):
         return goal is not None and (old - goal) * (new - goal) <= 0 and new != old
 
