@@ -32,7 +32,6 @@ import numpy as np
 from ..fem.curves import Curve
 from ..fem.elements import gradient_operator
 from ..fem.selectors import select_nodes
-from ..model.gravity import GravityTerm
 from ..solve.linsolve import SingularTangentError, factorize
 from ..solve.solver import DisplacementControl
 from .plausible import modulus_units, tables_out_of_reach
@@ -312,12 +311,14 @@ def inverting_loads(built: Built) -> list[str]:
             _, ge, _ = cav.evaluate(zero, tangent=False)
             f = np.bincount(cav.dofs.ravel(), ge.ravel(), body.n_full) * step
             loads.append((f"cavity[{i}].pressure", gas.pressure, units.pressure, f, None))
-    for weight in (t for t in body.terms if isinstance(t, GravityTerm)):
-        assert case.gravity is not None, "a weight comes from [gravity]"
-        step = _step_increment(weight.curve, t_end, steps)
-        if step:
-            density = f"(material.density {case.material.density:g})"
-            loads.append(("gravity.g", case.gravity.g, density, weight.force * step, None))
+    if case.gravity is not None:
+        from ..model.gravity import GravityTerm  # only where the case has a weight
+
+        for weight in (t for t in body.terms if isinstance(t, GravityTerm)):
+            step = _step_increment(weight.curve, t_end, steps)
+            if step:
+                density = f"(material.density {case.material.density:g})"
+                loads.append(("gravity.g", case.gravity.g, density, weight.force * step, None))
     for i, fix in enumerate(case.fix):
         if not fix.value:
             continue
