@@ -48,3 +48,18 @@ def test_a_freeze_modulus_in_pa_in_an_mpa_case_is_warned(tmp_path, capsys):
     ), err
     code, err = check(capsys, case_with(tmp_path, lambda d: (freezing(150.0)(d), d.update(units={"pressure": "MPa"}))))
     assert code == 0 and "shear modulus" not in err, err
+
+
+def test_a_freezing_law_under_a_cooling_program_is_not_said_to_ignore_its_temperature(tmp_path, capsys):
+    """[material.freeze] with a prescribed cooling ([temperature] change) and no other use of
+    the temperature: the frozen network is born from it, so no "changes nothing" warning."""
+
+    def cooled(d):
+        d.pop("thermal")
+        d.pop("convection")
+        d["material"]["freeze"] = dict(FROZEN)
+        d["temperature"]["change"] = [[0.0, 0.0], [19.0, -40.0]]
+        d["pressure"] = [{"on": {"z": 2.0}, "value": 0.01}]
+
+    code, err = check(capsys, case_with(tmp_path, cooled))
+    assert code == 0 and "changes nothing" not in err, err
