@@ -63,3 +63,14 @@ def test_a_freezing_law_under_a_cooling_program_is_not_said_to_ignore_its_temper
 
     code, err = check(capsys, case_with(tmp_path, cooled))
     assert code == 0 and "changes nothing" not in err, err
+
+
+def test_a_freezing_law_at_a_constant_temperature_is_said_to_ignore_it(tmp_path, capsys):
+    def constant(d):
+        d.pop("thermal")
+        d.pop("convection")
+        d["material"]["freeze"] = dict(FROZEN)
+        d["pressure"] = [{"on": {"z": 2.0}, "value": 0.01}]
+
+    code, err = check(capsys, case_with(tmp_path, constant))
+    assert code == 0 and "warning: temperature: " in err and "changes nothing" in err, err

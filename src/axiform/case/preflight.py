@@ -377,8 +377,8 @@ def _internal_rate(model, u_p: np.ndarray) -> np.ndarray:
 
 def idle_temperature(built: Built) -> list[str]:
     """A [temperature] that changes nothing: a shift without a Prony series (nothing
-    relaxes), or a temperature with neither tables of T in the law, a frozen network, a shift
-    nor [thermal]."""
+    relaxes), or a temperature with neither tables of T in the law, a shift, [thermal] nor a
+    frozen network under a prescribed change."""
     case = built.case
     heat = case.temperature
     if heat is None:
@@ -389,7 +389,8 @@ def idle_temperature(built: Built) -> list[str]:
             "temperature.shift: the material has no Prony series ([material] viscoelastic) and no network: "
             "the shift of its relaxation times changes nothing"
         ]
-    if heat.shift is None and not case.material.tables() and case.material.freeze is None and case.thermal is None:
+    freezing = case.material.freeze is not None and heat.change is not None  # a frozen network born as it cools
+    if heat.shift is None and not case.material.tables() and not freezing and case.thermal is None:
         return [
             "temperature: no constant of [material] is a table of T, there is no shift and no [thermal]: the "
             "temperature is written out but changes nothing"
