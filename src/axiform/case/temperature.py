@@ -23,6 +23,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import ValidationError, field_validator, model_validator
 
+from ..fem.assembly import point_values
 from ..fem.curves import Curve
 from ..fem.mesh import Mesh
 from ..materials.temperature import WLF, Arrhenius, Shift, Table, TemperatureDomainError
@@ -286,6 +287,7 @@ def give_temperature(model: Model, mesh: Mesh, case) -> None:
             raise CaseError(f"temperature.initial: {exc}") from None
         key = "wlf.C2" if heat.shift.wlf is not None else "arrhenius"
         raise CaseError(f"temperature.shift.{key}: {exc} (temperature.initial)") from None
-    check_change(case, initial, shift)
+    # the coldest of the nodes and of the points between them (a Q8's shape functions may dip below its nodes)
+    check_change(case, np.concatenate([initial, point_values(mesh, initial).ravel()]), shift)
     model.program(None if heat.change is None else Curve(heat.change))
     check_boundary_temperatures(case, shift)
