@@ -28,12 +28,13 @@ class Guarded:
     """A text stream that a closed reader cannot break: the first write or flush that finds
     the pipe closed (BrokenPipeError, EPIPE) points the stream's file descriptor at os.devnull
     (so that the interpreter's own flush at exit finds nothing to complain about, as Python's
-    documentation on SIGPIPE suggests) and every later write is dropped.  All else is the
-    wrapped stream's."""
+    documentation on SIGPIPE suggests) and every later write is dropped.  A stream closed
+    before the command started (None: Python's sys.stdout under `>&-`) drops every write from
+    the start.  All else is the wrapped stream's."""
 
     def __init__(self, stream):
         self._stream = stream
-        self.broken = False
+        self.broken = stream is None
 
     def _drop(self) -> None:
         self.broken = True
@@ -46,11 +47,12 @@ class Guarded:
         except (OSError, ValueError, AttributeError, io.UnsupportedOperation):
             pass  # no descriptor (a StringIO, pytest's capture): dropping the writes is enough
 
-    def _guard(self, call, *args):
+    def _guard(self, name: str, *args):
+        """The wrapped stream's method `name` called with args, unless the stream is broken."""
         if self.broken:
             return None
         try:
-            return call(*args)
+            return getattr(self._stream, name)(*args)
         except OSError as exc:  # BrokenPipeError, or EPIPE / EINVAL on a closed pipe elsewhere
             if not isinstance(exc, BrokenPipeError) and exc.errno not in (errno.EPIPE, errno.EINVAL):
                 raise
@@ -61,7 +63,7 @@ class Guarded:
             return None
 
     def write(self, text: str) -> int:
-        self._guard(self._stream.write, text)
+        self._guard("write", text)
         return len(text)
 
     def writelines(self, lines) -> None:
@@ -69,10 +71,10 @@ class Guarded:
             self.write(line)
 
     def flush(self) -> None:
-        self._guard(self._stream.flush)
+        self._guard("flush")
 
     def isatty(self) -> bool:
-        return not self.broken and bool(self._guard(self._stream.isatty))
+        return not self.broken and bool(self._guard("isatty"))
 
     def __getattr__(self, name):
         return getattr(self._stream, name)

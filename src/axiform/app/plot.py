@@ -27,6 +27,7 @@ def plot(folder: str, field: str, animate: bool = False) -> int:
     """(Re)write the PNG plots of a results folder; returns the exit code."""
     from ..case.suggest import nearest
     from ..post.plots import FieldError, plot_folder, read_history
+    from ..post.results_folder import FolderInfo, UnreadableResults
     from .run import writable
 
     path = Path(folder)
@@ -40,6 +41,7 @@ def plot(folder: str, field: str, animate: bool = False) -> int:
         return 2
     try:
         read_history(path / "history.csv")
+        FolderInfo.read(path)
         fields = fields_of(path)
     except (OSError, ValueError, KeyError, IndexError, SyntaxError) as exc:  # SyntaxError: XML
         say(f"axiform: {folder}: unreadable results ({type(exc).__name__}: {exc})")
@@ -57,6 +59,9 @@ def plot(folder: str, field: str, animate: bool = False) -> int:
         pngs = plot_folder(path, field, animate)
     except FieldError as exc:
         say(f"axiform: --field: {exc}")
+        return 2
+    except UnreadableResults as exc:
+        say(f"axiform: {folder}: unreadable results ({exc})")
         return 2
     except OSError as exc:  # the folder turned read-only, or the disk is full
         say(f"axiform: cannot write the plots in {folder} ({exc.strerror or exc})")

@@ -8,7 +8,8 @@ those steps must be what makes the next ones: the tables of FROZEN_TABLES whole 
 numerical ones of CONTACT_NUMERICS (its geometry, motion, friction and heat), and the loads
 ([[fix]], [[pressure]], [[point_load]], [[cavity]]) up to the resume time: each key of
 theirs but `curve` unchanged, and their curve f(t) the same from t = 0 to the load factor
-the checkpoint reached (a curve may change beyond it).  A later solver.target, other solver
+the checkpoint reached (a curve may change beyond it); [gravity] as those loads; and [units]
+temperature (an Arrhenius shift's absolute temperature).  A later solver.target, other solver
 numbers and more output are allowed.  The checkpoint's meta holds these tables as the case
 had them (`frozen_meta`); a checkpoint written before it (only the fingerprints of [mesh]
 and [material]) is checked on those two.
@@ -16,6 +17,7 @@ and [material]) is checked on those two.
 
 from __future__ import annotations
 
+import hashlib
 import json
 from pathlib import Path
 from typing import Any
@@ -33,6 +35,8 @@ FINGERPRINTED = ("mesh", "material")
 CONTACT_NUMERICS = ("name", "penalty", "tangential_penalty", "depth", "search", "stabilization")
 # the arrays of tables whose loads are frozen up to the resume time: every key but the curve
 LOADS = ("fix", "pressure", "point_load", "cavity")
+# single load tables, frozen as those of LOADS are
+SINGLE_LOADS = ("gravity",)
 
 
 def _plain(value: Any) -> Any:
@@ -40,11 +44,52 @@ def _plain(value: Any) -> Any:
     return json.loads(json.dumps(value, sort_keys=True, default=str))
 
 
-def frozen_meta(data: dict[str, Any]) -> dict[str, Any]:
+def _physics(data: dict[str, Any]) -> dict[str, Any]:
+    """The frozen tables, the [[contact]], the load tables and the temperature unit of a case
+    (as JSON has them)."""
+    units = data.get("units")
+    unit = units.get("temperature") if isinstance(units, dict) else None
+    physics = {key: data.get(key) for key in (*FROZEN_TABLES, "contact", *LOADS, *SINGLE_LOADS)}
+    return _plain(physics | {"units": {"temperature": unit}})
+
+
+def _named_files(data: dict[str, Any]) -> list[tuple[str, str]]:
+    """(key path, file name) of the files the frozen tables read: the gmsh mesh, the moulds'
+    outlines and drawings."""
+    out = []
+    mesh = data.get("mesh")
+    if isinstance(mesh, dict) and isinstance(mesh.get("file"), str):
+        out.append(("mesh.file", mesh["file"]))
+    contacts = data.get("contact")
+    for k, c in enumerate(contacts if isinstance(contacts, list) else []):
+        surface = c.get("surface") if isinstance(c, dict) else None
+        for key in ("file", "dxf"):
+            if isinstance(surface, dict) and isinstance(surface.get(key), str):
+                out.append((f"contact[{k}].surface.{key}", surface[key]))
+    return out
+
+
+def _file_digests(data: dict[str, Any], base: Path) -> dict[str, str]:
+    """key path -> the SHA-256 of the file it names (relative names from the folder `base`,
+    the case file's), "" where it cannot be read: the geometry the frozen tables stand for."""
+    from ..io.text import read_bytes
+
+    out = {}
+    for key, name in _named_files(data):
+        try:
+            out[key] = hashlib.sha256(read_bytes(base / name)).hexdigest()
+        except OSError:
+            out[key] = ""
+    return out
+
+
+def frozen_meta(data: dict[str, Any], base: Path) -> dict[str, Any]:
     """What a checkpoint keeps of the case (its meta): the fingerprints of FINGERPRINTED and,
-    under `physics`, the frozen tables, the [[contact]] and the load tables as the case has them."""
-    physics = {key: data.get(key) for key in (*FROZEN_TABLES, "contact", *LOADS)}
-    return {key: fingerprint(data.get(key, {})) for key in FINGERPRINTED} | {"physics": _plain(physics)}
+    under `physics`, the frozen tables, the [[contact]], the load tables and the temperature
+    unit as the case has them, and the digests of the files they read (`base`: the case
+    file's folder)."""
+    physics = _physics(data) | {"files": _file_digests(data, base)}
+    return {key: fingerprint(data.get(key, {})) for key in FINGERPRINTED} | {"physics": physics}
 
 
 def _first_difference(a: Any, b: Any, where: str) -> str | None:
@@ -87,36 +132,67 @@ def _check_entries(table: str, old: list, new: list, reached: float) -> None:
     for i, (a, b) in enumerate(zip(old, new, strict=True)):
         if table == "contact":
             a, b = ({k: v for k, v in x.items() if k not in CONTACT_NUMERICS} for x in (a, b))
-        elif table in LOADS:
-            if not _same_curve(a.get("curve"), b.get("curve"), reached):
-                raise _refuse(table, f"{table}[{i}].curve", f"the curve differs before the resume time {reached:g}")
-            a, b = ({k: v for k, v in x.items() if k != "curve"} for x in (a, b))
-        found = _first_difference(a, b, f"{table}[{i}]")
-        if found:
-            raise _refuse(table, found)
+            found = _first_difference(a, b, f"{table}[{i}]")
+            if found:
+                raise _refuse(table, found)
+        else:
+            _check_load(table, f"{table}[{i}]", a, b, reached)
 
 
-def check_frozen(meta: dict[str, Any], data: dict[str, Any], reached: float) -> None:
+def _check_load(table: str, where: str, old: dict, new: dict, reached: float) -> None:
+    """A load table (at the key path `where`) of a resumed case against the run's: every key
+    but the curve the same, the curve the same up to the load factor `reached`."""
+    if not _same_curve(old.get("curve"), new.get("curve"), reached):
+        raise _refuse(table, f"{where}.curve", f"the curve differs before the resume time {reached:g}")
+    a, b = ({k: v for k, v in x.items() if k != "curve"} for x in (old, new))
+    found = _first_difference(a, b, where)
+    if found:
+        raise _refuse(table, found)
+
+
+def check_frozen(meta: dict[str, Any], data: dict[str, Any], reached: float, base: Path) -> None:
     """CaseError naming the table (and the key) where the case of a resumed run changes the
-    physics of the run its checkpoint (meta) was made by, up to the load factor `reached`."""
+    physics of the run its checkpoint (meta) was made by, up to the load factor `reached`
+    (`base`: the case file's folder, where its files are read from)."""
     physics = meta.get("physics")
     if not isinstance(physics, dict):  # a checkpoint of before the physics in its meta
         for key in FINGERPRINTED:
             if meta.get(key) != fingerprint(data.get(key, {})):
                 raise _refuse(key, key)
         return
-    new = _plain({key: data.get(key) for key in physics})
-    for key in FROZEN_TABLES:
-        found = _first_difference(physics.get(key), new.get(key), key)
+    new = _physics(data)
+    for key in (*FROZEN_TABLES, "units"):  # "units": not in the meta of earlier checkpoints
+        found = _first_difference(physics.get(key), new.get(key), key) if key in physics else None
         if found:
             raise _refuse(key, found)
     for key in ("contact", *LOADS):
         _check_entries(key, physics.get(key) or [], new.get(key) or [], reached)
+    for key in SINGLE_LOADS:
+        if key not in physics:  # earlier checkpoints
+            continue
+        old_load, new_load = physics[key], new.get(key)
+        if (old_load is None) != (new_load is None):
+            raise _refuse(key, key, "added since the run being resumed" if old_load is None else "dropped")
+        if isinstance(old_load, dict) and isinstance(new_load, dict):
+            _check_load(key, key, old_load, new_load, reached)
+    _check_files(physics.get("files"), _file_digests(data, base), dict(_named_files(data)))
 
 
-def resume_state(folder: Path, data: dict) -> dict:
-    """The checkpoint of a results folder to resume, after checking that the case changes
-    nothing frozen (check_frozen); CaseError (exit 2) otherwise."""
+def _check_files(old: Any, new: dict[str, str], names: dict[str, str]) -> None:
+    """The files the frozen tables read, by their digests (`old` None: a checkpoint of before them)."""
+    if not isinstance(old, dict):
+        return
+    for key, digest in new.items():
+        if key in old and old[key] != digest:
+            raise _refuse(
+                key.split(".")[0].split("[")[0], key, f"the file {names[key]} changed since the run being resumed"
+            )
+
+
+def resume_state(folder: Path, data: dict, base: Path) -> dict:
+    """The checkpoint of a results folder to resume, after checking that the case (its files
+    read from the folder `base`) changes nothing frozen (check_frozen); CaseError (exit 2)
+    otherwise."""
     from ..io.checkpoint import load as load_checkpoint
 
     try:
@@ -131,7 +207,7 @@ def resume_state(folder: Path, data: dict) -> dict:
         raise CaseError(f"--resume: {exc}") from None
     path = state.get("path")
     reached = path.get("lam", 0.0) if isinstance(path, dict) else 0.0
-    check_frozen(meta, data, float(reached) if isinstance(reached, int | float) else 0.0)
+    check_frozen(meta, data, float(reached) if isinstance(reached, int | float) else 0.0, base)
     return state
 
 

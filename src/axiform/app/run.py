@@ -167,7 +167,7 @@ class Job:
             if out is not None and Path(out).resolve() != Path(resume).resolve():
                 raise CaseError("--out: a resumed run writes in the folder it resumes (--resume)")
             out = resume
-            state = resume_state(Path(resume), data)
+            state = resume_state(Path(resume), data, case_file.parent)
         built = build(case, case_file.parent)
         if state is not None and out is not None:
             check_fit(state, built.model, Path(out))
@@ -213,7 +213,7 @@ class Job:
             labels=case_labels(case),
             case=self.origin(out_dir),
             restart_every=case.restart.every,
-            restart_meta=frozen_meta(self.data),
+            restart_meta=frozen_meta(self.data, self.case_file.parent),
             resume=self.state,
             flush_every_s=FLUSH_EVERY_S,
             warnings=self.warnings,

@@ -1,12 +1,13 @@
 """Pre-run warnings of a built case about its units (case.preflight runs them): numbers that
 are valid but probably typed in another unit than the rest of the case.
 
-- a table of T (a constant of the law, a heat property) whose temperatures lie wholly outside
-  every temperature the case can reach (the initial field, and with heat conduction the
-  moulds' and films' temperatures x their curves): only its end value is ever used, a sign
-  of a kelvin / Celsius mix-up (a table at 110 to 150 in a case at 423);
-- a shear modulus above MAX_MPA_MODULUS in a case whose [units] pressure is MPa (a modulus
-  in Pa: 1e6 times too stiff).
+- a table of T (a constant of the law, the modulus of its frozen network, a heat property)
+  whose temperatures lie wholly outside every temperature the case can reach (the initial
+  field, and with heat conduction the moulds' and films' temperatures x their curves): only
+  its end value is ever used, a sign of a kelvin / Celsius mix-up (a table at 110 to 150 in a
+  case at 423);
+- a shear modulus (the law's, its frozen network's) above MAX_MPA_MODULUS in a case whose
+  [units] pressure is MPa (a modulus in Pa: 1e6 times too stiff).
 
 Each warning is one line that begins with the table and key at fault.
 """
@@ -39,9 +40,12 @@ def reachable_range(built) -> tuple[float, float] | None:
 
 
 def _tables(case):
-    """(key, T knots) of every table of T of the case: the law's constants, the heat properties."""
+    """(key, T knots) of every table of T of the case: the law's constants, the modulus of its
+    frozen network, the heat properties."""
     for name, table in case.material.tables().items():
         yield f"material.{name}", np.asarray(table.T)
+    if case.material.freeze is not None:
+        yield "material.freeze.modulus", np.array([row[0] for row in case.material.freeze.modulus], float)
     if case.thermal is not None:
         for name in ("conductivity", "density", "specific_heat"):
             value = getattr(case.thermal, name)
@@ -69,13 +73,16 @@ def tables_out_of_reach(built) -> list[str]:
 
 
 def modulus_units(built) -> list[str]:
-    """A shear modulus above MAX_MPA_MODULUS in a case whose [units] pressure is MPa."""
+    """A shear modulus above MAX_MPA_MODULUS in a case whose [units] pressure is MPa: the
+    law's (its networks' included), the largest of its frozen network's table."""
     if built.case.units.pressure not in MPA:
         return []
-    mu = float(getattr(built.model.material, "shear_modulus", 0.0))
-    if not mu > MAX_MPA_MODULUS:
-        return []
+    moduli = [("material", float(getattr(built.model.material, "shear_modulus", 0.0)))]
+    if built.case.material.freeze is not None:
+        moduli.append(("material.freeze.modulus", max(row[1] for row in built.case.material.freeze.modulus)))
     return [
-        f"material: a shear modulus of {mu:.3g} MPa is above {MAX_MPA_MODULUS:g} MPa (a glassy polymer's is "
+        f"{key}: a shear modulus of {mu:.3g} MPa is above {MAX_MPA_MODULUS:g} MPa (a glassy polymer's is "
         f'about 1e3, a rubber\'s 0.1 to 10): is it in Pa ([units] pressure = "{built.case.units.pressure}")?'
+        for key, mu in moduli
+        if mu > MAX_MPA_MODULUS
     ]

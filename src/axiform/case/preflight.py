@@ -2,7 +2,8 @@
 meant, found without solving.  Each warning is one line that begins with the table and key at
 fault.
 
-- a load curve (fix, pressure, point load, mould motion, cavity) that still changes after
+- a curve (of a fix, pressure, point load, cavity, the weight, a mould's motion or temperature,
+  a film's ambient, the prescribed change of temperature) that still changes after
   [solver] target: the run ends at target, the rest of the process is cut off;
 - slave nodes inside a mould at t = 0 (deeper than the contact smoothing);
 - a mould that faces away from its slaves (a polyline walked the wrong way, a circle with the
@@ -10,11 +11,12 @@ fault.
   own outward normal does, not against it, the slaves behind it; or slaves on the face of
   the body away from the mould (the same normals, the slaves in front of it: the body would
   pass through the mould);
-- a load that inverts elements within one nominal step, in one linear solve of the reference
-  tangent (no contact) for the largest increment its curve makes over one nominal step
-  (INVERTING_FRACTION of it): a value typed in other units (a pressure in Pa in an mm / MPa
-  case); under displacement control (the load factor an unknown), the driven dof's step
-  target / steps instead.  Not for cavities under volume or gas control;
+- a load (the weight too) that inverts elements within one nominal step, in one linear
+  solve of the reference tangent (no contact) for the largest increment its curve makes
+  over one nominal step (INVERTING_FRACTION of it): a value typed in other units (a
+  pressure in Pa in an mm / MPa case, a density in kg/m^3 in a t/mm^3 one); under
+  displacement control (the load factor an unknown), the driven dof's step target / steps
+  instead.  Not for cavities under volume or gas control;
 - the units' plausibility (case.plausible): tables of T out of reach of every temperature
   of the case, a modulus in Pa in an MPa case.
 
@@ -80,6 +82,15 @@ def _curves(built: Built):
     for i, c in enumerate(case.contact):
         if c.motion.curve is not None:
             yield f"contact[{i}].motion.curve", c.motion.curve
+        if c.temperature_curve is not None:
+            yield f"contact[{i}].temperature_curve", c.temperature_curve
+    for i, film in enumerate(case.convection):
+        if film.curve is not None:
+            yield f"convection[{i}].curve", film.curve
+    if case.gravity is not None and case.gravity.curve is not None:
+        yield "gravity.curve", case.gravity.curve
+    if case.temperature is not None and case.temperature.change is not None:
+        yield "temperature.change", case.temperature.change
 
 
 def _end_time(built: Built) -> float | None:
@@ -300,6 +311,14 @@ def inverting_loads(built: Built) -> list[str]:
             _, ge, _ = cav.evaluate(zero, tangent=False)
             f = np.bincount(cav.dofs.ravel(), ge.ravel(), body.n_full) * step
             loads.append((f"cavity[{i}].pressure", gas.pressure, units.pressure, f, None))
+    if case.gravity is not None:
+        from ..model.gravity import GravityTerm  # only where the case has a weight
+
+        for weight in (t for t in body.terms if isinstance(t, GravityTerm)):
+            step = _step_increment(weight.curve, t_end, steps)
+            if step:
+                density = f"(material.density {case.material.density:g})"
+                loads.append(("gravity.g", case.gravity.g, density, weight.force * step, None))
     for i, fix in enumerate(case.fix):
         if not fix.value:
             continue
@@ -358,7 +377,8 @@ def _internal_rate(model, u_p: np.ndarray) -> np.ndarray:
 
 def idle_temperature(built: Built) -> list[str]:
     """A [temperature] that changes nothing: a shift without a Prony series (nothing
-    relaxes), or a temperature with neither tables of T in the law, a shift nor [thermal]."""
+    relaxes), or a temperature with neither tables of T in the law, a shift, [thermal] nor a
+    frozen network under a prescribed change."""
     case = built.case
     heat = case.temperature
     if heat is None:
@@ -369,7 +389,8 @@ def idle_temperature(built: Built) -> list[str]:
             "temperature.shift: the material has no Prony series ([material] viscoelastic) and no network: "
             "the shift of its relaxation times changes nothing"
         ]
-    if heat.shift is None and not case.material.tables() and case.thermal is None:
+    freezing = case.material.freeze is not None and heat.change is not None  # a frozen network born as it cools
+    if heat.shift is None and not case.material.tables() and not freezing and case.thermal is None:
         return [
             "temperature: no constant of [material] is a table of T, there is no shift and no [thermal]: the "
             "temperature is written out but changes nothing"

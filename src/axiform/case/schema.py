@@ -164,7 +164,8 @@ def law_keys(data: dict[str, Any]) -> dict[tuple, list[str]]:
     model = table.get("model") if isinstance(table, dict) else None
     if not isinstance(model, str) or model not in LAWS:
         return {}
-    return {("material",): ["model", *LAWS[model].key_names, "kappa", "E", "nu", "viscoelastic", "network", "freeze"]}
+    common = ["kappa", "E", "nu", "viscoelastic", "network", "freeze", "density"]
+    return {("material",): ["model", *LAWS[model].key_names, *common]}
 
 
 def parse(data: dict[str, Any]) -> Case:

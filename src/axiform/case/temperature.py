@@ -23,6 +23,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import ValidationError, field_validator, model_validator
 
+from ..fem.assembly import point_values
 from ..fem.curves import Curve
 from ..fem.mesh import Mesh
 from ..materials.temperature import WLF, Arrhenius, Shift, Table, TemperatureDomainError
@@ -231,8 +232,11 @@ def check_boundary_temperatures(case, shift: Shift | None) -> None:
 
 
 def _end_time(case) -> float | None:
-    """The run's end time ([solver] target under load control), None where not known."""
-    return float(case.solver.target) if case.solver.control == "load" and case.solver.target is not None else None
+    """The run's end time under load control ([solver] target, 1 by default), None where not
+    known (the load factor an unknown)."""
+    if case.solver.control != "load":
+        return None
+    return 1.0 if case.solver.target is None else float(case.solver.target)
 
 
 def change_values(case) -> list[tuple[float, str]]:
@@ -283,6 +287,7 @@ def give_temperature(model: Model, mesh: Mesh, case) -> None:
             raise CaseError(f"temperature.initial: {exc}") from None
         key = "wlf.C2" if heat.shift.wlf is not None else "arrhenius"
         raise CaseError(f"temperature.shift.{key}: {exc} (temperature.initial)") from None
-    check_change(case, initial, shift)
+    # the coldest of the nodes and of the points between them (a Q8's shape functions may dip below its nodes)
+    check_change(case, np.concatenate([initial, point_values(mesh, initial).ravel()]), shift)
     model.program(None if heat.change is None else Curve(heat.change))
     check_boundary_temperatures(case, shift)

@@ -134,8 +134,10 @@ def read_dxf(
     try:
         if path.is_dir():
             raise DxfError(f"{path} is a folder, not a DXF drawing")
-        if not path.is_file():
+        if not path.exists():
             raise DxfError(f"no such file {path}")
+        if not path.is_file():
+            raise DxfError(f"{path} is not a regular file (a device, a pipe or a socket), not a DXF drawing")
     except OSError as exc:  # a name longer than the file system allows, a folder that cannot be read
         raise DxfError(f"cannot read {path} ({exc.strerror or exc})") from None
     try:

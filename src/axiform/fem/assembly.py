@@ -14,6 +14,14 @@ from .elements import gauss_quad, gradient_operator
 from .mesh import Mesh
 
 
+def point_values(mesh: Mesh, nodal: np.ndarray) -> np.ndarray:
+    """A nodal field (n,) at the quadrature points (e, q), by the element's shape functions
+    (SFR: its Q4 ones; a Q8's quadratic ones may leave the range of the nodes' values)."""
+    kind = mesh.element
+    N = kind.shape(gauss_quad(kind.gauss)[0])[0]  # (q, k)
+    return nodal[mesh.cells] @ N.T
+
+
 def element_dofs(cells: np.ndarray, dofs_per_node: int) -> np.ndarray:
     """Full dof numbers (e, k * dofs_per_node) of the cells, node by node."""
     return (cells[:, :, None] * dofs_per_node + np.arange(dofs_per_node)).reshape(len(cells), -1)
@@ -46,9 +54,7 @@ class SolidAssembly:
     def point_values(self, nodal: np.ndarray) -> np.ndarray:
         """A nodal field (n,) at the quadrature points (e, q), by the element's shape
         functions (SFR: its Q4 ones)."""
-        kind = self.mesh.element
-        N = kind.shape(gauss_quad(kind.gauss)[0])[0]  # (q, k)
-        return nodal[self.mesh.cells] @ N.T
+        return point_values(self.mesh, nodal)
 
     def stress(
         self,

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..fem.assembly import SolidAssembly
+from ..fem.assembly import SolidAssembly, point_values
 from ..fem.cavity import Cavity
 from ..fem.constraints import BorderedPattern, DofMap, SparsePattern
 from ..fem.curves import PROPORTIONAL, Curve
@@ -101,12 +101,20 @@ class Model:
         by the element's shape functions); shift: the shift of the relaxation times
         (materials.temperature.WLF or Arrhenius), None for none.  The law's constants that
         are tables of T are taken at the points' temperatures.  ValueError where a
-        temperature lies beyond the shift's domain."""
+        temperature, of a node or of a quadrature point, lies beyond the shift's domain."""
         T = np.broadcast_to(np.asarray(T, float), (self.mesh.n_nodes,)).copy()
         if not np.isfinite(T).all():
             raise ValueError("every temperature must be a finite number")
         if shift is not None:
             shift.check(T)
+            try:
+                shift.check(point_values(self.mesh, T))
+            except ValueError as exc:
+                raise type(exc)(
+                    f"{exc}: a quadrature point between nodes above it (the element's quadratic shape functions "
+                    "overshoot a field whose slope changes inside the element; put the knots of the field on "
+                    "element boundaries, or use q4)"
+                ) from None
         self.temperature, self.shift = T, shift
 
     def program(self, change: Curve | None) -> None:

@@ -21,6 +21,22 @@ class FieldError(ValueError):
     """A field (or component) that the results folder does not have."""
 
 
+class UnreadableResults(ValueError):
+    """A file of a results folder that is not what a run writes (the message names it)."""
+
+
+# summary.json's keys the pictures read, and the JSON type each must have
+_SUMMARY_TYPES = {
+    "title": str,
+    "units": dict,
+    "load": dict,
+    "monitor_quantities": dict,
+    "contact": list,
+    "applied": list,
+    "cavities": dict,
+}
+
+
 @dataclass
 class FolderInfo:
     """What summary.json says about the numbers: the case title, its units, the quantity the
@@ -38,10 +54,24 @@ class FolderInfo:
 
     @classmethod
     def read(cls, folder: Path) -> FolderInfo:
+        """What the folder's summary.json says (nothing where there is none); UnreadableResults
+        naming the file where it is not a JSON object, or a key the pictures read has another type."""
         path = Path(folder) / "summary.json"
         if not path.exists():
             return cls()
-        s = json.loads(path.read_text())
+        try:
+            s = json.loads(path.read_text())
+        except ValueError as exc:  # JSONDecodeError, UnicodeDecodeError
+            raise UnreadableResults(f"{path}: not JSON ({exc})") from None
+        if not isinstance(s, dict):
+            raise UnreadableResults(f"{path}: not a JSON object")
+        for key, kind in _SUMMARY_TYPES.items():
+            if s.get(key) is not None and not isinstance(s[key], kind):
+                raise UnreadableResults(
+                    f"{path}: {key} is not a JSON {'string' if kind is str else 'object' if kind is dict else 'array'}"
+                )
+        if not all(isinstance(c, dict) for c in s.get("contact") or []):
+            raise UnreadableResults(f"{path}: contact is not a list of JSON objects")
         contacts = [c.get("name", f"contact[{k}]") for k, c in enumerate(s.get("contact") or [])]
         return cls(
             s.get("title", ""),

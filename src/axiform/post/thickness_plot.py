@@ -13,7 +13,10 @@ import numpy as np
 from .figures import colormap, new_figure, save, title
 from .labels import short, with_unit
 from .margins import grid_margins
-from .results_folder import FolderInfo
+from .results_folder import FolderInfo, UnreadableResults
+
+# the columns of a thickness table the picture draws
+NEEDED = ("s", "z", "thickness", "initial_thickness", "ratio")
 
 
 def _read_thickness(path: Path) -> tuple[dict[str, np.ndarray], int]:
@@ -25,10 +28,13 @@ def _read_thickness(path: Path) -> tuple[dict[str, np.ndarray], int]:
     else:
         try:
             step = int(json.loads((path.parent / "summary.json").read_text())["steps"])
-        except (OSError, ValueError, KeyError):
+        except (OSError, ValueError, KeyError, TypeError):
             step = 0
     data = np.genfromtxt(path, delimiter=",", names=True, ndmin=1)
     names = data.dtype.names or ()
+    missing = [k for k in NEEDED if k not in names]
+    if data.size and missing:
+        raise UnreadableResults(f"{path}: no column {', '.join(missing)}")
     table = {k: np.atleast_1d(data[k]) for k in names} if data.size else {}
     return table, step
 
