@@ -128,6 +128,18 @@ def test_a_prony_series_and_networks_combine_and_the_shift_reaches_the_networks(
         (("A = 0.5\n", "A = 0.5\nstiffness_ratio = 2.0\n"), r"material\.network\[0\]: .*model .* or stiffness_ratio"),
         (("A = 0.5\n", "A = 0.5\nshift = 1\n"), r"material\.network\[0\]\.shift"),
         (
+            ('model = "neo-hooke"\nC1 = 1.0', 'model = "ogden"\nmu = [1.0]\nalpha = [0.0]'),
+            r"material\.network\[0\]\.alpha: every alpha must be non-zero",
+        ),
+        (
+            ('model = "neo-hooke"\nC1 = 1.0', 'model = "ogden"\nmu = [1.0, 0.5]\nalpha = [2.0]'),
+            r"material\.network\[0\]\.alpha: needs as many entries as mu",
+        ),
+        (
+            ('model = "neo-hooke"\nC1 = 1.0', 'model = "ogden"\nmu = [-1.0]\nalpha = [2.0]'),
+            r"material\.network\[0\]\.alpha: sum of mu_i alpha_i must be > 0",
+        ),
+        (
             ("E = 0.01\n", "E = 0.01\n[material.freeze]\nmodulus = [[150.0, 0.0], [90.0, 20.0]]\n"),
             r"material\.freeze\.modulus: the temperatures must increase",
         ),
