@@ -276,3 +276,19 @@ def test_a_bar_cooled_by_a_temperature_program_keeps_its_length_and_springs_back
     assert l1 > 1.2 and abs(length[2.0] / l1 - 1.0) < 2e-3 and abs(length[2.5] / l1 - 1.0) < 2e-3
     exact = brentq(lambda s: MU * (s - s**-2) + MU_F * (s / l1**2 - l1 / s**2), 1.0, l1)
     assert abs(length[3.5] / exact - 1.0) < 1e-4
+
+
+def test_a_bar_at_a_programmed_temperature_from_the_start_freezes_nothing(tmp_path):
+    """`change = [[0.0, -60.0]]`: the bar is at 90 from t = 0 on, its temperature never falls,
+    so no network is born: loaded it stretches as the bar at 150 without freezing (the same
+    equilibrium law), and unloaded it comes back to its length."""
+    case = tmp_path / "bar.toml"
+    case.write_text(
+        FROZEN_BAR.replace(f"change = [[1.0, 0.0], [2.0, {COLD - HOT}]]", f"change = [[0.0, {COLD - HOT}]]")
+    )
+    assert main(["run", str(case), "--out", str(tmp_path / "out"), "-q", "--set", "output.plots=false"]) == 0
+    h = history(tmp_path / "out")
+    length = dict(zip(np.round(h["time"], 9), 1.0 + h["top"], strict=True))
+    loaded = brentq(lambda s: MU * (s - s**-2) - STRESS / s, 1.0, 2.0)  # nominal = Cauchy / s
+    assert abs(length[2.5] / loaded - 1.0) < 1e-3
+    assert abs(length[3.5] - 1.0) < 1e-6
