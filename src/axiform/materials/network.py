@@ -218,12 +218,13 @@ def solve_local(
 
 def unconverged(X: tuple[np.ndarray, ...]) -> np.ndarray:
     """Where the local state X (14 rows (n)) is not converged (n, bool): |r| above TOLERANCE,
-    or above ROUNDOFF |dr/dw|_F where that is more.  A step far longer than the flow's
+    or above ROUNDOFF tr(dr/dw) where that is more (the trace: about the largest eigenvalue of
+    dr/dw, whose diagonal is 1 + a g k_ii + ..., positive).  A step far longer than the flow's
     relaxation makes dr/dw large (I + a g k) and r's round-off with it (about eps a g |k|); the
     stress is then as exact as where the test is TOLERANCE: dtau = k (dr/dw)^-1 dr ~ dr / (a g).
     A residual that is not a number is unconverged."""
-    frobenius = X[JYY] ** 2 + X[JYZ] ** 2 + X[JZY] ** 2 + X[JZZ] ** 2
-    return ~(X[NORM] <= np.maximum(TOLERANCE * TOLERANCE, (ROUNDOFF * ROUNDOFF) * frobenius))
+    scale = ROUNDOFF * (X[JYY] + X[JZZ])
+    return ~(X[NORM] <= np.maximum(TOLERANCE * TOLERANCE, scale * scale))
 
 
 def scatter(X: tuple[np.ndarray, ...], idx: np.ndarray, new: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
