@@ -292,3 +292,18 @@ def test_a_bar_at_a_programmed_temperature_from_the_start_freezes_nothing(tmp_pa
     loaded = brentq(lambda s: MU * (s - s**-2) - STRESS / s, 1.0, 2.0)  # nominal = Cauchy / s
     assert abs(length[2.5] / loaded - 1.0) < 1e-3
     assert abs(length[3.5] - 1.0) < 1e-6
+
+
+def test_a_slow_stretch_of_a_fast_linear_network_runs_at_its_nominal_steps(tmp_path):
+    """m = 1, the network's relaxation some 1e-2 s, the bar stretched to 2 over 1e4 s in 10
+    steps (each some 1e5 relaxation times): the run takes its 10 steps and ends at the
+    equilibrium law's force (the network's viscous stress some 1e-6 of it)."""
+    text = BAR.replace("A = 0.5", "A = 1.0").replace("C = -0.7", "C = -0.5").replace("m = 3.0", "m = 1.0")
+    text = text.replace(f"value = {RATE}", "value = 1.0e-4").replace("target = 2.0", "target = 1.0e4")
+    case = tmp_path / "bar.toml"
+    case.write_text(text.replace("steps = 200", "steps = 10"))
+    assert main(["run", str(case), "--out", str(tmp_path / "out"), "-q", "--set", "output.plots=false"]) == 0
+    h = history(tmp_path / "out")
+    assert len(h["time"]) == 11 and h["time"][-1] == pytest.approx(1.0e4)
+    lam = 2.0
+    assert h["force"][-1] / np.pi == pytest.approx(2.0 * C1 * (lam**2 - 1.0 / lam) / lam, rel=1e-4)
