@@ -128,6 +128,10 @@ def test_a_prony_series_and_networks_combine_and_the_shift_reaches_the_networks(
         (("A = 0.5\n", "A = 0.5\nstiffness_ratio = 2.0\n"), r"material\.network\[0\]: .*model .* or stiffness_ratio"),
         (("A = 0.5\n", "A = 0.5\nshift = 1\n"), r"material\.network\[0\]\.shift"),
         (
+            ("C1 = 1.0\n", "C1 = 1.0\nkappa = 5.0\n"),
+            r"material\.network\[0\]\.kappa: unknown key; this table takes model, C1, stiffness_ratio, flow",
+        ),
+        (
             ('model = "neo-hooke"\nC1 = 1.0', 'model = "ogden"\nmu = [1.0]\nalpha = [0.0]'),
             r"material\.network\[0\]\.alpha: every alpha must be non-zero",
         ),
