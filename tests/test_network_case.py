@@ -311,3 +311,21 @@ def test_a_slow_stretch_of_a_fast_linear_network_runs_at_its_nominal_steps(tmp_p
     assert len(h["time"]) == 11 and h["time"][-1] == pytest.approx(1.0e4)
     lam = 2.0
     assert h["force"][-1] / np.pi == pytest.approx(2.0 * C1 * (lam**2 - 1.0 / lam) / lam, rel=1e-4)
+
+
+def test_a_freeze_table_out_of_every_reached_temperature_is_warned_about():
+    """G_f(T) in kelvin in a case in degrees (150 cooled to 90): the table's temperatures lie
+    outside every temperature the case reaches, the network never freezes; a warning names
+    material.freeze.modulus (a kelvin / Celsius mix-up?). The table in degrees: none."""
+    import tomllib
+
+    from axiform.case.plausible import tables_out_of_reach
+    from axiform.case.schema import parse
+
+    kelvin = FROZEN_BAR.replace(
+        f"[[{COLD}, {MU_F}], [{HOT}, 0.0]]", f"[[{COLD + 273.15}, {MU_F}], [{HOT + 273.15}, 0.0]]"
+    )
+    assert kelvin != FROZEN_BAR
+    warned = tables_out_of_reach(build(parse(tomllib.loads(kelvin))))
+    assert len(warned) == 1 and warned[0].startswith("material.freeze.modulus: the table's temperatures")
+    assert tables_out_of_reach(build(parse(tomllib.loads(FROZEN_BAR)))) == []

@@ -1,10 +1,11 @@
 """Pre-run warnings of a built case about its units (case.preflight runs them): numbers that
 are valid but probably typed in another unit than the rest of the case.
 
-- a table of T (a constant of the law, a heat property) whose temperatures lie wholly outside
-  every temperature the case can reach (the initial field, and with heat conduction the
-  moulds' and films' temperatures x their curves): only its end value is ever used, a sign
-  of a kelvin / Celsius mix-up (a table at 110 to 150 in a case at 423);
+- a table of T (a constant of the law, the frozen network's G_f, a heat property) whose
+  temperatures lie wholly outside every temperature the case can reach (the initial field,
+  and with heat conduction the moulds' and films' temperatures x their curves): only its end
+  value is ever used, a sign of a kelvin / Celsius mix-up (a table at 110 to 150 in a case
+  at 423);
 - a shear modulus above MAX_MPA_MODULUS in a case whose [units] pressure is MPa (a modulus
   in Pa: 1e6 times too stiff).
 
@@ -39,9 +40,12 @@ def reachable_range(built) -> tuple[float, float] | None:
 
 
 def _tables(case):
-    """(key, T knots) of every table of T of the case: the law's constants, the heat properties."""
+    """(key, T knots) of every table of T of the case: the law's constants, its frozen
+    network's G_f(T), the heat properties."""
     for name, table in case.material.tables().items():
         yield f"material.{name}", np.asarray(table.T)
+    if case.material.freeze is not None:
+        yield "material.freeze.modulus", np.array([row[0] for row in case.material.freeze.modulus], float)
     if case.thermal is not None:
         for name in ("conductivity", "density", "specific_heat"):
             value = getattr(case.thermal, name)
