@@ -128,6 +128,22 @@ def test_a_prony_series_and_networks_combine_and_the_shift_reaches_the_networks(
         (("A = 0.5\n", "A = 0.5\nstiffness_ratio = 2.0\n"), r"material\.network\[0\]: .*model .* or stiffness_ratio"),
         (("A = 0.5\n", "A = 0.5\nshift = 1\n"), r"material\.network\[0\]\.shift"),
         (
+            ("C1 = 1.0\n", "C1 = 1.0\nkappa = 5.0\n"),
+            r"material\.network\[0\]\.kappa: unknown key; this table takes model, C1, stiffness_ratio, flow",
+        ),
+        (
+            ('model = "neo-hooke"\nC1 = 1.0', 'model = "ogden"\nmu = [1.0]\nalpha = [0.0]'),
+            r"material\.network\[0\]\.alpha: every alpha must be non-zero",
+        ),
+        (
+            ('model = "neo-hooke"\nC1 = 1.0', 'model = "ogden"\nmu = [1.0, 0.5]\nalpha = [2.0]'),
+            r"material\.network\[0\]\.alpha: needs as many entries as mu",
+        ),
+        (
+            ('model = "neo-hooke"\nC1 = 1.0', 'model = "ogden"\nmu = [-1.0]\nalpha = [2.0]'),
+            r"material\.network\[0\]\.alpha: sum of mu_i alpha_i must be > 0",
+        ),
+        (
             ("E = 0.01\n", "E = 0.01\n[material.freeze]\nmodulus = [[150.0, 0.0], [90.0, 20.0]]\n"),
             r"material\.freeze\.modulus: the temperatures must increase",
         ),
@@ -264,3 +280,52 @@ def test_a_bar_cooled_by_a_temperature_program_keeps_its_length_and_springs_back
     assert l1 > 1.2 and abs(length[2.0] / l1 - 1.0) < 2e-3 and abs(length[2.5] / l1 - 1.0) < 2e-3
     exact = brentq(lambda s: MU * (s - s**-2) + MU_F * (s / l1**2 - l1 / s**2), 1.0, l1)
     assert abs(length[3.5] / exact - 1.0) < 1e-4
+
+
+def test_a_bar_at_a_programmed_temperature_from_the_start_freezes_nothing(tmp_path):
+    """`change = [[0.0, -60.0]]`: the bar is at 90 from t = 0 on, its temperature never falls,
+    so no network is born: loaded it stretches as the bar at 150 without freezing (the same
+    equilibrium law), and unloaded it comes back to its length."""
+    case = tmp_path / "bar.toml"
+    case.write_text(
+        FROZEN_BAR.replace(f"change = [[1.0, 0.0], [2.0, {COLD - HOT}]]", f"change = [[0.0, {COLD - HOT}]]")
+    )
+    assert main(["run", str(case), "--out", str(tmp_path / "out"), "-q", "--set", "output.plots=false"]) == 0
+    h = history(tmp_path / "out")
+    length = dict(zip(np.round(h["time"], 9), 1.0 + h["top"], strict=True))
+    loaded = brentq(lambda s: MU * (s - s**-2) - STRESS / s, 1.0, 2.0)  # nominal = Cauchy / s
+    assert abs(length[2.5] / loaded - 1.0) < 1e-3
+    assert abs(length[3.5] - 1.0) < 1e-6
+
+
+def test_a_slow_stretch_of_a_fast_linear_network_runs_at_its_nominal_steps(tmp_path):
+    """m = 1, the network's relaxation some 1e-2 s, the bar stretched to 2 over 1e4 s in 10
+    steps (each some 1e5 relaxation times): the run takes its 10 steps and ends at the
+    equilibrium law's force (the network's viscous stress some 1e-6 of it)."""
+    text = BAR.replace("A = 0.5", "A = 1.0").replace("C = -0.7", "C = -0.5").replace("m = 3.0", "m = 1.0")
+    text = text.replace(f"value = {RATE}", "value = 1.0e-4").replace("target = 2.0", "target = 1.0e4")
+    case = tmp_path / "bar.toml"
+    case.write_text(text.replace("steps = 200", "steps = 10"))
+    assert main(["run", str(case), "--out", str(tmp_path / "out"), "-q", "--set", "output.plots=false"]) == 0
+    h = history(tmp_path / "out")
+    assert len(h["time"]) == 11 and h["time"][-1] == pytest.approx(1.0e4)
+    lam = 2.0
+    assert h["force"][-1] / np.pi == pytest.approx(2.0 * C1 * (lam**2 - 1.0 / lam) / lam, rel=1e-4)
+
+
+def test_a_freeze_table_out_of_every_reached_temperature_is_warned_about():
+    """G_f(T) in kelvin in a case in degrees (150 cooled to 90): the table's temperatures lie
+    outside every temperature the case reaches, the network never freezes; a warning names
+    material.freeze.modulus (a kelvin / Celsius mix-up?). The table in degrees: none."""
+    import tomllib
+
+    from axiform.case.plausible import tables_out_of_reach
+    from axiform.case.schema import parse
+
+    kelvin = FROZEN_BAR.replace(
+        f"[[{COLD}, {MU_F}], [{HOT}, 0.0]]", f"[[{COLD + 273.15}, {MU_F}], [{HOT + 273.15}, 0.0]]"
+    )
+    assert kelvin != FROZEN_BAR
+    warned = tables_out_of_reach(build(parse(tomllib.loads(kelvin))))
+    assert len(warned) == 1 and warned[0].startswith("material.freeze.modulus: the table's temperatures")
+    assert tables_out_of_reach(build(parse(tomllib.loads(FROZEN_BAR)))) == []

@@ -9,7 +9,7 @@ import pytest
 from oracles import network_flow
 
 from axiform import ArrudaBoyce, Gent, MooneyRivlin, NeoHooke, Ogden, Yeoh
-from axiform.materials.network import BergstromBoyce, Network, network_rows
+from axiform.materials.network import BergstromBoyce, LocalUpdateError, Network, network_rows, solve_local
 from axiform.materials.parallel import NetworkLaw
 from axiform.materials.principal import BASIS, generic_plane, generic_principal, plane_function
 from axiform.materials.temperature import WLF
@@ -209,6 +209,41 @@ def test_large_steps_of_a_steep_flow_converge():
     x = np.stack(list(F_CASES.values()))
     P, _, trial = law.update(x, law.initial_state((len(x),)), 1e6, None)
     assert np.isfinite(P).all() and np.isfinite(trial["network0"]).all()
+
+
+@pytest.mark.parametrize("dt", [1e3, 1e4, 1e6])
+@pytest.mark.parametrize(
+    "elastic",
+    [NeoHooke(1.0, 0.0), MooneyRivlin(0.8, 0.3, 0.0), Yeoh(0.5, -0.05, 0.01, 0.0), Gent(1.0, 20.0, 0.0)]
+    + [ArrudaBoyce(1.0, 3.0, 0.0), Ogden((1.2, 0.3), (2.5, -2.0), 0.0)],
+    ids=["neo-hooke", "mooney-rivlin", "yeoh", "gent", "arruda-boyce", "ogden"],
+)
+def test_a_linear_flow_over_a_step_far_longer_than_its_relaxation_gives_the_viscous_stress(elastic, dt):
+    """m = 1 (a Newtonian network) over a step of 1e4 to 1e8 relaxation times, from rest to a
+    stretch 1.5: the network flows nearly all the step's strain and carries the viscous stress
+    of its mean rate, tau_z - tau_r = ln(1.5) / (dt rate), rate = A E^C (lambda_v = 1 at the
+    start), to the first order in the relaxation time over dt."""
+    flow = BergstromBoyce(A=1.0, C=-0.5, m=1.0, E=0.01)
+    law = law_of(flow, elastic)
+    x = uniaxial(1.5)
+    P, _, _ = law.update(x, law.initial_state(()), dt, None)
+    net = P - EQUILIBRIUM.stress(x)
+    viscous = np.log(1.5) / (dt * flow.A * flow.E**flow.C)
+    assert net[3] * x[3] - net[0] * x[0] == pytest.approx(viscous, rel=1e-3)
+
+
+def test_a_local_update_that_gives_no_number_is_not_taken_as_converged():
+    """An elastic part whose stresses are not numbers (a law past its domain) stops the update
+    naming every such point, rather than passing NaN stresses on as converged."""
+
+    def no_number(y, z):
+        nan = np.full_like(y, np.nan)
+        return nan, nan, nan, nan, nan
+
+    w = np.array([0.1, 0.2, 0.3])
+    with pytest.raises(LocalUpdateError) as caught:
+        solve_local(no_number, w, -w, np.ones(3), 2.0, 0.1)
+    assert caught.value.points.tolist() == [0, 1, 2]
 
 
 @pytest.mark.parametrize(

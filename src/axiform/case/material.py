@@ -125,6 +125,19 @@ class ViscoelasticSpec(BaseModel):
         return self
 
 
+def _ogden_alpha(alpha: list[float], mu: Any) -> list[float]:
+    """Ogden's alpha (its checks against mu, where mu is a valid list): every alpha non-zero,
+    as many as mu, sum mu_i alpha_i > 0 (a positive initial shear modulus)."""
+    if 0.0 in alpha:
+        raise ValueError("every alpha must be non-zero")
+    if isinstance(mu, list):
+        if len(mu) != len(alpha):
+            raise ValueError(f"needs as many entries as mu ({len(mu)}), got {len(alpha)}")
+        if not sum(m * a for m, a in zip(mu, alpha, strict=False)) > 0:
+            raise ValueError("sum of mu_i alpha_i must be > 0 (a positive initial shear modulus)")
+    return alpha
+
+
 def _known_model(value: str) -> str:
     """A registered law's name, else pydantic's literal error listing them."""
     if value not in LAWS:
@@ -201,7 +214,8 @@ class NetworkSpec(BaseModel):
         if name not in law_keys(model):
             raise ValueError(f'does not belong to model = "{model}" (its keys: {", ".join(law_keys(model))})')
         if _is_list(name, model):
-            return _numbers(value, f"{model} {name}")
+            numbers = _numbers(value, f"{model} {name}")
+            return _ogden_alpha(numbers, info.data.get("mu")) if name == "alpha" else numbers
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise ValueError(f"must be a number, got {value!r}")
         return _check_number(value, *_range(name, model))
@@ -321,16 +335,7 @@ class MaterialSpec(BaseModel):
     @classmethod
     def _alpha(cls, value: Any, info: ValidationInfo) -> list[float]:
         _belongs("alpha", info)
-        alpha = _numbers(value, "alpha")
-        if 0.0 in alpha:
-            raise ValueError("every alpha must be non-zero")
-        mu = info.data.get("mu")
-        if isinstance(mu, list):
-            if len(mu) != len(alpha):
-                raise ValueError(f"needs as many entries as mu ({len(mu)}), got {len(alpha)}")
-            if not sum(m * a for m, a in zip(mu, alpha, strict=False)) > 0:
-                raise ValueError("sum of mu_i alpha_i must be > 0 (a positive initial shear modulus)")
-        return alpha
+        return _ogden_alpha(_numbers(value, "alpha"), info.data.get("mu"))
 
     @model_validator(mode="after")
     def _constants(self):

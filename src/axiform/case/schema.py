@@ -157,15 +157,28 @@ def not_table_numbers(data: Any, path: list[str | int] | None = None) -> list[st
     return bad
 
 
+NETWORK_KEYS = ("stiffness_ratio", "flow", "A", "C", "m", "E", "shift")  # a [[material.network]]'s own
+
+
 def law_keys(data: dict[str, Any]) -> dict[tuple, list[str]]:
-    """The keys [material] takes for its model (when the model is a known one), for the
-    "did you mean" of an unknown key there: C3 in a Mooney-Rivlin table is not a Yeoh C30."""
+    """The keys [material] and each [[material.network]] take for their model (when the model
+    is a known one; a network without one: its own keys), for the "did you mean" of an unknown
+    key there: C3 in a Mooney-Rivlin table is not a Yeoh C30, kappa in a network no Ogden alpha."""
     table = data.get("material")
-    model = table.get("model") if isinstance(table, dict) else None
-    if not isinstance(model, str) or model not in LAWS:
+    if not isinstance(table, dict):
         return {}
-    common = ["kappa", "E", "nu", "viscoelastic", "network", "freeze", "density"]
-    return {("material",): ["model", *LAWS[model].key_names, *common]}
+    out: dict[tuple, list[str]] = {}
+    model = table.get("model")
+    if isinstance(model, str) and model in LAWS:
+        common = ["kappa", "E", "nu", "viscoelastic", "network", "freeze", "density"]
+        out[("material",)] = ["model", *LAWS[model].key_names, *common]
+    networks = table.get("network")
+    for k, network in enumerate(networks if isinstance(networks, list) else ()):
+        model = network.get("model") if isinstance(network, dict) else None
+        if model is None or (isinstance(model, str) and model in LAWS):
+            own = LAWS[model].key_names if model is not None else ()
+            out[("material", "network", k)] = ["model", *own, *NETWORK_KEYS]
+    return out
 
 
 def parse(data: dict[str, Any]) -> Case:

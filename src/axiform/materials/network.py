@@ -43,6 +43,7 @@ from .principal import SQRT2, SQRT6, Plane, plane_function
 PlaneLaw = Callable[[np.ndarray, np.ndarray], Plane]
 MAX_ITERATIONS = 50
 TOLERANCE = 1e-12  # on the local residual, a logarithmic strain (its Euclidean norm)
+ROUNDOFF = 1e-14  # the residual's round-off per unit of |dr/dw| (some 50 machine epsilons)
 DEGENERATE = 1e-8  # relative gap of the meridian eigenvalues below which the limit is used
 # rows of the local state (local_system): the unknowns, the law's t and k there, the residual,
 # the Jacobian dr/dw and the residual's squared norm
@@ -189,9 +190,8 @@ def solve_local(
         if far.size:
             new = local_system(plane, rho * y_tr[far], rho * z_tr[far], y_tr[far], z_tr[far], rate[far], m, a)
             X = scatter(X, far, new)
-    tolerance = TOLERANCE * TOLERANCE
     for _ in range(MAX_ITERATIONS):
-        active = X[NORM] > tolerance
+        active = unconverged(X)
         count = np.count_nonzero(active)
         if not count:
             return X
@@ -213,7 +213,18 @@ def solve_local(
                 break
             factor = np.where(worse, 0.5 * factor, factor)
         X = new if idx is None else scatter(X, idx, new)
-    raise LocalUpdateError(np.flatnonzero(X[NORM] > tolerance))
+    raise LocalUpdateError(np.flatnonzero(unconverged(X)))
+
+
+def unconverged(X: tuple[np.ndarray, ...]) -> np.ndarray:
+    """Where the local state X (14 rows (n)) is not converged (n, bool): |r| above TOLERANCE,
+    or above ROUNDOFF tr(dr/dw) where that is more (the trace: about the largest eigenvalue of
+    dr/dw, whose diagonal is 1 + a g k_ii + ..., positive).  A step far longer than the flow's
+    relaxation makes dr/dw large (I + a g k) and r's round-off with it (about eps a g |k|); the
+    stress is then as exact as where the test is TOLERANCE: dtau = k (dr/dw)^-1 dr ~ dr / (a g).
+    A residual that is not a number is unconverged."""
+    scale = ROUNDOFF * (X[JYY] + X[JZZ])
+    return ~(X[NORM] <= np.maximum(TOLERANCE * TOLERANCE, scale * scale))
 
 
 def scatter(X: tuple[np.ndarray, ...], idx: np.ndarray, new: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:

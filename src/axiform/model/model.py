@@ -190,7 +190,11 @@ class Model:
         by_curve: dict[Curve, np.ndarray] = {}  # point loads grouped by curve
         for d, v, c in self.point_loads:
             by_curve.setdefault(c, np.zeros(n))[d] += v
-        solid_term = SolidTerm(solid, n, self.shift, self.temperature)
+        # the law's initial state at the temperature of t = 0: a programmed change counts from there
+        start = (
+            self.temperature if self.change is None or self.temperature is None else self.temperature + self.change(0.0)
+        )
+        solid_term = SolidTerm(solid, n, self.shift, start)
         terms: list[Term] = [solid_term, *(PressureTerm(p, n) for p in self.pressures)]
         terms += [PointLoadTerm(by_curve, n)] if by_curve else []
         terms += self.added
