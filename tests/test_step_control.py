@@ -88,3 +88,19 @@ def test_bad_stops_are_refused_naming_the_key(solver, message):
     case["solver"].update(solver)
     with pytest.raises(CaseError, match=re.escape(message)):
         build(parse(case))
+
+
+def test_a_ramp_shorter_than_the_steps_is_cut_against_its_own_length():
+    """The punch pressed in over t = 0..1, then held to t = 1e4 in 4 steps: the first step (the
+    whole press, too hard at 4 iterations) is cut below 1e-4 of the nominal step of 2500 but
+    not of the ramp's length 1, and the run finishes (it stopped with the step 'cut below the
+    minimum' before any step)."""
+    case = copy.deepcopy(PUNCH)
+    case["contact"][0]["motion"] = {"uz": -0.8, "curve": [[0.0, 0.0], [1.0, 1.0], [1.0e4, 1.0]]}
+    case["solver"].update(target=1.0e4, max_iterations=4)
+    built = build(parse(case))
+    result = solve(built.model, built.control, built.options)
+    assert result.status == "finished", result.message
+    lams = [s.lam for s in result.steps]
+    sizes = [b - a for a, b in zip([0.0, *lams], lams, strict=False)]
+    assert min(sizes) < 1e-4 * 2500.0 and 1.0 in lams and lams[-1] == 1.0e4

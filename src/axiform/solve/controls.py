@@ -83,7 +83,8 @@ class NewtonOptions:
     it cut.  Under arc length the step grows back by `growth` up to the nominal arc.  A step
     of a fraction f of the nominal size moves the contact multipliers f of the way
     (ContactState.advanced).  The run stops when a step would be smaller than min_step times
-    the nominal step."""
+    the nominal step, or times the interval between two knots of the loads' curves where that
+    is shorter (PathFollowing.span)."""
 
     tolerance: float = 1e-8
     max_iterations: int = 20

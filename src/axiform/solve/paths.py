@@ -53,6 +53,11 @@ class PathFollowing:
     def clip(self, size: float) -> float:
         return size
 
+    def span(self) -> float:
+        """The length a step's smallest size (NewtonOptions.min_step) is a fraction of: the
+        nominal step."""
+        return abs(self.nominal)
+
     _state_keys: tuple[str, ...] = ("u_f", "lam")
     _optional: dict[str, Any] = {}  # state keys a checkpoint of an older version may lack: their defaults
 
@@ -218,6 +223,18 @@ class LoadPath(PathFollowing):
     def clip(self, size):
         remaining = self._next_stop() - self.lam
         return remaining if abs(size) > abs(remaining) else size
+
+    def span(self) -> float:
+        """The nominal step, or where it is shorter the interval between the stops (the curves'
+        knots, solver.stops, the start, the end) around the converged state: a ramp much
+        shorter than the steps (a load applied over 1 s, then held for 1e5 s) is cut against
+        its own length, not against a step that would not fit in it."""
+        direction = np.sign(self.target)
+        ahead = self.stops[(self.stops - self.lam) * direction > 1e-12 * abs(self.target)]
+        behind = [k for k in self.stops if (self.lam - k) * direction >= -1e-12 * abs(self.target)]
+        start = float(behind[-1]) if behind else 0.0
+        end = float(ahead[0]) if ahead.size else self.target
+        return min(abs(self.nominal), abs(end - start))
 
     def attempt(self, size):
         stop = self._next_stop()

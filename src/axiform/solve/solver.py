@@ -79,7 +79,7 @@ def solve(
             result.cuts += 1
             path.cut()  # the rest of this step's nominal interval is sub-stepped
             size = trial / 2.0
-            if abs(size) < opts.min_step * abs(path.nominal):
+            if abs(size) < opts.min_step * path.span():
                 result.status = "stopped"
                 result.message = _stop_message(
                     first + result.n_steps,
