@@ -243,3 +243,30 @@ def test_a_run_resumed_onto_a_new_knot_at_its_end_takes_the_steps_of_that_case()
     for a, b in zip(rest.steps, full.steps[k:], strict=True):
         assert a.iterations == b.iterations
         np.testing.assert_allclose(a.u, b.u, rtol=1e-10, atol=1e-12 * np.abs(b.u).max())
+
+
+@pytest.mark.parametrize(
+    ("solver", "said"),
+    [
+        ({"control": "load", "target": 2.0, "steps": 4}, "solver.control: differs from the run being resumed"),
+        (
+            {**PLATE["solver"], "dof": {"at": {"r": 7.0, "z": 0.5}, "dof": "uz"}, "target": 7.0},
+            "solver.dof.at.r: differs from the run being resumed",
+        ),
+    ],
+    ids=["control", "driven-dof"],
+)
+def test_resume_refuses_another_path(tmp_path, capsys, solver, said):
+    """The control of the path and the dof displacement control drives are the checkpoint's
+    own (its progress is that dof's): a change is refused with exit 2 naming the key, before
+    any step (another control failed with exit 3 inside the run, another dof was accepted and
+    the steps sized against the old dof's value)."""
+    out = tmp_path / "run"
+    assert cli.main(["run", str(_write(tmp_path, PLATE)), "--out", str(out), "-q"]) == 0
+    before = (out / "history.csv").read_text()
+    later = tmp_path / "later"
+    later.mkdir()
+    capsys.readouterr()
+    assert cli.main(["run", str(_write(later, {**PLATE, "solver": solver})), "--resume", str(out), "-q"]) == 2
+    assert said in capsys.readouterr().err
+    assert (out / "history.csv").read_text() == before

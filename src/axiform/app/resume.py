@@ -9,10 +9,11 @@ numerical ones of CONTACT_NUMERICS (its geometry, motion, friction and heat), an
 ([[fix]], [[pressure]], [[point_load]], [[cavity]]) up to the resume time: each key of
 theirs but `curve` unchanged, and their curve f(t) the same from t = 0 to the load factor
 the checkpoint reached (a curve may change beyond it); [gravity] as those loads; and [units]
-temperature (an Arrhenius shift's absolute temperature).  A later solver.target, other solver
-numbers and more output are allowed.  The checkpoint's meta holds these tables as the case
-had them (`frozen_meta`); a checkpoint written before it (only the fingerprints of [mesh]
-and [material]) is checked on those two.
+temperature (an Arrhenius shift's absolute temperature); the path the steps followed
+(solver.control, and the dof displacement control drives: the checkpoint's progress is that
+dof's).  A later solver.target, other solver numbers and more output are allowed.  The
+checkpoint's meta holds these tables as the case had them (`frozen_meta`); a checkpoint
+written before it (only the fingerprints of [mesh] and [material]) is checked on those two.
 """
 
 from __future__ import annotations
@@ -45,12 +46,14 @@ def _plain(value: Any) -> Any:
 
 
 def _physics(data: dict[str, Any]) -> dict[str, Any]:
-    """The frozen tables, the [[contact]], the load tables and the temperature unit of a case
-    (as JSON has them)."""
+    """The frozen tables, the [[contact]], the load tables, the temperature unit and the path
+    (solver.control, solver.dof) of a case (as JSON has them)."""
     units = data.get("units")
     unit = units.get("temperature") if isinstance(units, dict) else None
+    solver = data.get("solver") if isinstance(data.get("solver"), dict) else {}
+    path = {"control": solver.get("control", "load"), "dof": solver.get("dof")}
     physics = {key: data.get(key) for key in (*FROZEN_TABLES, "contact", *LOADS, *SINGLE_LOADS)}
-    return _plain(physics | {"units": {"temperature": unit}})
+    return _plain(physics | {"units": {"temperature": unit}, "path": path})
 
 
 def _named_files(data: dict[str, Any]) -> list[tuple[str, str]]:
@@ -161,6 +164,13 @@ def check_frozen(meta: dict[str, Any], data: dict[str, Any], reached: float, bas
                 raise _refuse(key, key)
         return
     new = _physics(data)
+    found = _first_difference(physics.get("path"), new["path"], "solver") if "path" in physics else None
+    if found:  # not in the meta of earlier checkpoints
+        raise CaseError(
+            f"{found}: differs from the run being resumed: the control of the path and the dof it drives "
+            "cannot change on --resume (a later target, other step numbers and tolerances can); start a new "
+            "run instead"
+        )
     for key in (*FROZEN_TABLES, "units"):  # "units": not in the meta of earlier checkpoints
         found = _first_difference(physics.get(key), new.get(key), key) if key in physics else None
         if found:
