@@ -50,7 +50,9 @@ def _physics(data: dict[str, Any]) -> dict[str, Any]:
     (solver.control, solver.dof) of a case (as JSON has them)."""
     units = data.get("units")
     unit = units.get("temperature") if isinstance(units, dict) else None
-    solver = data.get("solver") if isinstance(data.get("solver"), dict) else {}
+    solver = data.get("solver")
+    if not isinstance(solver, dict):
+        solver = {}
     path = {"control": solver.get("control", "load"), "dof": solver.get("dof")}
     physics = {key: data.get(key) for key in (*FROZEN_TABLES, "contact", *LOADS, *SINGLE_LOADS)}
     return _plain(physics | {"units": {"temperature": unit}, "path": path})
