@@ -217,6 +217,14 @@ def test_bad_target_files(tmp_path, text, message):
         read_target(path)
 
 
+def test_a_target_written_by_a_spreadsheet_is_read(tmp_path):
+    """TARGET.csv is read as CSV: quoted cells (a spreadsheet's export) and CRLF line ends."""
+    path = tmp_path / "target.csv"
+    path.write_bytes(b'"s","thickness"\r\n# a comment\r\n"0","1.5"\r\n"2.5","1.25"\r\n')
+    s, t = read_target(path)
+    assert s.tolist() == [0.0, 2.5] and t.tolist() == [1.5, 1.25]
+
+
 def test_bad_target_on_the_command_line_exits_2(tmp_path, capsys):
     case = tmp_path / "case.toml"
     case.write_text(tomli_w.dumps(TUBE))

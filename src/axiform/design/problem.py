@@ -11,6 +11,8 @@ stations inside the target's range, plus a small smoothness term on the design.
 from __future__ import annotations
 
 import copy
+import csv
+import io
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -40,17 +42,21 @@ def read_target(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
         text = read_text(path)
     except (OSError, UnicodeDecodeError) as exc:
         raise TargetError(f"{path}: cannot read it ({getattr(exc, 'strerror', None) or exc})") from None
-    rows = [(n, line) for n, line in enumerate(text.splitlines(), 1) if line.strip() and not line.startswith("#")]
-    if not rows or [c.strip() for c in rows[0][1].split(",")] != ["s", "thickness"]:
+    try:
+        reader = csv.reader(io.StringIO(text))
+        rows = [(reader.line_num, cells) for cells in reader if "".join(cells).strip() and not cells[0].startswith("#")]
+    except csv.Error as exc:
+        raise TargetError(f"{path}: not a CSV file ({exc})") from None
+    if not rows or [c.strip() for c in rows[0][1]] != ["s", "thickness"]:
         raise TargetError(f"{path}: the first row must be the header 's,thickness'")
     s: list[float] = []
     t: list[float] = []
-    for n, line in rows[1:]:
-        cells = line.split(",")
+    for n, cells in rows[1:]:
         try:
             a, b = (float(c) for c in cells)
         except ValueError:
-            raise TargetError(f"{path}: line {n}: expected two numbers s,thickness, got {line.strip()!r}") from None
+            line = ",".join(cells).strip()
+            raise TargetError(f"{path}: line {n}: expected two numbers s,thickness, got {line!r}") from None
         if not (np.isfinite(a) and np.isfinite(b)) or b <= 0:
             raise TargetError(f"{path}: line {n}: s must be finite and the thickness finite and > 0")
         for name, value in (("s", a), ("thickness", b)):

@@ -84,17 +84,18 @@ CONTACT_COLUMNS = ("pair", "node", "r", "z", "gap", "pressure", "status", "first
 def contact_table(reports: list[dict], x: np.ndarray, status_names: dict[int, str]) -> str:
     """contact.csv as text: a row per slave node of every pair's report (ContactPair.report:
     node, gap, pressure, status, first_contact, each (m,)) at the current nodes x (n, 2); gap
-    and first_contact empty where NaN.  Formatted column by column (no cell needs quotes)."""
-    lines = [",".join(CONTACT_COLUMNS)]
+    and first_contact empty where NaN.  Each column formatted at once, the rows written by
+    `csv.writer`."""
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(CONTACT_COLUMNS)
     for k, rep in enumerate(reports):
         node = np.asarray(rep["node"], dtype=np.int64)
-        r, z = x[node, 0].tolist(), x[node, 1].tolist()
+        r = [f"{a:.10g}" for a in x[node, 0].tolist()]
+        z = [f"{b:.10g}" for b in x[node, 1].tolist()]
         gap = ["" if g != g else f"{g:.6g}" for g in np.asarray(rep["gap"], float).tolist()]
         pressure = [f"{p:.6g}" for p in np.asarray(rep["pressure"], float).tolist()]
         status = [status_names[s] for s in np.asarray(rep["status"]).astype(int).tolist()]
         first = ["" if t != t else repr(t) for t in np.asarray(rep["first_contact"], float).tolist()]
-        lines += [
-            f"{k},{n},{a:.10g},{b:.10g},{g},{p},{s},{t}"
-            for n, a, b, g, p, s, t in zip(node.tolist(), r, z, gap, pressure, status, first, strict=False)
-        ]
-    return "\n".join(lines) + "\n"
+        writer.writerows(zip([k] * len(node), node.tolist(), r, z, gap, pressure, status, first, strict=True))
+    return out.getvalue()
