@@ -18,7 +18,7 @@ from pathlib import Path
 from ..design.optimize import Design, OptimizeResult, Solved, case_text
 from ..io.files import write_atomic
 from .console import say, tell, trace, warn
-from .run import EXIT, Interrupted, Job, Stops, prepare_folder, status_line
+from .run import EXIT, Interrupted, Job, Stops, locked_folder, status_line
 
 INTERRUPTED = (128 + signal.SIGINT, 128 + signal.SIGTERM)  # the exit codes 130, 143
 
@@ -57,7 +57,6 @@ def write_solved(case_file: Path, folder: Path, solved: Solved) -> int | None:
     has other unknowns (the run of the case then says why or solves it).  summary.json's
     wall_time_s counts the solve the steps come from."""
     from ..case.schema import CaseError
-    from ..io.lock import FolderLock, FolderLocked
 
     with Stops() as stops:
         try:
@@ -69,15 +68,8 @@ def write_solved(case_file: Path, folder: Path, solved: Solved) -> int | None:
                 solved.model.n_free,
             ):
                 return None
-            problem = prepare_folder(folder)
-            if problem:
-                say(f"axiform: invalid output folder:\n--out: {problem}")
-                return 2
-            lock = FolderLock(folder)
-            try:
-                lock.acquire()
-            except (FolderLocked, OSError) as exc:
-                say(f"axiform: invalid output folder:\n--out: {exc}")
+            lock = locked_folder(folder, "out")
+            if lock is None:
                 return 2
             try:  # the lock is dropped however the writing ends
                 return _write(job, folder, solved, stops)

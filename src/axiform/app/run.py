@@ -243,7 +243,6 @@ def _run(
     case_file: Path, out: str | None, quiet: bool, overrides: list[str], stops: Stops, resume: str | None, stream
 ) -> int:
     from ..case.schema import CaseError
-    from ..io.lock import FolderLock, FolderLocked
 
     try:
         job = Job.read(case_file, overrides, out, resume)
@@ -252,20 +251,31 @@ def _run(
     except Exception as exc:  # noqa: BLE001 - a fault of axiform's, not of the case: exit 3
         return failed(exc, f"failed while building the model of {case_file}")
     out_dir, note = job.folder()
-    problem = prepare_folder(out_dir)
-    if problem:
-        say(f"axiform: invalid output folder:\n--out: {problem}")
-        return 2
-    lock = FolderLock(out_dir)
-    try:
-        lock.acquire()
-    except (FolderLocked, OSError) as exc:
-        say(f"axiform: invalid output folder:\n--{'resume' if resume else 'out'}: {exc}")
+    lock = locked_folder(out_dir, "resume" if resume else "out")
+    if lock is None:
         return 2
     try:  # the lock is dropped however the run ends (an error, SIGINT, SIGTERM included)
         return _write(job, out_dir, note, quiet, stops, stream)
     finally:
         lock.release()
+
+
+def locked_folder(out_dir: Path, option: str):
+    """The results folder out_dir made ready for a run and locked (its FolderLock, to release),
+    or None after saying why not (exit 2; `option`: the command-line option that named it)."""
+    from ..io.lock import FolderLock, FolderLocked
+
+    problem = prepare_folder(out_dir)
+    if problem:
+        say(f"axiform: invalid output folder:\n--out: {problem}")
+        return None
+    lock = FolderLock(out_dir)
+    try:
+        lock.acquire()
+    except (FolderLocked, OSError) as exc:
+        say(f"axiform: invalid output folder:\n--{option}: {exc}")
+        return None
+    return lock
 
 
 def _write(job: Job, out_dir: Path, note: str, quiet: bool, stops: Stops, stream) -> int:
