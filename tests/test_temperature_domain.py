@@ -121,6 +121,8 @@ def test_arrhenius_in_celsius_shifts_as_in_kelvin():
     assert celsius.shift(np.array([100.0, 20.0])) == pytest.approx(kelvin.shift(np.array([373.15, 293.15])), rel=1e-14)
     with pytest.raises(TemperatureDomainError, match="at element 1 is at or below absolute zero"):
         celsius.shift(np.array([[20.0, 30.0], [-300.0, 10.0]]))
+    assert kelvin.describe().startswith("absolute zero (0;")  # not "-0"
+    assert celsius.describe().startswith("absolute zero (-273.15;")
     with pytest.raises(TemperatureDomainError, match=r"-5 at node 2 is at or below the WLF pole T_ref - C2 = 98\.4"):
         WLF(17.44, 51.6, 150.0).shift(np.array([120.0, 110.0, -5.0]))
 

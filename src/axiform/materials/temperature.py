@@ -118,7 +118,7 @@ class Arrhenius:
     @property
     def pole(self) -> float:
         """The lowest temperature excluded: absolute zero in the case's unit."""
-        return -self.offset
+        return 0.0 - self.offset  # 0.0 -: 0 K is 0, not -0, where the case is in kelvin
 
     def describe(self) -> str:
         return f"absolute zero ({self.pole:.6g}; an Arrhenius shift needs T > 0 K)"
