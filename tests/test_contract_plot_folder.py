@@ -50,3 +50,17 @@ def test_a_thickness_table_without_its_columns_is_refused_naming_it(tmp_path, re
     code, out, err = call(["plot", str(folder)], 60.0)
     assert code == 2 and "Traceback" not in out + err, err
     assert "thickness.csv" in err and "initial_thickness" in err, err
+
+
+def test_a_field_asked_of_a_folder_without_vtu_files_is_refused(tmp_path, results):
+    """`--field` colours deformed.png, drawn from the last VTU file: on a folder without any
+    (output.vtu = false) a field, misspelt or not, is refused naming --field (it was ignored,
+    exit 0); without --field the other pictures are drawn."""
+    folder = tmp_path / "out"
+    shutil.copytree(results, folder)
+    shutil.rmtree(folder / "fields")
+    (folder / "fields.pvd").unlink()
+    code, out, err = call(["plot", str(folder), "--field", "von_mizes"], 60.0)
+    assert code == 2 and "--field" in err and "no VTU files" in err, err
+    code, out, err = call(["plot", str(folder)], 60.0)
+    assert code == 0 and "load_curve.png" in out, err

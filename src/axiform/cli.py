@@ -106,8 +106,7 @@ def _plot_and_fit(sub) -> argparse.ArgumentParser:
     p_plot.add_argument("folder", help="a results folder written by `axiform run`")
     p_plot.add_argument(
         "--field",
-        default="von_mises",
-        help="nodal field colouring the deformed shape (von_mises, J, thickness, ...; "
+        help="nodal field colouring the deformed shape (default von_mises; J, thickness, ...; "
         "a component as cauchy_stress:zz or displacement:uz; vectors and tensors "
         "alone: their magnitude)",
     )

@@ -23,8 +23,9 @@ def fields_of(folder: Path) -> set[str] | None:
     }
 
 
-def plot(folder: str, field: str, animate: bool = False) -> int:
-    """(Re)write the PNG plots of a results folder; returns the exit code."""
+def plot(folder: str, field: str | None = None, animate: bool = False) -> int:
+    """(Re)write the PNG plots of a results folder, deformed.png coloured by `field` (None:
+    von_mises); returns the exit code."""
     from ..case.suggest import nearest
     from ..post.plots import FieldError, plot_folder, read_history
     from ..post.results_folder import FolderInfo, UnreadableResults
@@ -46,6 +47,10 @@ def plot(folder: str, field: str, animate: bool = False) -> int:
     except (OSError, ValueError, KeyError, IndexError, SyntaxError) as exc:  # SyntaxError: XML
         say(f"axiform: {folder}: unreadable results ({type(exc).__name__}: {exc})")
         return 2
+    if field is not None and fields is None:
+        say(f"axiform: --field: {folder} has no VTU files (its run had output.vtu = false): no shape to colour")
+        return 2
+    field = field or "von_mises"
     if fields is not None and field.split(":")[0] not in fields:
         guess = nearest(field.split(":")[0], sorted(fields))
         hint = f'; did you mean "{guess}"?' if guess else ""
