@@ -135,8 +135,10 @@ def test_sweep_failure_recorded_and_resume(sweep_dir, capsys):
     # resume: the finished cases are skipped (their folders untouched), the other runs again
     stamps = {c: (out / "cases" / c / "history.csv").stat().st_mtime_ns for c in ("0001", "0002", "0003")}
     assert main(args) == 1
-    err = capsys.readouterr().err
-    assert "case 0001 skipped" in err and "case 0003 skipped" in err and "3 cases of plate.toml, 1 to run" in err
+    said = capsys.readouterr()  # the progress on stdout, with the header and the final line
+    printed = said.out
+    assert "case 0001 skipped" in printed and "case 0003 skipped" in printed, said
+    assert "3 cases of plate.toml, 1 to run" in printed and "case 0001" not in said.err
     assert (out / "cases" / "0001" / "history.csv").stat().st_mtime_ns == stamps["0001"]
     assert (out / "cases" / "0003" / "history.csv").stat().st_mtime_ns == stamps["0003"]
     assert (out / "cases" / "0002" / "history.csv").stat().st_mtime_ns != stamps["0002"]

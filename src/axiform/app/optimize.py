@@ -23,7 +23,7 @@ from ..design.problem import SMOOTHNESS, Objective, TargetError, ThicknessDesign
 from ..design.temperature_design import TemperatureDesign
 from ..io.files import write_atomic
 from ..post.optimize_plots import OptimizePicture, PictureRun, plot_optimization
-from .console import say
+from .console import say, tell
 from .optimize_final import INTERRUPTED, run_final
 from .run import Interrupted, Stops
 
@@ -54,7 +54,7 @@ class Progress:
             if better:
                 write_atomic(self.out / "optimized.toml", case_text(self.design, it.design, it.stops))
         if not self.quiet:
-            say(
+            tell(
                 f"iteration {row[0]}  objective {row[1]:.4g}  max deviation {100 * row[2]:.3g} %  "
                 f"forward solves {row[3]}"
             )
@@ -275,7 +275,7 @@ def run(
                 result.status, result.message = "interrupted", f"{result.message}; {exc} before the final run"
         stops.raised = True  # a signal from here on is recorded: the files are written first
         write_outputs(out_dir, design, result, target, final)
-    say(
+    tell(
         f"axiform optimize: {result.status} after {max(len(result.rows) - 1, 0)} iterations, "
         f"{result.forward_solves} forward solves, {result.wall_time_s:.1f} s: max deviation "
         f"{100 * result.best.deviation:.3g} % ({result.message}) -> {out_dir}"

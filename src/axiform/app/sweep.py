@@ -50,7 +50,7 @@ from ..case.schema import CaseError, build, fingerprint, parse, read
 from ..io.text import MAX_CASE_BYTES, FileTooLarge, read_text
 from ..post.sweep_plots import plot_sweep
 from ..post.sweep_plots import value_text as toml_value
-from .console import ProgressLine
+from .console import ProgressLine, tell
 from .sweep_rows import summary_row
 
 SWEEP_KEYS = ("case", "vary", "cases", "report")
@@ -339,7 +339,7 @@ def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: 
     n = len(sweep.cases)
     rows: list[dict | None] = [None] * n
     folders = [root / "cases" / f"{k + 1:04d}" for k in range(n)]
-    progress = SweepProgress(say, n)
+    progress = SweepProgress(sys.stdout, n)  # what the command produces on stdout, errors on stderr
     todo = []
     for k in range(n):  # resume: a finished folder of the same case text is kept
         done = summary_row(folders[k])
@@ -350,7 +350,7 @@ def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: 
             progress(folders[k].name, row, skipped=True)
         else:
             todo.append(k)
-    print(f"axiform sweep: {n} cases of {sweep.case_file.name}, {len(todo)} to run -> {root}", file=say)
+    tell(f"axiform sweep: {n} cases of {sweep.case_file.name}, {len(todo)} to run -> {root}")
     write_table(root / "sweep.csv", sweep, rows)
     if todo:
         from distributed import as_completed
@@ -387,10 +387,9 @@ def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: 
     except Exception as exc:  # noqa: BLE001 - the cases and sweep.csv stand; say why the picture does not
         print(f"axiform sweep: sweep.png not written ({type(exc).__name__}: {exc})", file=say)
     bad = [f"{k + 1:04d}" for k, r in enumerate(rows) if (r or {}).get("status") != "finished"]
-    print(
+    tell(
         f"axiform sweep: {n - len(bad)} of {n} cases finished"
         + (f"; not finished: {', '.join(bad)}" if bad else "")
-        + f" -> {root / 'sweep.csv'}",
-        file=say,
+        + f" -> {root / 'sweep.csv'}"
     )
     return 1 if bad else 0
