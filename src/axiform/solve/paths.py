@@ -205,9 +205,12 @@ class LoadPath(PathFollowing):
         the last increment nor the rate of before the knot is carried across it: the rate is
         taken anew at the converged state, as in a run of that case from the start."""
         super().restore(state)
-        on_knot = self.knots.size and np.abs(self.knots - self.lam).min() <= 1e-12 * abs(self.target)
-        if on_knot and self.previous is not None:
+        if self._on_knot(self.lam) and self.previous is not None:
             self.previous = self.rate = None
+
+    def _on_knot(self, lam: float) -> bool:
+        """Whether lam is a knot of the loads' curves (where their rates jump)."""
+        return self.knots.size > 0 and np.abs(self.knots - lam).min() <= 1e-12 * abs(self.target)
 
     def _next_stop(self) -> float:
         """The end of the interval being sub-stepped, or else the next knot or the end."""
@@ -229,10 +232,9 @@ class LoadPath(PathFollowing):
         knots, solver.stops, the start, the end) around the converged state: a ramp much
         shorter than the steps (a load applied over 1 s, then held for 1e5 s) is cut against
         its own length, not against a step that would not fit in it."""
-        direction = np.sign(self.target)
-        ahead = self.stops[(self.stops - self.lam) * direction > 1e-12 * abs(self.target)]
-        behind = [k for k in self.stops if (self.lam - k) * direction >= -1e-12 * abs(self.target)]
-        start = float(behind[-1]) if behind else 0.0
+        beyond = (self.stops - self.lam) * np.sign(self.target) > 1e-12 * abs(self.target)  # the stops ahead
+        ahead, behind = self.stops[beyond], self.stops[~beyond]
+        start = float(behind[-1]) if behind.size else 0.0
         end = float(ahead[0]) if ahead.size else self.target
         return min(abs(self.nominal), abs(end - start))
 
@@ -279,8 +281,7 @@ class LoadPath(PathFollowing):
         # the last increment, none across a knot (the rate jumps there); the rate at the new state
         # from the tangent of the step's converged evaluation (whose history is that of the step's
         # start: a node that stuck in the step is not yet tied in it)
-        knot = self.knots.size > 0 and np.abs(self.knots - lam).min() <= 1e-12 * abs(self.target)
-        self.previous = None if knot else (u_f - self.u_f, lam - self.lam)
+        self.previous = None if self._on_knot(lam) else (u_f - self.u_f, lam - self.lam)
         self.rate = self._tangent_rate(self.converged, u_f, lam)
         self.converged = None
         super().accept(u_f, lam, size)
