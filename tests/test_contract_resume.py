@@ -11,7 +11,7 @@ import shutil
 import pytest
 from test_fuzz import toml
 from test_fuzz_files import call
-from test_resume_frozen import HEATED_PUNCH
+from test_resume_frozen import HEATED_PUNCH, resumed
 
 WEIGHED = copy.deepcopy(HEATED_PUNCH)
 WEIGHED["material"]["density"] = 1.0e-9
@@ -32,15 +32,6 @@ def finished(tmp_path_factory):
     return case, d / "run"
 
 
-def resumed(case, folder, *sets: str) -> tuple[int, str]:
-    argv = ["run", str(case), "--resume", str(folder), "-q", "--set", "solver.target=1.5"]
-    for s in sets:
-        argv += ["--set", s]
-    code, out, err = call(argv, 120.0)
-    assert "Traceback" not in out + err
-    return code, err
-
-
 @pytest.mark.parametrize(
     "change, said",
     [
@@ -52,7 +43,7 @@ def resumed(case, folder, *sets: str) -> tuple[int, str]:
 def test_a_change_of_the_weight_or_of_the_temperature_unit_is_refused(finished, change, said):
     case, folder = finished
     before = (folder / "history.csv").read_text()
-    code, err = resumed(case, folder, change)
+    code, err = resumed((case, folder), change)
     assert code == 2 and said in err, err
     assert (folder / "history.csv").read_text() == before
 
@@ -61,14 +52,14 @@ def test_a_dropped_weight_is_refused(tmp_path, finished):
     case = copy.deepcopy(WEIGHED)
     del case["gravity"]
     (tmp_path / "case.toml").write_text(toml(case))
-    code, err = resumed(tmp_path / "case.toml", finished[1])
+    code, err = resumed((tmp_path / "case.toml", finished[1]))
     assert code == 2 and "gravity: " in err and "[gravity] cannot change" in err, err
 
 
 def test_a_gravity_curve_changed_after_the_resume_time_is_allowed(tmp_path, finished):
     folder = tmp_path / "run"
     shutil.copytree(finished[1], folder)
-    code, err = resumed(finished[0], folder, "gravity.curve=[[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]")
+    code, err = resumed((finished[0], folder), "gravity.curve=[[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]")
     assert code == 0, err
 
 
@@ -85,7 +76,7 @@ def test_a_mould_file_changed_since_the_run_is_refused(tmp_path, edited):
     code, out, err = call(["run", str(tmp_path / "case.toml"), "--out", str(folder), "-q"], 120.0)
     assert code == 0, err
     (tmp_path / edited).write_text("12.0,1.5\n-1.0,1.5\n")
-    code, err = resumed(tmp_path / "case.toml", folder)
+    code, err = resumed((tmp_path / "case.toml", folder))
     if edited == "other":
         assert code == 0, err
     else:
