@@ -201,6 +201,30 @@ def test_a_conductance_needs_the_mould_temperature(tmp_path, capsys):
     assert "contact[0]: temperature (the mould's) and conductance go together" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize(
+    "heat, message",
+    [
+        ("film", r"convection: a film needs the case's \[thermal\]"),
+        ("mould", r"contact\[0\].conductance: needs the case's \[thermal\]"),
+    ],
+)
+def test_heat_keys_without_thermal_are_refused_naming_the_key(tmp_path, capsys, heat, message):
+    """A film or a mould's conductance in a case without [thermal] (the thermal table's module is
+    then imported only to say so)."""
+    from axiform.cli import main
+
+    data = tomllib.loads(CASE)
+    del data["thermal"]
+    if heat == "mould":
+        del data["convection"]
+        data["contact"] = [MOULD]
+    case = tmp_path / "slab.toml"
+    case.write_text(tomli_w.dumps(data))
+    assert main(["check", str(case)]) == 2
+    err = capsys.readouterr().err
+    assert re.search(message, err), err
+
+
 @pytest.mark.parametrize("through", ["film", "contact"])
 def test_the_steps_land_on_the_knots_of_the_heat_curves(through):
     """A film's ambient curve and a mould's temperature_curve are curves of the process like

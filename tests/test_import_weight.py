@@ -80,7 +80,10 @@ def test_a_mould_brings_its_table_and_the_contact_code():
         f"from axiform.case.schema import build, load\nbuild(load({str(case)!r}), {str(case.parent)!r})"
     )
     assert "axiform.case.contact" in modules and "axiform.contact.pair" in modules
-    assert loaded(modules, ("axiform.case.cavity", "axiform.case.gravity")) == []
+    assert (
+        loaded(modules, ("axiform.case.cavity", "axiform.case.gravity", "axiform.case.thermal", "axiform.fem.heat"))
+        == []
+    )
 
 
 def test_vtu_files_bring_their_writer_and_no_drawing(tmp_path):

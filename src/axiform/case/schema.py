@@ -313,8 +313,8 @@ def _loads_and_moulds(case: Case, model: Model, mesh, base: Path) -> tuple[dict,
         pairs = [contact_pair(mesh, model, c, base, f"contact[{i}]") for i, c in enumerate(case.contact)]
         for pair in pairs:
             model.contact(pair)
-    if case.thermal is not None or case.convection or case.contact:
-        from .thermal import build_conduction
+    if case.thermal is not None or case.convection or any(c.conductance is not None for c in case.contact):
+        from .thermal import build_conduction  # also to refuse a film or a conductance without [thermal]
 
         build_conduction(model, mesh, case.thermal, case.convection, case.contact, case.material.density)
     if case.gravity is not None:
