@@ -139,7 +139,7 @@ def fake_model(stabilization=0.0, energy=1.0):
     top = np.flatnonzero(np.isclose(mesh.points[:, 1], 0.3))
     pair = SimpleNamespace(name="punch", nodes=top, stabilization=stabilization)
     model = SimpleNamespace(
-        mesh=mesh, contacts=[pair], strain_energy=lambda u: energy, contact_states=lambda state: state.terms
+        mesh=mesh, contacts=[pair], strain_energy=lambda u, state=None: energy, contact_states=lambda state: state.terms
     )
     return model, top
 

@@ -8,7 +8,10 @@ scales), monitor_quantities, the case's origin and fingerprint (and more).  fiel
 ParaView series (step_NNNN.vtu listed in fields.pvd with the time t of its step as timestep,
 files.write_pvd; surfaces_NNNN.csv the moulds at that step).  thickness.csv: the wall
 thickness along the body at the last written step; thickness/step_NNNN.csv every
-`thickness_every` steps.
+`thickness_every` steps.  A step's fields are of its converged mechanical state: under heat
+conduction at the temperature its mechanics ran at (ModelState.field_temperature, the one
+they write as `temperature`), not the one after the step's heat update, which the next step
+starts from and history.csv's temperature monitors show at the row's time.
 Every file is written whole to a temporary name, then renamed over the old one (`atomic`).
 """
 
@@ -278,7 +281,7 @@ class ResultsWriter:
         if step is None:
             return
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
-        table = thickness_table(self.model.mesh, u, self.model.contact_states(step.state), step.state.temperature)
+        table = thickness_table(self.model.mesh, u, self.model.contact_states(step.state), step.state.field_temperature)
         if table is None:
             return
         self.summary["thickness"] = thickness_summary(table)
@@ -290,7 +293,7 @@ class ResultsWriter:
         mesh = self.model.mesh
         self._last_written = step.number
         self._thickness_step = step
-        T = step.state.temperature
+        T = step.state.field_temperature  # beside the stresses: the temperature the mechanics ran at
         if T is not None:
             self.summary["temperature"] = {"min": float(T.min()), "max": float(T.max())}
         if self.vtu and self.model.contacts:
@@ -328,7 +331,7 @@ class ResultsWriter:
     def _write_thickness_step(self, step):
         """thickness/step_NNNN.csv: the thickness table of one step."""
         u = step.u.reshape(-1, self.model.dpn)[:, :2]
-        table = thickness_table(self.model.mesh, u, self.model.contact_states(step.state), step.state.temperature)
+        table = thickness_table(self.model.mesh, u, self.model.contact_states(step.state), step.state.field_temperature)
         if table is not None:
             write_thickness_csv(self.out / "thickness" / f"step_{step.number:04d}.csv", table)
 

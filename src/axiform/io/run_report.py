@@ -115,11 +115,12 @@ class RunRecord:
                 }
 
     def stabilization(self, step) -> dict | None:
-        """{work, strain_energy, ratio} of the last step where a pair is stabilized, else None."""
+        """{work, strain_energy, ratio} of the last step where a pair is stabilized, else None
+        (the strain energy at the temperatures the step's mechanics ran at)."""
         if not any(getattr(p, "stabilization", 0.0) for p in self.model.contacts):
             return None
         work = float(sum(held.damping_work for held in self.model.contact_states(step.state)))
-        energy = float(self.model.strain_energy(step.u))
+        energy = float(self.model.strain_energy(step.u, step.state))
         return {"work": work, "strain_energy": energy, "ratio": work / energy if energy > 0 else float("inf")}
 
     def _through(self, k: int, step) -> PassedThrough | None:

@@ -44,16 +44,32 @@ class ModelState:
     """The committed (or trial) history of a model at process time t: one state per term of
     the residual, in the system's order of its terms (`terms`; None for a term without
     history; model.system.System reads a kind of them: contact_states, cavity_states,
-    solid_state), and the nodes' temperature (n_nodes,) (None without one).  dt = t_trial -
-    t_committed is what a term integrates over."""
+    solid_state), and the nodes' temperature (n_nodes,) (None without one): the one the next
+    step's mechanics starts from.  dt = t_trial - t_committed is what a term integrates over.
+
+    mechanics_temperature (n_nodes,): where heat conduction advanced `temperature` after the
+    step's mechanics converged (System.settle, staggered), the temperature that mechanics ran
+    at; None where it is `temperature` itself.  The state's stresses, and every field written
+    of it, are at `field_temperature`."""
 
     t: float
     terms: tuple[Any, ...] = ()
     temperature: np.ndarray | None = None
+    mechanics_temperature: np.ndarray | None = None
+
+    @property
+    def field_temperature(self) -> np.ndarray | None:
+        """The nodes' temperature (n_nodes,) or None at which the state's mechanics converged:
+        its stresses are at it (post.fields), so the fields written of the state show it."""
+        return self.temperature if self.mechanics_temperature is None else self.mechanics_temperature
 
     def to_dict(self) -> dict:
-        """Plain arrays and numbers (a checkpoint): t, one entry per term, the temperature."""
+        """Plain arrays and numbers (a checkpoint): t, one entry per term, the temperature and,
+        where it differs, the mechanics' temperature (a state restored from it writes the same
+        fields)."""
         out: dict[str, Any] = {"t": float(self.t), "terms": [saved(s) for s in self.terms]}
         if self.temperature is not None:
             out["temperature"] = np.array(self.temperature, copy=True)
+        if self.mechanics_temperature is not None:
+            out["mechanics_temperature"] = np.array(self.mechanics_temperature, copy=True)
         return out

@@ -162,8 +162,11 @@ class System:
         if ("temperature" in saved) != (self.temperature is not None):
             raise ValueError("the saved state has another temperature field than this model")
         temperature = np.asarray(saved["temperature"], float) if "temperature" in saved else None
+        mechanics = saved.get("mechanics_temperature")  # absent: a checkpoint without conduction, or older
         states = tuple(term.restore(part) for term, part in zip(self.terms, saved["terms"], strict=True))
-        return ModelState(float(saved.get("t", 0.0)), states, temperature)
+        return ModelState(
+            float(saved.get("t", 0.0)), states, temperature, None if mechanics is None else np.asarray(mechanics, float)
+        )
 
     def contact_states(self, state: ModelState) -> tuple[ContactState, ...]:
         """The contact pairs' states of a model state, in the order of `contacts`."""
@@ -191,12 +194,13 @@ class System:
         """The state to commit after a converged step: the trial state of its accepted
         evaluation, with the temperature advanced from the committed state's over the step
         on the converged positions X + u_full (staggered: the step's mechanics ran at the
-        temperatures of its start)."""
+        temperatures of its start, kept as its `mechanics_temperature`: the state's stresses
+        and written fields are at those, the next step starts from the advanced ones)."""
         if self.conduction is None:
             return trial
         x = self.mesh.points + u_full.reshape(-1, self.dpn)[:, :2]
         T = self.conduction.step(committed.temperature, trial.t - committed.t, x, trial.t, self.contact_states(trial))
-        return replace(trial, temperature=T)
+        return replace(trial, temperature=T, mechanics_temperature=trial.temperature)
 
     # ---- the solid alone ---------------------------------------------------------------------
     def relaxation_rate(self, u_f: np.ndarray, t: float, state: ModelState, h: float) -> np.ndarray:
@@ -217,10 +221,11 @@ class System:
 
     def strain_energy(self, u_full: np.ndarray, state: ModelState | None = None) -> float:
         """The strain energy stored in the body at the displacements u_full (n_full,) (at the
-        temperatures of `state`, default the initial ones): the law's W at every quadrature
-        point (of its elastic part: materials.protocol `energy`), integrated over the revolved body."""
+        temperatures the mechanics of `state` ran at, ModelState.field_temperature; default the
+        initial ones): the law's W at every quadrature point (of its elastic part:
+        materials.protocol `energy`), integrated over the revolved body."""
         x = self.solid.gradient(u_full)
-        T = (state or self.initial_state()).temperature
+        T = (state or self.initial_state()).field_temperature
         W = self.solid.law.energy(x.reshape(-1, 5), None if T is None else self.solid.point_values(T))
         W = W.reshape(x.shape[:-1])
         return float((W * self.solid.dV).sum())

@@ -25,13 +25,19 @@ def point_fields(model, u_full: np.ndarray, state=None) -> dict[str, np.ndarray]
     hoop), hydrostatic_pressure (-tr sigma / 3); fibre_rotation (SFR); temperature (with one); thickness (meshes
     with fibres); contact_pressure and
     first_contact (the time a slave node first touched, -1 where never) with contact, and
-    first_contact_K per piece K where several record it."""
+    first_contact_K per piece K where several record it.
+
+    Every field is of the converged mechanical state: the stresses at the temperature the
+    state's mechanics ran at (ModelState.field_temperature; under heat conduction the
+    temperature of the step's start, before its heat update), and `temperature` is that same
+    field, so that the stresses and the temperature written beside them agree, as in a state
+    restored from the step's checkpoint."""
     mesh = model.mesh
     dpn = model.dpn
     u = u_full.reshape(-1, dpn)
     solid = model.solid
     x = solid.gradient(u_full)
-    T = (state or model.initial_state()).temperature  # the nodes' (n,) or None
+    T = (state or model.initial_state()).field_temperature  # the nodes' (n,) or None: the mechanics'
     # mixed: with the element pressure; a law with state: its stress at the committed state
     held = model.solid_state(state) if state is not None else {}
     held = {k: v for k, v in held.items() if k != "t"} or None
