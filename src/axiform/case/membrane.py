@@ -1,28 +1,30 @@
-"""The membrane's answer to a load on a wall: the tension the load asks of the wall's
-mid-surface, over the most tension a sheet of the wall's thickness carries at the material's
-shear modulus.  case.preflight's second opinion on a load whose linear estimate inverts
-elements.
+"""The membrane's answer to a load on a wall: the least tension the load asks of the wall's
+mid-surface, over the most a sheet of the wall's thickness carries at the material's shear
+modulus.  case.preflight's second opinion on a load whose linear estimate inverts elements.
 
 Why: a thin wall at rest carries a load across it by bending alone, so a linear estimate
-(the reference tangent) overestimates its first deflection by about (L / t)^2 (the span over
-the thickness): 1e2 to 1e4 for the sheets of forming, the range of a value typed in other
-units (1e3 to 1e6).  Once deflected, the wall carries the load by the tension of its
-mid-surface, and that tension follows from the load and the geometry alone:
+(the reference tangent) overestimates its first deflection, by (L / t)^2 (p L / (mu t))^(2/3)
+in order of magnitude for a span L, a thickness t and a pressure p (a plate's bending against
+a membrane's stretch): 1e2 to 1e5 for the sheets of forming, the range of a value typed in
+other units (1e3 to 1e6).  Once deflected, the wall carries the load by the tension of its
+mid-surface, and the least tension any shape of it needs follows from the load and the
+geometry alone:
 
-- a pressure p over a face of length L in the meridian: T = p L / 2, the tension of a cap of
-  radius L / 2 .. L spanning it (L at most the diameter 2 r_max of the face: the hoop of a
-  tube);
+- a pressure p over a face of length L in the meridian: T = p L / 2, that of a hemispherical
+  cap spanning a disc of radius L, of a half cylinder spanning a strip L wide (L at most the
+  diameter 2 r_max of the face: a tube's hoop, T = p r);
 - a point load (a ring of force F at radius r): T = F / (4 pi r), the line load F / (2 pi r)
-  shared by the wall on either side (r at least the wall's thickness: on the axis);
-- the weight (rho g per unit volume) of a wall spanning L, the body's largest extent:
-  T = rho g t L / 2.
+  pulled at right angles by the wall on either side (r at least the wall's thickness: on the
+  axis);
+- the weight (rho g per unit volume) of a wall spanning the body's largest extent L: that of
+  a pressure rho g t, T = rho g t L / 2.
 
 No stretch of a neo-Hookean sheet of thickness t carries more than mu t per unit length (its
 equibiaxial tension mu (lambda^2 - lambda^-4) times its current thickness t / lambda^2 is
-mu t (1 - lambda^-6)): at T / (mu t) > 1 a sheet without its mould bursts, which a sheet
-pressed onto a mould does within a few steps (the mould carries the rest), and a value in
-other units does a thousand times over.  The thickness t is the wall's at the loaded nodes
-(`wall_thickness`)."""
+mu t (1 - lambda^-6)); other laws carry it at stretches of order one.  At T / (mu t) > 1 a
+sheet without its mould bursts, which a sheet pressed onto a mould does within a few steps
+(the mould carries the rest), and a value in other units does a thousand times over.  The
+thickness t is the wall's at the loaded nodes (`wall_thickness`)."""
 
 from __future__ import annotations
 
