@@ -82,6 +82,22 @@ def test_a_pressure_in_kilopascal_on_the_cup_is_warned():
     assert "a tension 2.1e+02 times" in warning
 
 
+@pytest.mark.parametrize("pressure, warned", [(0.11, False), (110.0, True), (1.1e5, True)])
+def test_a_blowing_pressure_in_other_units_is_warned(pressure, warned):
+    """The parison (13 in radius inside, 2 thick, mu = 0.4) blown under pressure control in
+    24 steps: 0.11 MPa as meant; in kPa, a step of 4.6 asks its hoop p r = 60 of mu t = 0.8,
+    74 times; in Pa, 7.4e4 times.  The linear estimate flags both (gradients 3.2e2 and 3.2e5
+    in a step)."""
+    data = read(EXAMPLES / "parison_bottle.toml")
+    data["cavity"][0].pop("volume")
+    data["cavity"][0] |= {"control": "pressure", "pressure": pressure}
+    warnings = inverting_loads(build(parse(data), EXAMPLES))
+    assert bool(warnings) == warned, warnings
+    if warned:
+        assert warnings[0].startswith(f"cavity[0].pressure: {pressure:g} MPa would invert elements")
+        assert f"a tension {pressure / 110.0 * 74.5:.2g} times" in warnings[0]
+
+
 def test_the_wall_thickness_is_the_distance_across_the_wall():
     """A sheet 0.05 thick: 0.05 from its faces; a plate 0.5 thick, 7.5 wide: 0.5 (the side
     faces run along the wall, not across it); the balloon (0.01 thick): 0.01 on its inner

@@ -49,10 +49,10 @@ from .schema import Built
 # carries), while a value in other units is off by 1e3 to 1e6
 INVERTING_FRACTION = 0.1
 # ... and where its largest step asks the wall's mid-surface this many times the tension a
-# sheet of its thickness carries (case.membrane): a sheet pressed onto a mould in 20 steps
-# asks 1.5 to 3 (0.2 and 0.05 thick, 10 wide, at a pressure 0.6 times its modulus), in one
-# step 15 to 60; a pressure in Pa for MPa 1e5 and more, one in kPa for MPa on the cup 230
-MEMBRANE_MARGIN = 100.0
+# sheet of its thickness carries (case.membrane): a sheet 10 wide pressed onto a mould at 0.6
+# times its modulus asks 0.75 and 3 in 20 steps (0.2 and 0.05 thick), 15 and 60 in one; a
+# pressure in kPa for MPa 74 (the parison's cavity), 211 (the cup), in Pa 7e4 and more
+MEMBRANE_MARGIN = 50.0
 # a mould faces away from its slaves where more than this fraction of the slave nodes that
 # project onto it lie behind it with its normal pointing the way their body's outward normal does
 WRONG_FACE_FRACTION = 0.5
