@@ -13,10 +13,13 @@ fault.
   pass through the mould);
 - a load (the weight too) that inverts elements within one nominal step, in one linear
   solve of the reference tangent (no contact) for the largest increment its curve makes
-  over one nominal step (INVERTING_FRACTION of it): a value typed in other units (a
-  pressure in Pa in an mm / MPa case, a density in kg/m^3 in a t/mm^3 one); under
-  displacement control (the load factor an unknown), the driven dof's step target / steps
-  instead.  Not for cavities under volume or gas control;
+  over one nominal step (INVERTING_FRACTION of it), and for a force whose step also asks
+  the wall's mid-surface MEMBRANE_MARGIN times the tension a sheet of its thickness carries
+  (case.membrane: a thin wall's linear bending overestimates its first step as much as a
+  unit's factor): a value typed in other units (a pressure in Pa in an mm / MPa case, a
+  density in kg/m^3 in a t/mm^3 one); under displacement control (the load factor an
+  unknown), the driven dof's step target / steps instead.  Not for cavities under volume or
+  gas control;
 - the units' plausibility (case.plausible): tables of T out of reach of every temperature
   of the case, a modulus in Pa in an MPa case.
 
@@ -26,6 +29,8 @@ fault.
 from __future__ import annotations
 
 import dataclasses
+import functools
+from collections.abc import Callable
 
 import numpy as np
 
@@ -34,14 +39,20 @@ from ..fem.elements import gradient_operator
 from ..fem.selectors import select_nodes
 from ..solve.linsolve import SingularTangentError, factorize
 from ..solve.solver import DisplacementControl
+from . import membrane
 from .plausible import modulus_units, tables_out_of_reach
 from .schema import Built
 
 # a load is flagged where this fraction of its largest step would already invert elements in
-# the linear estimate: a margin for thin walls, whose linear bending overestimates the first
-# step many times over (the cup's vacuum: gradients up to 9 in a linear step that the membrane
+# the linear estimate: a margin for walls whose linear bending overestimates the first step
+# several times over (the cup's vacuum: gradients up to 9 in a linear step that the membrane
 # carries), while a value in other units is off by 1e3 to 1e6
 INVERTING_FRACTION = 0.1
+# ... and where its largest step asks the wall's mid-surface this many times the tension a
+# sheet of its thickness carries (case.membrane): a sheet 10 wide pressed onto a mould at 0.6
+# times its modulus asks 0.75 and 3 in 20 steps (0.2 and 0.05 thick), 15 and 60 in one; a
+# pressure in kPa for MPa 74 (the parison's cavity), 211 (the cup), in Pa 7e4 and more
+MEMBRANE_MARGIN = 50.0
 # a mould faces away from its slaves where more than this fraction of the slave nodes that
 # project onto it lie behind it with its normal pointing the way their body's outward normal does
 WRONG_FACE_FRACTION = 0.5
@@ -134,17 +145,8 @@ def _mould_name(built: Built, i: int) -> str:
 
 def body_normals(pair) -> np.ndarray:
     """The body's outward unit normal at each slave node of a contact pair (n, 2): the mean
-    of the outward normals of its slave edges (they run counter-clockwise around the body,
-    so the outward normal is the direction of travel turned by -90 degrees)."""
-    x = pair.X
-    e = pair.edges
-    t = x[e[:, 1]] - x[e[:, 0]]
-    n_edge = np.column_stack([t[:, 1], -t[:, 0]])
-    n_edge /= np.linalg.norm(n_edge, axis=1)[:, None]
-    out = np.zeros_like(x)
-    for k in range(e.shape[1]):
-        np.add.at(out, e[:, k], n_edge)
-    return out / np.maximum(np.linalg.norm(out, axis=1), 1e-300)[:, None]
+    of the outward normals of its slave edges (membrane.outward_normals)."""
+    return membrane.outward_normals(pair.X, pair.edges)
 
 
 def mould_checks(built: Built) -> list[str]:
@@ -253,7 +255,8 @@ def _inverts(body, du: np.ndarray, presc: np.ndarray) -> tuple[bool, float]:
 
 def _driven_step(built: Built, reference) -> list[str]:
     """Displacement control: whether the driven dof's step target / steps inverts elements,
-    the loads in proportion along the reference tangent."""
+    the loads in proportion along the reference tangent.  The linear estimate alone: the
+    step's size is given, not estimated."""
     body, ev, solve = reference
     control = built.control
     assert isinstance(control, DisplacementControl), "called for displacement control only"
@@ -274,34 +277,43 @@ def _driven_step(built: Built, reference) -> list[str]:
     ]
 
 
-def inverting_loads(built: Built) -> list[str]:
-    """Loads that invert elements within one nominal step, by a linear estimate (under
-    displacement control: the driven dof's step)."""
-    reference = _reference_tangent(built)
-    if reference is None:
-        return []  # held by its moulds alone: no reference tangent without them
-    if isinstance(built.control, DisplacementControl):
-        return _driven_step(built, reference)
-    body, ev, solve = reference
-    t_end, steps = float(built.control.target), int(built.control.steps)
-    case = built.case
-    dm = body.dofmap
-    nf, n_eq = dm.nf, body.n_free
-    zero = np.zeros(body.n_full)
+@dataclasses.dataclass
+class _Load:
+    """One load over its largest nominal step: where it is given (key path), its value and
+    unit (or what stands for it), its full load vector (n_full,), the full prescribed
+    displacements (a fix's; None for a force) and the membrane's answer to it (`membrane`:
+    T / (mu t), case.membrane; None for a displacement, whose size is given)."""
+
+    where: str
+    value: float
+    unit: str | None
+    force: np.ndarray
+    prescribed: np.ndarray | None = None
+    membrane: Callable[[], float] | None = None
+
+
+def _force_loads(built: Built, body, t_end: float, steps: int) -> list[_Load]:
+    """The pressures, point loads, cavities under pressure control and the weight of a case,
+    each over its largest nominal step, with the membrane's answer (lazily: only a load the
+    linear estimate flags asks it)."""
+    case, mesh, zero = built.case, body.mesh, np.zeros(body.n_full)
+    mu = float(getattr(body.material, "shear_modulus", np.nan))
     units = case.units
-    # (key path, value, what, full load vector, full prescribed displacements)
-    loads: list[tuple[str, float, str | None, np.ndarray, np.ndarray | None]] = []
+    loads = []
     for i, (spec, p) in enumerate(zip(case.pressure, body.pressures, strict=False)):
         step = spec.value * _step_increment(p.curve, t_end, steps)
         if step:
             fe, _ = p.evaluate(zero, tangent=False)
             f = np.bincount(p.dofs.ravel(), fe.ravel(), body.n_full) / p.value * step
-            loads.append((f"pressure[{i}].value", spec.value, units.pressure, f, None))
+            ask = functools.partial(membrane.pressure_ratio, mesh, p.nodes, step, mu)
+            loads.append(_Load(f"pressure[{i}].value", spec.value, units.pressure, f, membrane=ask))
     for i, load in enumerate(case.point_load):
         step = load.value * _step_increment(load.build_curve(), t_end, steps)
         if step:
             f = _point_load_vector(body, case, i) * step / load.value
-            loads.append((f"point_load[{i}].value", load.value, units.force, f, None))
+            nodes = np.flatnonzero(f.reshape(-1, body.dpn).any(axis=1))
+            ask = functools.partial(membrane.ring_ratio, mesh, nodes, step, mu)
+            loads.append(_Load(f"point_load[{i}].value", load.value, units.force, f, membrane=ask))
     for i, (gas, cav) in enumerate(zip(case.cavity, body.cavities, strict=False)):
         if gas.control != "pressure":
             continue
@@ -310,7 +322,8 @@ def inverting_loads(built: Built) -> list[str]:
         if step:
             _, ge, _ = cav.evaluate(zero, tangent=False)
             f = np.bincount(cav.dofs.ravel(), ge.ravel(), body.n_full) * step
-            loads.append((f"cavity[{i}].pressure", gas.pressure, units.pressure, f, None))
+            ask = functools.partial(membrane.pressure_ratio, mesh, cav.nodes, step, mu)
+            loads.append(_Load(f"cavity[{i}].pressure", gas.pressure, units.pressure, f, membrane=ask))
     if case.gravity is not None:
         from ..model.gravity import GravityTerm  # only where the case has a weight
 
@@ -318,30 +331,69 @@ def inverting_loads(built: Built) -> list[str]:
             step = _step_increment(weight.curve, t_end, steps)
             if step:
                 density = f"(material.density {case.material.density:g})"
-                loads.append(("gravity.g", case.gravity.g, density, weight.force * step, None))
-    for i, fix in enumerate(case.fix):
+                rho_g = (case.material.density or 0.0) * case.gravity.g * step  # a weight has its density
+                ask = functools.partial(membrane.weight_ratio, mesh, rho_g, mu)
+                loads.append(_Load("gravity.g", case.gravity.g, density, weight.force * step, membrane=ask))
+    return loads
+
+
+def _fix_loads(built: Built, body, t_end: float, steps: int) -> list[_Load]:
+    """The prescribed displacements of a case, each over its largest nominal step (the load:
+    the internal forces they make at the reference state, reversed)."""
+    out = []
+    for i, fix in enumerate(built.case.fix):
         if not fix.value:
             continue
         step = fix.value * _step_increment(fix.build_curve(), t_end, steps)
         if step:
             u_fix = np.zeros(body.n_full)
-            u_fix[_fix_dofs(body, case, i)] = step
-            loads.append((f"fix[{i}].value", fix.value, units.length, -_internal_rate(body, u_fix), u_fix))
+            u_fix[_fix_dofs(body, built.case, i)] = step
+            unit = built.case.units.length
+            out.append(_Load(f"fix[{i}].value", fix.value, unit, -_internal_rate(body, u_fix), u_fix))
+    return out
+
+
+def inverting_loads(built: Built) -> list[str]:
+    """Loads that invert elements within one nominal step (under displacement control: the
+    driven dof's step), where two estimates agree: the linear one (one solve of the reference
+    tangent: INVERTING_FRACTION of the step inverts an element) and, for a force, the
+    membrane's (case.membrane: the step asks the wall's mid-surface MEMBRANE_MARGIN times the
+    tension a sheet of its thickness carries).  The linear estimate of a wall of span L and
+    thickness t overestimates its first deflection by about (L / t)^2, as much as a unit's
+    factor; the membrane's answer does not, and a value in other units still asks a thousand
+    times what the wall carries.  A displacement (a fix's value, the driven dof) is given,
+    not estimated: the linear estimate alone."""
+    reference = _reference_tangent(built)
+    if reference is None:
+        return []  # held by its moulds alone: no reference tangent without them
+    if isinstance(built.control, DisplacementControl):
+        return _driven_step(built, reference)
+    body, ev, solve = reference
+    t_end, steps = float(built.control.target), int(built.control.steps)
+    dm = body.dofmap
+    nf, n_eq = dm.nf, body.n_free
     out = []
-    for where, value, unit, f_full, u_p in loads:
+    for load in _force_loads(built, body, t_end, steps) + _fix_loads(built, body, t_end, steps):
         b = np.zeros(n_eq)
-        b[:nf] = dm.gather(f_full)[:nf]
+        b[:nf] = dm.gather(load.force)[:nf]
         presc = np.zeros(dm.np)
-        if u_p is not None:
-            presc[dm.eq[np.flatnonzero(u_p)] - nf] = u_p[np.flatnonzero(u_p)]
+        if load.prescribed is not None:
+            moved = np.flatnonzero(load.prescribed)
+            presc[dm.eq[moved] - nf] = load.prescribed[moved]
         bad, h = _inverts(body, solve(b), presc)
-        if bad:
-            given = f"{value:g}" + (f" {unit}" if unit else "")
-            out.append(
-                f"{where}: {given} would invert elements within one nominal step (a linear estimate at the "
-                f"reference state: displacement gradients up to {h:.2g} in one step of "
-                f"{t_end / steps:g}): is it in the units of the rest of the case?"
-            )
+        if not bad:
+            continue
+        tension = load.membrane() if load.membrane is not None else None
+        if tension is not None and tension < MEMBRANE_MARGIN:  # NaN (no modulus): the linear estimate alone
+            continue
+        given = f"{load.value:g}" + (f" {load.unit}" if load.unit else "")
+        known = tension is not None and np.isfinite(tension)
+        said = f"; the membrane's: a tension {tension:.2g} times what its wall carries" if known else ""
+        out.append(
+            f"{load.where}: {given} would invert elements within one nominal step (a linear estimate at the "
+            f"reference state: displacement gradients up to {h:.2g} in one step of {t_end / steps:g}"
+            f"{said}): is it in the units of the rest of the case?"
+        )
     return out
 
 
