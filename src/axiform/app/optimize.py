@@ -251,7 +251,7 @@ def run(
         say(f"axiform: invalid output folder:\n--out: {problem}")
         return 2
     if not quiet:
-        say(
+        tell(
             f"axiform optimize: {design.knots.size} design variables ({design.name}), method {method}, "
             f"tolerance {tolerance:g} -> {out_dir}"
         )

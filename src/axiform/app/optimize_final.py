@@ -34,11 +34,12 @@ def run_final(out_dir: Path, design: Design, result: OptimizeResult, quiet: bool
     case_out = out_dir / "optimized.toml"
     write_atomic(case_out, case_text(design, result.best.design, result.best.stops))
     final = out_dir / "final"
+    stream = io.StringIO() if quiet else sys.stdout  # the final run's status line: one of the progress lines
     with contextlib.redirect_stderr(io.StringIO()) if quiet else contextlib.nullcontext():
         solved = result.best.solved
-        code = None if solved is None else write_solved(case_out, final, solved)
+        code = None if solved is None else write_solved(case_out, final, solved, stream)
         if code is None:
-            code = run_case(str(case_out), str(final), quiet=True)
+            code = run_case(str(case_out), str(final), quiet=True, stream=stream)
     if code in INTERRUPTED:
         result.status = "interrupted"
         name = signal.Signals(code - 128).name
@@ -49,10 +50,10 @@ def run_final(out_dir: Path, design: Design, result: OptimizeResult, quiet: bool
     return final, code
 
 
-def write_solved(case_file: Path, folder: Path, solved: Solved) -> int | None:
+def write_solved(case_file: Path, folder: Path, solved: Solved, stream=None) -> int | None:
     """`axiform run case_file --out folder -q` for a case solved already: the results folder
     written from the steps of `solved` (every converged step of the solve), the run's status
-    line on stderr; the exit code.  None, and nothing written, where the case does not read
+    line on `stream` (default stdout); the exit code.  None, and nothing written, where the case does not read
     or asks for another load control or other Newton options than the solve followed, or
     has other unknowns (the run of the case then says why or solves it).  summary.json's
     wall_time_s counts the solve the steps come from."""
@@ -72,7 +73,7 @@ def write_solved(case_file: Path, folder: Path, solved: Solved) -> int | None:
             if lock is None:
                 return 2
             try:  # the lock is dropped however the writing ends
-                return _write(job, folder, solved, stops)
+                return _write(job, folder, solved, stops, stream or sys.stdout)
             finally:
                 lock.release()
         except CaseError:
@@ -82,7 +83,7 @@ def write_solved(case_file: Path, folder: Path, solved: Solved) -> int | None:
             return 128 + exc.signum
 
 
-def _write(job: Job, folder: Path, solved: Solved, stops: Stops) -> int:
+def _write(job: Job, folder: Path, solved: Solved, stops: Stops, stream) -> int:
     """The steps of `solved` through the job's results writer, then its wind-up (app/run.py's
     run: the status, the last files, the status line); the exit code."""
     from ..io.results import NonFiniteResult
@@ -111,7 +112,7 @@ def _write(job: Job, folder: Path, solved: Solved, stops: Stops) -> int:
         trace(exc)
     wall = solved.result.wall_time_s
     line = status_line(status, message, job.warnings, writer.steps, writer.newton_iterations, wall, folder)
-    tell(line, stream=sys.stderr)
+    tell(line, stream=stream)
     if status == "interrupted":
         return 128 + (stops.signum or signal.SIGINT)
     return EXIT.get(status, 1)
