@@ -292,10 +292,15 @@ def write_table(path: Path, sweep: Sweep, rows: list[dict | None]) -> None:
                 " ".join(str(row.get("message", "")).split()),
                 *[repr(monitors[m]) if m in monitors else "" for m in sweep.monitors],
                 "" if thinnest is None else repr(thinnest),
-                *[repr(v) for m in sweep.monitors for v in extremes.get(m, ("", ""))],
+                *[cell for m in sweep.monitors for cell in _extreme_cells(extremes.get(m))],
             ]
         )
     write_atomic(path, text.getvalue())
+
+
+def _extreme_cells(pair: tuple[float, float] | None) -> tuple[str, str]:
+    """A monitor's (min, max) cells of sweep.csv: empty for a case without a history."""
+    return ("", "") if pair is None else (repr(pair[0]), repr(pair[1]))
 
 
 def _client(scheduler: str | None, workers: int | None):
