@@ -25,7 +25,8 @@ skips the cases whose summary.json says "finished" for the same case text (resum
 Dask distributed runs the cases: a LocalCluster of N single-threaded worker processes
 (default: the cores), or the scheduler at --scheduler (its workers need axiform and the
 folders, by a shared file system).  Exit 0 when every case finished, 1 when some did not,
-2 for an invalid sweep file (refused before any work).
+2 for an invalid sweep file (refused before any work); SIGINT or SIGTERM closes the cluster
+and keeps the rows of the finished cases, the others "interrupted": exit 130 or 143.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ import io
 import itertools
 import math
 import os
+import signal
 import sys
 import time
 import tomllib
@@ -51,6 +53,7 @@ from ..io.text import MAX_CASE_BYTES, FileTooLarge, read_text
 from ..post.sweep_plots import plot_sweep
 from ..post.sweep_plots import value_text as toml_value
 from .console import ProgressLine, tell
+from .run import Stops
 from .sweep_rows import summary_row
 
 SWEEP_KEYS = ("case", "vary", "cases", "report")
@@ -357,44 +360,73 @@ def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: 
             todo.append(k)
     tell(f"axiform sweep: {n} cases of {sweep.case_file.name}, {len(todo)} to run -> {root}")
     write_table(root / "sweep.csv", sweep, rows)
-    if todo:
-        from distributed import as_completed
-
-        client, cluster = _client(scheduler, workers)
+    with Stops() as stops:
         try:
-            futures = {
-                client.submit(
-                    run_case,
-                    str(sweep.case_file),
-                    sweep.overrides(k),
-                    str(folders[k].resolve()),
-                    key=f"axiform-case-{k + 1:04d}-{os.getpid()}-{time.time_ns()}",
-                    pure=False,
-                ): k
-                for k in todo
-            }
-            for future in as_completed(futures):
-                k = futures[future]
-                try:
-                    row = future.result()
-                except Exception as exc:  # noqa: BLE001 - a worker died or was lost: the row says so
-                    row = {"status": "failed", "exit_code": 3, "message": f"{type(exc).__name__}: {exc}"}
-                rows[k] = row
-                progress(folders[k].name, row)
-                write_table(root / "sweep.csv", sweep, rows)
-        finally:
+            if todo:
+                _run_cases(sweep, root, todo, rows, progress, (scheduler, workers), stops)
+        except Exception:
+            # SIGINT or SIGTERM (Interrupted, or whatever the cluster's code made of it)
+            if stops.signum is None:
+                raise
+        stops.raised = True  # a later signal waits for the wind-up: the table, the picture, the last line
+        return _wind_up(sweep, root, rows, progress, stops.signum)
+
+
+def _run_cases(sweep: Sweep, root: Path, todo: list[int], rows: list, progress, where, stops) -> None:
+    """The cases `todo` on the cluster (where: the scheduler's address or None, the workers),
+    each row in `rows` and root/sweep.csv as it comes; the cluster closed however it ends."""
+    from distributed import as_completed
+
+    folders = [root / "cases" / f"{k + 1:04d}" for k in range(len(rows))]
+    client, cluster = _client(*where)
+    try:
+        futures = {
+            client.submit(
+                run_case,
+                str(sweep.case_file),
+                sweep.overrides(k),
+                str(folders[k].resolve()),
+                key=f"axiform-case-{k + 1:04d}-{os.getpid()}-{time.time_ns()}",
+                pure=False,
+            ): k
+            for k in todo
+        }
+        for future in as_completed(futures):
+            k = futures[future]
+            try:
+                row = future.result()
+            except Exception as exc:  # noqa: BLE001 - a worker died or was lost: the row says so
+                row = {"status": "failed", "exit_code": 3, "message": f"{type(exc).__name__}: {exc}"}
+            rows[k] = row
+            progress(folders[k].name, row)
+            write_table(root / "sweep.csv", sweep, rows)
+    finally:
+        with stops.held():  # a signal waits for the cluster to close
             client.close()
             if cluster is not None:
                 cluster.close()
+
+
+def _wind_up(sweep: Sweep, root: Path, rows: list, progress, signum: int | None) -> int:
+    """After the cases (all, or those a signal let finish: the others' rows say "interrupted"):
+    sweep.csv, sweep.png and the final line; the exit code."""
+    n = len(rows)
+    if signum is not None:
+        why = f"interrupted by {signal.Signals(signum).name} before the case finished"
+        rows[:] = [row or {"status": "interrupted", "message": why} for row in rows]
+        write_table(root / "sweep.csv", sweep, rows)
     progress.close()
     try:
         plot_sweep(root / "sweep.png", sweep, rows)
     except Exception as exc:  # noqa: BLE001 - the cases and sweep.csv stand; say why the picture does not
-        print(f"axiform sweep: sweep.png not written ({type(exc).__name__}: {exc})", file=say)
+        print(f"axiform sweep: sweep.png not written ({type(exc).__name__}: {exc})", file=sys.stderr)
     bad = [f"{k + 1:04d}" for k, r in enumerate(rows) if (r or {}).get("status") != "finished"]
+    head = "axiform sweep: " + ("" if signum is None else f"interrupted by {signal.Signals(signum).name}: ")
     tell(
-        f"axiform sweep: {n - len(bad)} of {n} cases finished"
+        f"{head}{n - len(bad)} of {n} cases finished"
         + (f"; not finished: {', '.join(bad)}" if bad else "")
         + f" -> {root / 'sweep.csv'}"
     )
+    if signum is not None:
+        return 128 + signum
     return 1 if bad else 0
