@@ -1,14 +1,17 @@
 """`axiform sweep` on cases its first tests did not hold (§ 17: every sweep shows its
 progress, errors and warnings on stderr): SIGINT stops it as it stops a run (exit 130, the
 rows of the finished cases kept, the others "interrupted", the final line; it was a
-KeyboardInterrupt with every row left "pending"), and sweep.csv leaves the extremes of a
-case without a history empty (a pending or failed case had '' in them)."""
+KeyboardInterrupt with every row left "pending"), -q prints the final line alone and nothing
+of the cluster's own reaches stderr (another sweep holding port 8787 made Dask warn), and
+sweep.csv leaves the extremes of a case without a history empty (a pending or failed case
+had '' in them)."""
 
 from __future__ import annotations
 
 import csv
 import os
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -70,3 +73,21 @@ def test_sigint_keeps_the_finished_rows_and_says_so(tmp_path):
     assert [r["status"] for r in table(tmp_path)] == ["finished", "interrupted", "interrupted"]
     last = out.splitlines()[-1]
     assert last.startswith("axiform sweep: interrupted by SIGINT: 1 of 3 cases finished; not finished: 0002, 0003")
+
+
+def test_quiet_prints_the_final_line_alone_and_the_cluster_nothing(tmp_path):
+    """With port 8787 taken (by another sweep's cluster, say): stdout one line, stderr empty."""
+    held = socket.socket()
+    try:
+        held.bind(("", 8787))
+        held.listen()
+    except OSError:
+        pass  # taken already: as the test wants it
+    try:
+        proc = sweep(tmp_path, 'case = "plate.toml"\n[vary]\n"material.C1" = [60.0, 80.0]\n', "-q")
+        out, err = proc.communicate(timeout=120)
+    finally:
+        held.close()
+    assert proc.returncode == 0, err
+    assert out.splitlines() == [f"axiform sweep: 2 of 2 cases finished -> {tmp_path / 'out' / 'sweep.csv'}"]
+    assert err == ""

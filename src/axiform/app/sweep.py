@@ -1,4 +1,4 @@
-"""`axiform sweep SWEEP.toml --out DIR [--scheduler ADDRESS] [--workers N]`: many variants
+"""`axiform sweep SWEEP.toml --out DIR [--scheduler ADDRESS] [--workers N] [-q]`: many variants
 of one case on a Dask cluster.
 
     case = "plate.toml"                 # relative to SWEEP.toml
@@ -237,10 +237,10 @@ def run_case(case_file: str, overrides: list[str], out: str) -> dict[str, Any]:
 
 class SweepProgress:
     """The progress of a sweep (console.ProgressLine): a bar of the cases done on a terminal,
-    else one line per finished case."""
+    else one line per finished case; nothing when quiet."""
 
-    def __init__(self, stream, total: int):
-        self.line = ProgressLine(stream, total)
+    def __init__(self, stream, total: int, quiet: bool = False):
+        self.line = ProgressLine(stream, total, quiet)
         self.total = total
         self.done = self.failed = 0
 
@@ -314,19 +314,26 @@ def _client(scheduler: str | None, workers: int | None):
 
     if scheduler:
         return Client(scheduler), None
+    # the cluster's own log lines are about its machinery, not the cases (each case's failure
+    # comes back as its row): at its close a worker's heartbeat may find the scheduler gone and
+    # log a traceback (ERROR); its HTTP server on a free port, not 8787 (taken by another
+    # sweep, with a warning)
     cluster = LocalCluster(
         n_workers=workers or os.cpu_count() or 1,
         threads_per_worker=1,
         processes=True,
         dashboard_address=None,
-        silence_logs=logging.ERROR,
+        scheduler_kwargs={"dashboard_address": ":0"},
+        silence_logs=logging.CRITICAL,
         env=WORKER_ENV,
     )
     return Client(cluster), cluster
 
 
-def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: int | None = None) -> int:
-    """The `axiform sweep` command; returns the exit code."""
+def run_sweep(
+    sweep_file: str, out: str, scheduler: str | None = None, workers: int | None = None, quiet: bool = False
+) -> int:
+    """The `axiform sweep` command; returns the exit code.  quiet: the final line alone."""
     say = sys.stderr
     try:
         sweep = load_sweep(sweep_file)
@@ -347,7 +354,7 @@ def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: 
     n = len(sweep.cases)
     rows: list[dict | None] = [None] * n
     folders = [root / "cases" / f"{k + 1:04d}" for k in range(n)]
-    progress = SweepProgress(sys.stdout, n)  # what the command produces on stdout, errors on stderr
+    progress = SweepProgress(sys.stdout, n, quiet)  # what the command produces on stdout, errors on stderr
     todo = []
     for k in range(n):  # resume: a finished folder of the same case text is kept
         done = summary_row(folders[k])
@@ -358,7 +365,8 @@ def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: 
             progress(folders[k].name, row, skipped=True)
         else:
             todo.append(k)
-    tell(f"axiform sweep: {n} cases of {sweep.case_file.name}, {len(todo)} to run -> {root}")
+    if not quiet:
+        tell(f"axiform sweep: {n} cases of {sweep.case_file.name}, {len(todo)} to run -> {root}")
     write_table(root / "sweep.csv", sweep, rows)
     with Stops() as stops:
         try:
