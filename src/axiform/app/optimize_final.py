@@ -29,8 +29,9 @@ def run_final(
 ) -> tuple[Path | None, int]:
     """optimized.toml and its results in out_dir/final/ (module docstring); the folder (None
     when no design finished) and the run's exit code.  warned: the warnings said already
-    (not said again where final/ is written from the best design's solve).  A final run that does not finish makes
-    the result "stopped"; one stopped by SIGINT or SIGTERM (exit 130 or 143) "interrupted"."""
+    (not said again where final/ is written from the best design's solve).  A final run that
+    does not finish makes the result "stopped"; one stopped by SIGINT or SIGTERM (exit 130 or
+    143) "interrupted"."""
     from .run import run as run_case
 
     if not result.best.finished:
