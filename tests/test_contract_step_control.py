@@ -9,7 +9,7 @@ import copy
 
 import numpy as np
 import pytest
-from test_restart import ARC
+from test_restart import ARC, PUNCH
 
 from axiform.case.schema import build, parse
 from axiform.io.checkpoint import load as load_checkpoint
@@ -52,3 +52,17 @@ def test_a_run_resumed_inside_a_sub_stepped_arc_takes_the_same_steps(tmp_path):
     for a, b in zip(rest.steps, full.steps[k:], strict=True):
         assert a.lam == pytest.approx(b.lam, rel=1e-10) and a.iterations == b.iterations
         np.testing.assert_allclose(a.u, b.u, rtol=1e-10, atol=1e-12 * np.abs(b.u).max())
+
+
+def test_an_arc_without_growth_follows_a_nominal_arc_that_grows():
+    """The sticky punch of test_restart pressed in after a hold, under arc length in 8 steps
+    without growth: the nominal arc is worked out anew after every step, and where it grows a
+    nominal arc is sub-stepped at the old size, then the new one taken (13 steps, none cut:
+    the first size was kept to the end)."""
+    case = copy.deepcopy(PUNCH)
+    case["contact"][0]["motion"] = {"uz": -0.8, "curve": [[0.0, 0.0], [0.5, 0.0], [1.0, 1.0]]}
+    case["solver"] = {"control": "arc-length", "steps": 8, "growth": 1.0}
+    result = arc_run(case)
+    assert result.status == "finished", result.message
+    assert result.cuts == 0 and result.n_steps <= 11
+    assert result.last.lam == 1.0
