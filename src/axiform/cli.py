@@ -224,6 +224,7 @@ def _optimize_and_sweep(sub) -> None:
     p_sweep.add_argument("--out", required=True, help="the sweep folder: cases/NNNN/, sweep.csv, sweep.png")
     p_sweep.add_argument("--scheduler", help="address of a running Dask scheduler (default: a LocalCluster)")
     p_sweep.add_argument("--workers", type=int, help="worker processes of the LocalCluster (default: the cores)")
+    p_sweep.add_argument("-q", "--quiet", action="store_true", help="print only one line: the final status")
 
 
 def dispatch(args: argparse.Namespace) -> int:
@@ -267,7 +268,7 @@ def dispatch(args: argparse.Namespace) -> int:
     if args.command == "sweep":
         from .app.sweep import run_sweep
 
-        return run_sweep(args.sweep, args.out, args.scheduler, args.workers)
+        return run_sweep(args.sweep, args.out, args.scheduler, args.workers, args.quiet)
     if args.command == "plot":
         from .app.plot import plot
 

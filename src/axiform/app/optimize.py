@@ -18,12 +18,13 @@ from pathlib import Path
 
 import numpy as np
 
+from ..case.preflight import preflight
 from ..design.optimize import TOLERANCE, Design, Iterate, OptimizeResult, Row, case_text, optimize
 from ..design.problem import SMOOTHNESS, Objective, TargetError, ThicknessDesign, read_target
 from ..design.temperature_design import TemperatureDesign
 from ..io.files import write_atomic
 from ..post.optimize_plots import OptimizePicture, PictureRun, plot_optimization
-from .console import say, tell
+from .console import say, tell, warn
 from .optimize_final import INTERRUPTED, run_final
 from .run import Interrupted, Stops
 
@@ -251,10 +252,12 @@ def run(
         say(f"axiform: invalid output folder:\n--out: {problem}")
         return 2
     if not quiet:
-        say(
+        tell(
             f"axiform optimize: {design.knots.size} design variables ({design.name}), method {method}, "
             f"tolerance {tolerance:g} -> {out_dir}"
         )
+    warned = preflight(design.built)
+    warn(*warned)  # the case's pre-run warnings, before the first solve, as a run (also with -q)
     final, code = None, 0
     with Stops() as stops:
         progress = Progress(out_dir, design, stops, quiet)
@@ -270,7 +273,7 @@ def run(
             result = progress.interrupted(method, tolerance, Interrupted(stops.signum))
         else:
             try:
-                final, code = run_final(out_dir, design, result, quiet)
+                final, code = run_final(out_dir, design, result, quiet, warned)
             except Interrupted as exc:  # between the optimization and the final run
                 result.status, result.message = "interrupted", f"{result.message}; {exc} before the final run"
         stops.raised = True  # a signal from here on is recorded: the files are written first

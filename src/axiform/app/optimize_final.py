@@ -13,6 +13,7 @@ import contextlib
 import io
 import signal
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 
 from ..design.optimize import Design, OptimizeResult, Solved, case_text
@@ -23,10 +24,14 @@ from .run import EXIT, Interrupted, Job, Stops, locked_folder, status_line
 INTERRUPTED = (128 + signal.SIGINT, 128 + signal.SIGTERM)  # the exit codes 130, 143
 
 
-def run_final(out_dir: Path, design: Design, result: OptimizeResult, quiet: bool) -> tuple[Path | None, int]:
+def run_final(
+    out_dir: Path, design: Design, result: OptimizeResult, quiet: bool, warned: Sequence[str] = ()
+) -> tuple[Path | None, int]:
     """optimized.toml and its results in out_dir/final/ (module docstring); the folder (None
-    when no design finished) and the run's exit code.  A final run that does not finish makes
-    the result "stopped"; one stopped by SIGINT or SIGTERM (exit 130 or 143) "interrupted"."""
+    when no design finished) and the run's exit code.  warned: the warnings said already
+    (not said again where final/ is written from the best design's solve).  A final run that
+    does not finish makes the result "stopped"; one stopped by SIGINT or SIGTERM (exit 130 or
+    143) "interrupted"."""
     from .run import run as run_case
 
     if not result.best.finished:
@@ -34,11 +39,12 @@ def run_final(out_dir: Path, design: Design, result: OptimizeResult, quiet: bool
     case_out = out_dir / "optimized.toml"
     write_atomic(case_out, case_text(design, result.best.design, result.best.stops))
     final = out_dir / "final"
+    stream = io.StringIO() if quiet else sys.stdout  # the final run's status line: one of the progress lines
     with contextlib.redirect_stderr(io.StringIO()) if quiet else contextlib.nullcontext():
         solved = result.best.solved
-        code = None if solved is None else write_solved(case_out, final, solved)
+        code = None if solved is None else write_solved(case_out, final, solved, stream, warned)
         if code is None:
-            code = run_case(str(case_out), str(final), quiet=True)
+            code = run_case(str(case_out), str(final), quiet=True, stream=stream)
     if code in INTERRUPTED:
         result.status = "interrupted"
         name = signal.Signals(code - 128).name
@@ -49,13 +55,14 @@ def run_final(out_dir: Path, design: Design, result: OptimizeResult, quiet: bool
     return final, code
 
 
-def write_solved(case_file: Path, folder: Path, solved: Solved) -> int | None:
+def write_solved(case_file: Path, folder: Path, solved: Solved, stream=None, warned: Sequence[str] = ()) -> int | None:
     """`axiform run case_file --out folder -q` for a case solved already: the results folder
     written from the steps of `solved` (every converged step of the solve), the run's status
-    line on stderr; the exit code.  None, and nothing written, where the case does not read
-    or asks for another load control or other Newton options than the solve followed, or
-    has other unknowns (the run of the case then says why or solves it).  summary.json's
-    wall_time_s counts the solve the steps come from."""
+    line on `stream` (default stdout), its warnings but those `warned` already; the exit
+    code.  None, and nothing written, where the case does not read or asks for another load
+    control or other Newton options than the solve followed, or has other unknowns (the run
+    of the case then says why or solves it).  summary.json's wall_time_s counts the solve
+    the steps come from."""
     from ..case.schema import CaseError
 
     with Stops() as stops:
@@ -72,7 +79,7 @@ def write_solved(case_file: Path, folder: Path, solved: Solved) -> int | None:
             if lock is None:
                 return 2
             try:  # the lock is dropped however the writing ends
-                return _write(job, folder, solved, stops)
+                return _write(job, folder, solved, stops, stream or sys.stdout, warned)
             finally:
                 lock.release()
         except CaseError:
@@ -82,7 +89,7 @@ def write_solved(case_file: Path, folder: Path, solved: Solved) -> int | None:
             return 128 + exc.signum
 
 
-def _write(job: Job, folder: Path, solved: Solved, stops: Stops) -> int:
+def _write(job: Job, folder: Path, solved: Solved, stops: Stops, stream, warned: Sequence[str]) -> int:
     """The steps of `solved` through the job's results writer, then its wind-up (app/run.py's
     run: the status, the last files, the status line); the exit code."""
     from ..io.results import NonFiniteResult
@@ -92,7 +99,7 @@ def _write(job: Job, folder: Path, solved: Solved, stops: Stops) -> int:
         with stops.held():  # a signal waits for the writer: it is there when Interrupted comes
             writer = job.writer(folder)
             writer.t0 -= solved.result.wall_time_s  # the wall time of the solve and its files
-        warn(*job.warnings)
+        warn(*(w for w in job.warnings if w not in warned))
         for step in solved.result.steps:
             with stops.held():
                 writer.step(step)
@@ -111,7 +118,7 @@ def _write(job: Job, folder: Path, solved: Solved, stops: Stops) -> int:
         trace(exc)
     wall = solved.result.wall_time_s
     line = status_line(status, message, job.warnings, writer.steps, writer.newton_iterations, wall, folder)
-    tell(line, stream=sys.stderr)
+    tell(line, stream=stream)
     if status == "interrupted":
         return 128 + (stops.signum or signal.SIGINT)
     return EXIT.get(status, 1)

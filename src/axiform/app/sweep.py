@@ -1,4 +1,4 @@
-"""`axiform sweep SWEEP.toml --out DIR [--scheduler ADDRESS] [--workers N]`: many variants
+"""`axiform sweep SWEEP.toml --out DIR [--scheduler ADDRESS] [--workers N] [-q]`: many variants
 of one case on a Dask cluster.
 
     case = "plate.toml"                 # relative to SWEEP.toml
@@ -25,7 +25,8 @@ skips the cases whose summary.json says "finished" for the same case text (resum
 Dask distributed runs the cases: a LocalCluster of N single-threaded worker processes
 (default: the cores), or the scheduler at --scheduler (its workers need axiform and the
 folders, by a shared file system).  Exit 0 when every case finished, 1 when some did not,
-2 for an invalid sweep file (refused before any work).
+2 for an invalid sweep file (refused before any work); SIGINT or SIGTERM closes the cluster
+and keeps the rows of the finished cases, the others "interrupted": exit 130 or 143.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ import io
 import itertools
 import math
 import os
+import signal
 import sys
 import time
 import tomllib
@@ -51,6 +53,7 @@ from ..io.text import MAX_CASE_BYTES, FileTooLarge, read_text
 from ..post.sweep_plots import plot_sweep
 from ..post.sweep_plots import value_text as toml_value
 from .console import ProgressLine, tell
+from .run import Stops
 from .sweep_rows import summary_row
 
 SWEEP_KEYS = ("case", "vary", "cases", "report")
@@ -234,10 +237,10 @@ def run_case(case_file: str, overrides: list[str], out: str) -> dict[str, Any]:
 
 class SweepProgress:
     """The progress of a sweep (console.ProgressLine): a bar of the cases done on a terminal,
-    else one line per finished case."""
+    else one line per finished case; nothing when quiet."""
 
-    def __init__(self, stream, total: int):
-        self.line = ProgressLine(stream, total)
+    def __init__(self, stream, total: int, quiet: bool = False):
+        self.line = ProgressLine(stream, total, quiet)
         self.total = total
         self.done = self.failed = 0
 
@@ -292,10 +295,15 @@ def write_table(path: Path, sweep: Sweep, rows: list[dict | None]) -> None:
                 " ".join(str(row.get("message", "")).split()),
                 *[repr(monitors[m]) if m in monitors else "" for m in sweep.monitors],
                 "" if thinnest is None else repr(thinnest),
-                *[repr(v) for m in sweep.monitors for v in extremes.get(m, ("", ""))],
+                *[cell for m in sweep.monitors for cell in _extreme_cells(extremes.get(m))],
             ]
         )
     write_atomic(path, text.getvalue())
+
+
+def _extreme_cells(pair: tuple[float, float] | None) -> tuple[str, str]:
+    """A monitor's (min, max) cells of sweep.csv: empty for a case without a history."""
+    return ("", "") if pair is None else (repr(pair[0]), repr(pair[1]))
 
 
 def _client(scheduler: str | None, workers: int | None):
@@ -306,19 +314,26 @@ def _client(scheduler: str | None, workers: int | None):
 
     if scheduler:
         return Client(scheduler), None
+    # the cluster's own log lines are about its machinery, not the cases (each case's failure
+    # comes back as its row): at its close a worker's heartbeat may find the scheduler gone and
+    # log a traceback (ERROR); its HTTP server on a free port, not 8787 (taken by another
+    # sweep, with a warning)
     cluster = LocalCluster(
         n_workers=workers or os.cpu_count() or 1,
         threads_per_worker=1,
         processes=True,
         dashboard_address=None,
-        silence_logs=logging.ERROR,
+        scheduler_kwargs={"dashboard_address": ":0"},
+        silence_logs=logging.CRITICAL,
         env=WORKER_ENV,
     )
     return Client(cluster), cluster
 
 
-def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: int | None = None) -> int:
-    """The `axiform sweep` command; returns the exit code."""
+def run_sweep(
+    sweep_file: str, out: str, scheduler: str | None = None, workers: int | None = None, quiet: bool = False
+) -> int:
+    """The `axiform sweep` command; returns the exit code.  quiet: the final line alone."""
     say = sys.stderr
     try:
         sweep = load_sweep(sweep_file)
@@ -339,7 +354,7 @@ def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: 
     n = len(sweep.cases)
     rows: list[dict | None] = [None] * n
     folders = [root / "cases" / f"{k + 1:04d}" for k in range(n)]
-    progress = SweepProgress(sys.stdout, n)  # what the command produces on stdout, errors on stderr
+    progress = SweepProgress(sys.stdout, n, quiet)  # what the command produces on stdout, errors on stderr
     todo = []
     for k in range(n):  # resume: a finished folder of the same case text is kept
         done = summary_row(folders[k])
@@ -350,46 +365,76 @@ def run_sweep(sweep_file: str, out: str, scheduler: str | None = None, workers: 
             progress(folders[k].name, row, skipped=True)
         else:
             todo.append(k)
-    tell(f"axiform sweep: {n} cases of {sweep.case_file.name}, {len(todo)} to run -> {root}")
+    if not quiet:
+        tell(f"axiform sweep: {n} cases of {sweep.case_file.name}, {len(todo)} to run -> {root}")
     write_table(root / "sweep.csv", sweep, rows)
-    if todo:
-        from distributed import as_completed
-
-        client, cluster = _client(scheduler, workers)
+    with Stops() as stops:
         try:
-            futures = {
-                client.submit(
-                    run_case,
-                    str(sweep.case_file),
-                    sweep.overrides(k),
-                    str(folders[k].resolve()),
-                    key=f"axiform-case-{k + 1:04d}-{os.getpid()}-{time.time_ns()}",
-                    pure=False,
-                ): k
-                for k in todo
-            }
-            for future in as_completed(futures):
-                k = futures[future]
-                try:
-                    row = future.result()
-                except Exception as exc:  # noqa: BLE001 - a worker died or was lost: the row says so
-                    row = {"status": "failed", "exit_code": 3, "message": f"{type(exc).__name__}: {exc}"}
-                rows[k] = row
-                progress(folders[k].name, row)
-                write_table(root / "sweep.csv", sweep, rows)
-        finally:
+            if todo:
+                _run_cases(sweep, root, todo, rows, progress, (scheduler, workers), stops)
+        except Exception:
+            # SIGINT or SIGTERM (Interrupted, or whatever the cluster's code made of it)
+            if stops.signum is None:
+                raise
+        stops.raised = True  # a later signal waits for the wind-up: the table, the picture, the last line
+        return _wind_up(sweep, root, rows, progress, stops.signum)
+
+
+def _run_cases(sweep: Sweep, root: Path, todo: list[int], rows: list, progress, where, stops) -> None:
+    """The cases `todo` on the cluster (where: the scheduler's address or None, the workers),
+    each row in `rows` and root/sweep.csv as it comes; the cluster closed however it ends."""
+    from distributed import as_completed
+
+    folders = [root / "cases" / f"{k + 1:04d}" for k in range(len(rows))]
+    client, cluster = _client(*where)
+    try:
+        futures = {
+            client.submit(
+                run_case,
+                str(sweep.case_file),
+                sweep.overrides(k),
+                str(folders[k].resolve()),
+                key=f"axiform-case-{k + 1:04d}-{os.getpid()}-{time.time_ns()}",
+                pure=False,
+            ): k
+            for k in todo
+        }
+        for future in as_completed(futures):
+            k = futures[future]
+            try:
+                row = future.result()
+            except Exception as exc:  # noqa: BLE001 - a worker died or was lost: the row says so
+                row = {"status": "failed", "exit_code": 3, "message": f"{type(exc).__name__}: {exc}"}
+            rows[k] = row
+            progress(folders[k].name, row)
+            write_table(root / "sweep.csv", sweep, rows)
+    finally:
+        with stops.held():  # a signal waits for the cluster to close
             client.close()
             if cluster is not None:
                 cluster.close()
+
+
+def _wind_up(sweep: Sweep, root: Path, rows: list, progress, signum: int | None) -> int:
+    """After the cases (all, or those a signal let finish: the others' rows say "interrupted"):
+    sweep.csv, sweep.png and the final line; the exit code."""
+    n = len(rows)
+    if signum is not None:
+        why = f"interrupted by {signal.Signals(signum).name} before the case finished"
+        rows[:] = [row or {"status": "interrupted", "message": why} for row in rows]
+        write_table(root / "sweep.csv", sweep, rows)
     progress.close()
     try:
         plot_sweep(root / "sweep.png", sweep, rows)
     except Exception as exc:  # noqa: BLE001 - the cases and sweep.csv stand; say why the picture does not
-        print(f"axiform sweep: sweep.png not written ({type(exc).__name__}: {exc})", file=say)
+        print(f"axiform sweep: sweep.png not written ({type(exc).__name__}: {exc})", file=sys.stderr)
     bad = [f"{k + 1:04d}" for k, r in enumerate(rows) if (r or {}).get("status") != "finished"]
+    head = "axiform sweep: " + ("" if signum is None else f"interrupted by {signal.Signals(signum).name}: ")
     tell(
-        f"axiform sweep: {n - len(bad)} of {n} cases finished"
+        f"{head}{n - len(bad)} of {n} cases finished"
         + (f"; not finished: {', '.join(bad)}" if bad else "")
         + f" -> {root / 'sweep.csv'}"
     )
+    if signum is not None:
+        return 128 + signum
     return 1 if bad else 0

@@ -152,12 +152,17 @@ class Forward:
 
     def solve(self, x: np.ndarray) -> tuple[Solved, dict[str, np.ndarray] | None]:
         """The forward solve of the design x, every step kept, and its final thickness table
-        (None without a converged step)."""
+        (None without a converged step).  The solve whose step ends become the stops is kept
+        with the control that lands on them (the case optimized.toml writes for its design):
+        clipped to its own step ends, every step is the one it took, so the same path."""
         design = self.design
         model = design.model(x)
         control, options = self.control(), design.built.options
         result = solve(model, control, options)
-        self._keep_stops(result, model)
+        if self.stops is None:
+            self._keep_stops(result, model)
+            if self.stops:
+                control = replace(control, stops=self.stops)
         last = result.last
         table = None
         if last is not None:

@@ -27,7 +27,14 @@ BRANCH_CHECK_MAX = 20_000
 
 
 class ArcLengthPath(PathFollowing):
-    _state_keys = ("u_f", "lam", "previous", "finished", "nominal", "travelled", "progress", "orientation")
+    """The arc-length scheme.  The arc grows back by the growth after easy steps; where it
+    does not grow (growth = 1), a failed step is sub-stepped as under load control: its
+    `goal` is the arc still to go, the sub-steps add up to the failed step's arc (or to the
+    nominal arc where that has become shorter: it is worked out anew after every step, the
+    first along the initial tangent), then the nominal arc resumes (PathFollowing)."""
+
+    _state_keys = ("u_f", "lam", "previous", "finished", "nominal", "travelled", "progress", "orientation", "goal")
+    _optional = {"goal": None}
 
     def __init__(self, model, control: ArcLengthControl, opts):
         super().__init__(model, opts)
@@ -102,7 +109,24 @@ class ArcLengthPath(PathFollowing):
     def _crossed(self, old, new, goal):
         return goal is not None and (old - goal) * (new - goal) <= 0 and new != old
 
+    def _nominal_end(self) -> float:
+        """The arc of a nominal step (the goal's measure: the arc still to go)."""
+        return self.nominal
+
+    def cut(self) -> None:
+        if self.opts.growth <= 1.0:  # a growing arc comes back by itself
+            super().cut()
+
+    def hold(self, size: float) -> None:
+        if self.opts.growth <= 1.0:
+            super().hold(size)
+
+    def clip(self, size):
+        """The arc, at most what is left of the step being sub-stepped."""
+        return size if self.goal is None else min(size, self.goal)
+
     def attempt(self, size):
+        self.aim = size
         u_new, lam_new, its, res, ev = self._arc_step(size)
         if not self.loaded and self.control.arc_length is None and abs(lam_new - self.lam) > self.load_step:
             # where the displacements hardly move (a wall pressed on a mould) an arc of them is
@@ -162,6 +186,9 @@ class ArcLengthPath(PathFollowing):
                 self.nominal = rate / self.control.steps
         super().accept(u_f, lam, size)
         self.finished = self._landed
+        if self.goal is not None:  # the arc still to go of the step being sub-stepped, at most the new nominal one
+            left = self.goal - size
+            self.goal = min(left, self.nominal) if left > 1e-12 * self.goal else None
 
     def _load_step(self, dl):
         """Where no arc can be measured: a load step sized like the arc (dl / nominal load

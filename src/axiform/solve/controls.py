@@ -80,7 +80,9 @@ class NewtonOptions:
     landing on the interval's end.  There the nominal steps resume if that last sub-step was
     easy; if not, its size is carried into the next interval, which is sub-stepped the same
     way: no step crosses a nominal point, so every run passes the same nominal points however
-    it cut.  Under arc length the step grows back by `growth` up to the nominal arc.  A step
+    it cut.  Under arc length the step grows back by `growth` up to the nominal arc; with
+    growth = 1 a cut arc is sub-stepped (its sub-steps add up to it) and the nominal arc then
+    resumes.  A step
     of a fraction f of the nominal size moves the contact multipliers f of the way
     (ContactState.advanced).  The run stops when a step would be smaller than min_step times
     the nominal step, or times the interval between two knots of the loads' curves where that

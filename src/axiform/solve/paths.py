@@ -28,15 +28,16 @@ from .newton import (
 class PathFollowing:
     """Shared state of a path-following scheme: the last converged (u_f, lambda).
 
-    A scheme with a nominal grid (`grid`: load and displacement control) sub-steps a failed
-    step to the end of its own nominal interval: `cut()` keeps that end as `goal`, every
-    step is clipped to it and the last one lands exactly on it; then the grid resumes
-    (`goal` None), or, where the size carried on is below the nominal one, `hold` makes the
-    next nominal interval the goal, so that runs which cut different steps still pass the same
-    nominal points."""
+    Every scheme sub-steps a failed step to the end of its own interval: `cut()` keeps that
+    end as `goal` (in the scheme's own measure: lambda, the driven dof's value, or the arc
+    still to go), every step is clipped to it and the last one lands exactly on it; then the
+    nominal steps resume (`goal` None), or, where the size carried on is below the nominal
+    one, `hold` makes the next nominal interval the goal.  Under load and displacement
+    control runs which cut different steps so pass the same nominal points; under arc length
+    a cut step's arc is made up by its sub-steps, and the nominal arc comes back whatever the
+    growth."""
 
     max_steps = 10**9
-    grid = False
     nominal: float  # the nominal step (lambda, the driven dof's value or the arc)
 
     def __init__(self, model: System, opts: NewtonOptions):
@@ -47,8 +48,8 @@ class PathFollowing:
         self.u_f = np.zeros(model.n_free)
         self.lam = 0.0
         self.history = model.initial_state()  # the committed state of the last converged step
-        self.goal: float | None = None  # the end of the nominal interval being sub-stepped (grid schemes)
-        self.aim = 0.0  # where the last attempted step was to end (lambda, or the driven dof's value)
+        self.goal: float | None = None  # the end of the interval being sub-stepped (None: none is)
+        self.aim = 0.0  # where the last attempted step was to end (lambda, the driven dof's value, or its arc)
 
     def clip(self, size: float) -> float:
         return size
@@ -62,20 +63,21 @@ class PathFollowing:
     _optional: dict[str, Any] = {}  # state keys a checkpoint of an older version may lack: their defaults
 
     def cut(self) -> None:
-        """The step just attempted failed: where the scheme has a grid, the rest of that step's
-        nominal interval is sub-stepped (the goal is the end the failed step aimed at)."""
-        if self.grid and self.goal is None:
+        """The step just attempted failed: the rest of that step's interval is sub-stepped (the
+        goal is the end the failed step aimed at)."""
+        if self.goal is None:
             self.goal = self.aim
 
     def hold(self, size: float) -> None:
-        """The next step is `size`: where it is shorter than the nominal one on a scheme with a
-        grid, the nominal interval ahead is sub-stepped (its end becomes the goal), so that
-        sizes carried from a cut interval never take the run off the nominal points."""
-        if self.grid and self.goal is None and abs(size) < abs(self.nominal) and not self.done():
+        """The next step is `size`: where it is shorter than the nominal one, the nominal
+        interval ahead is sub-stepped (its end becomes the goal), so that sizes carried from a
+        cut interval never take the run off the nominal points (or, under arc length, come
+        back to the nominal arc once that interval is done)."""
+        if self.goal is None and abs(size) < abs(self.nominal) and not self.done():
             self.goal = self._nominal_end()
 
     def _nominal_end(self) -> float:
-        """Where a nominal step from the last converged state ends (grid schemes)."""
+        """Where a nominal step from the last converged state ends, in the goal's measure."""
         raise NotImplementedError
 
     def done(self) -> bool:
@@ -177,7 +179,6 @@ class LoadPath(PathFollowing):
 
     _state_keys = ("u_f", "lam", "rate", "previous", "goal")
     _optional = {"goal": None}
-    grid = True
 
     def __init__(self, model, control: LoadControl, opts):
         super().__init__(model, opts)
@@ -302,7 +303,6 @@ class LoadPath(PathFollowing):
 class DisplacementPath(PathFollowing):
     _state_keys = ("u_f", "lam", "previous", "reached", "goal")
     _optional = {"goal": None}
-    grid = True
 
     def __init__(self, model, control: DisplacementControl, opts):
         super().__init__(model, opts)
