@@ -39,15 +39,18 @@ def passed_through(pair, x: np.ndarray, t: float) -> PassedThrough | None:
     return PassedThrough(int(behind.sum()), float(-proj.g[k]), (float(x[k, 0]), float(x[k, 1])))
 
 
-def unheld_behind(pair, x: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray]:
-    """The boundary nodes of the body that are not slaves of the pair and lie behind its
-    surface at positions x (n_nodes, 2) at time t, on a piece they project onto and in front
-    of none: their indices (k,) and depths (k,) (none: empty arrays)."""
-    nodes = np.setdiff1d(np.unique(pair.mesh.boundary_edges), pair.nodes)
+def unheld(pair) -> np.ndarray:
+    """The boundary nodes of the body that are not slaves of the pair (k,)."""
+    return np.setdiff1d(np.unique(pair.mesh.boundary_edges), pair.nodes)
+
+
+def unheld_behind(pair, nodes: np.ndarray, x: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray]:
+    """Those of `nodes` (k,) (the pair's `unheld`) that lie behind its surface at positions
+    x (n_nodes, 2) at time t, within the pair's search depth (deeper: `passed_through`), on a
+    piece they project onto and in front of none: their indices and depths (none: empty)."""
     if nodes.size == 0:
         return nodes, np.zeros(0)
     rel = x[nodes] - pair.surface.offset(t)
-    span = float(np.ptp(pair.mesh.points, axis=0).max())
-    proj = pair.surface.local(rel, rel, depth=REACH * span + pair.depth, method=pair.search)
+    proj = pair.surface.local(rel, rel, depth=pair.depth, method=pair.search)
     behind = proj.active & (proj.kind == 1) & (proj.g < 0.0)
     return nodes[behind], -proj.g[behind]

@@ -88,6 +88,11 @@ class RunRecord:
         """earlier: the `contact` entries of the summary.json a resumed run continues."""
         self.model = model
         self.pairs = [PairRecord(p.name or f"contact[{k}]") for k, p in enumerate(model.contacts)]
+        self.unheld: list[np.ndarray] = []  # each pair's boundary nodes that are not its slaves
+        if model.contacts:  # (a run without contact imports no contact module)
+            from ..contact.checks import unheld
+
+            self.unheld = [unheld(p) for p in model.contacts]
         for rec, old in zip(self.pairs, earlier or [], strict=False):
             rec.touched = bool(old.get("touched", False))
             for key in ("max_force_r", "max_force_z", "max_penetration_ratio"):
@@ -122,7 +127,7 @@ class RunRecord:
         (contact.checks.unheld_behind), against the local wall (n_nodes,)."""
         from ..contact.checks import unheld_behind
 
-        nodes, depth = unheld_behind(self.model.contacts[k], x, step.lam)
+        nodes, depth = unheld_behind(self.model.contacts[k], self.unheld[k], x, step.lam)
         if nodes.size == 0:
             return
         ratio = depth / wall[nodes]
