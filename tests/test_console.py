@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from axiform.app.console import COLUMNS, Guarded, ProgressLine, guarded_streams
+from axiform.app.console import COLUMNS, Guarded, ProgressLine, apart, guarded_streams
 from axiform.app.run import status_line
 from axiform.cli import build_parser, main
 
@@ -141,6 +141,15 @@ def test_a_run_prints_progress_and_status_on_stdout_and_nothing_on_stderr(tmp_pa
     steps = lines[1:-1]
     assert len(steps) == 40 and steps[0].startswith("step 1  lambda ")  # a plain pressure: lambda
     assert all(len(line) <= COLUMNS for line in steps)
+
+
+def test_two_steps_a_cut_apart_are_printed_as_two_times():
+    """A step cut eight times lands 7.3e-5 after the last one: four digits printed both as
+    0.9386; the progress gives the digits that tell them apart, and no more elsewhere."""
+    assert apart(0.9386474609375, 0.9385742187499999) == "0.93865"
+    assert apart(0.9385742187499999, 0.93828125) == "0.9386"
+    assert apart(0.5, None) == "0.5" and apart(0.5, 0.5) == "0.5"
+    assert apart(1.0 + 1e-13, 1.0) == "1.0000000000001"
 
 
 def test_the_load_factor_is_called_t_where_it_is_the_process_time(tmp_path, capsys):

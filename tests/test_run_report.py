@@ -15,6 +15,7 @@ import pytest
 
 from axiform import rectangle
 from axiform.case.schema import build, parse
+from axiform.contact.surfaces import Polyline
 from axiform.fem.mesh import layered
 from axiform.fem.profile import Arc, Line, Profile
 from axiform.io.results import ResultsWriter
@@ -133,11 +134,15 @@ def test_vtu_names_the_stress_components_and_the_hydrostatic_pressure(ring_run):
     assert np.mean(m.point_data["hydrostatic_pressure"]) == pytest.approx(np.mean(p), rel=0.05)
 
 
-def fake_model(stabilization=0.0, energy=1.0):
-    """A plate 0.3 thick (a wall through z) with one stub contact pair on its top face."""
+def fake_model(stabilization=0.0, energy=1.0, wall_at=10.0):
+    """A plate 0.3 thick (a wall through z) with one stub contact pair on its top face, whose
+    surface is a wall r = wall_at facing the plate (far from it by default)."""
     mesh = rectangle((0.0, 2.0), (0.0, 0.3), (4, 2), "q4")
     top = np.flatnonzero(np.isclose(mesh.points[:, 1], 0.3))
-    pair = SimpleNamespace(name="punch", nodes=top, stabilization=stabilization)
+    surface = Polyline(points=np.array([[wall_at, -1.0], [wall_at, 1.0]]))  # walked upwards: the plate on its left
+    pair = SimpleNamespace(
+        name="punch", nodes=top, stabilization=stabilization, mesh=mesh, surface=surface, depth=0.1, search="brute"
+    )
     model = SimpleNamespace(
         mesh=mesh, contacts=[pair], strain_energy=lambda u, state=None: energy, contact_states=lambda state: state.terms
     )
@@ -156,9 +161,9 @@ def test_a_penetration_above_5_percent_of_the_wall_is_a_warning():
     gap = np.zeros(len(top))
     gap[2] = -0.018  # 6 % of 0.3
     table = thickness_table(model.mesh, np.zeros_like(x))
-    rec.contact_step(SimpleNamespace(number=3), [report(top, gap, np.ones(len(top)))], x, table)
+    rec.contact_step(SimpleNamespace(number=3, lam=1.0), [report(top, gap, np.ones(len(top)))], x, table)
     gap[2] = -0.006
-    rec.contact_step(SimpleNamespace(number=4), [report(top, gap, np.ones(len(top)))], x, table)
+    rec.contact_step(SimpleNamespace(number=4, lam=1.0), [report(top, gap, np.ones(len(top)))], x, table)
     assert rec.pairs[0].max_penetration_ratio == pytest.approx(0.06)
     (line,) = rec.warnings(SimpleNamespace(state=state, u=None), None)
     assert line.startswith('contact[0] ("punch") penetrates 6.0 % of the local wall thickness (0.018 of 0.3 at r = 1')
@@ -167,8 +172,30 @@ def test_a_penetration_above_5_percent_of_the_wall_is_a_warning():
     model.mesh.fibres = None
     rec = RunRecord(model)
     gap[2] = -0.018
-    rec.contact_step(SimpleNamespace(number=1), [report(top, gap, np.ones(len(top)))], x, None)
+    rec.contact_step(SimpleNamespace(number=1, lam=1.0), [report(top, gap, np.ones(len(top)))], x, None)
     assert rec.pairs[0].max_penetration_ratio == pytest.approx(0.12)
+
+
+def test_a_face_that_is_not_a_slave_crossing_the_surface_is_a_warning():
+    """The pair holds the plate's top face; its surface, the wall r = 1.95, cuts the plate's
+    side r = 2, which it does not hold: the side's nodes below the top face lie 0.05 behind
+    it, 17 % of the wall (0.3).  A rubber ring's sides that barrel and fold onto a plate
+    holding only its faces passed through it so."""
+    model, top = fake_model(wall_at=1.95)
+    rec = RunRecord(model)
+    x = model.mesh.points.copy()
+    state = SimpleNamespace(terms=[SimpleNamespace(first_contact=np.full(len(top), 0.5), damping_work=0.0)])
+    table = thickness_table(model.mesh, np.zeros_like(x))
+    rec.contact_step(SimpleNamespace(number=2, lam=1.0), [report(top, np.zeros(len(top)), np.ones(len(top)))], x, table)
+    assert rec.pairs[0].unheld_ratio == pytest.approx(0.05 / 0.3)
+    (line,) = rec.warnings(SimpleNamespace(state=state, u=None), None)
+    assert line.startswith('contact[0] ("punch"): a face of the body that is not its slave crosses it: a boundary')
+    assert "0.05 behind it at r = 2, z = 0" in line and "step 2" in line and "select that face as slaves" in line
+    # the surface in front of the side: no warning
+    model, top = fake_model(wall_at=2.05)
+    rec = RunRecord(model)
+    rec.contact_step(SimpleNamespace(number=2, lam=1.0), [report(top, np.zeros(len(top)), np.ones(len(top)))], x, table)
+    assert rec.pairs[0].unheld_ratio == 0.0 and rec.warnings(SimpleNamespace(state=state, u=None), None) == []
 
 
 def test_stabilization_work_above_1_percent_of_the_strain_energy_is_a_warning():

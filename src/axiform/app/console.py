@@ -24,6 +24,17 @@ from typing import Any
 COLUMNS = 80
 
 
+def apart(value: float, previous: float | None, digits: int = 4) -> str:
+    """value with `digits` significant digits, or as many more (up to 15) as tell it from
+    `previous` (None: none before): two steps a cut apart (t 0.938574 and 0.938647) do not
+    read as one time printed twice."""
+    for n in range(digits, 16):
+        text = f"{value:.{n}g}"
+        if previous is None or value == previous or text != f"{previous:.{n}g}":
+            return text
+    return text
+
+
 class Guarded:
     """A text stream that a closed reader cannot break: the first write or flush that finds
     the pipe closed (BrokenPipeError, EPIPE) points the stream's file descriptor at os.devnull

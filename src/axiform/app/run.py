@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any, Self
 
 from .. import __version__
-from .console import COLUMNS, ProgressLine, failed, invalid, say, tell, trace, warn
+from .console import COLUMNS, ProgressLine, apart, failed, invalid, say, tell, trace, warn
 
 EXIT = {"finished": 0, "stopped": 1, "failed": 3}
 # history.csv, summary.json, thickness.csv and fields.pvd are rewritten at most every half
@@ -322,8 +322,8 @@ BAR_COLUMNS = 27
 def _step_progress(job: Job, quiet: bool, stream):
     """The progress of a run, called with each converged step and its monitor values: the
     driven dof, the stop dof of an arc length, or the load factor, against its goal.  A line
-    within COLUMNS: step, t with its unit (or lambda), Newton iterations, seconds, then the
-    monitors that fit."""
+    within COLUMNS: step, t with its unit (or lambda: with the digits that tell it from the
+    last step's), Newton iterations, seconds, then the monitors that fit."""
     control = job.built.control
     driven, goal = getattr(control, "dof", None), control.target
     if getattr(control, "stop_dof", None) is not None:
@@ -331,10 +331,13 @@ def _step_progress(job: Job, quiet: bool, stream):
     line = ProgressLine(stream, 1.0, quiet)
     lam, unit = time_name(job.case, job.built.model)
     unit = f" {unit}" if unit else ""
+    shown: list[float] = []  # the load factor of the step shown last
 
     def show(step, values: dict[str, float]) -> None:
         frac = (step.u[driven] if driven is not None else step.lam) / goal
-        head = f"step {step.number}  {lam} {step.lam:.4g}{unit}  its {step.iterations}  {line.elapsed:.1f} s"
+        at = apart(step.lam, shown[-1] if shown else None)
+        shown[:] = [step.lam]
+        head = f"step {step.number}  {lam} {at}{unit}  its {step.iterations}  {line.elapsed:.1f} s"
         mon = [f"{k} {v:.4g}" for k, v in list(values.items())[:3]]
         line.show(
             frac,

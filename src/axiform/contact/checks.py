@@ -1,7 +1,8 @@
-"""Checks of a contact pair at the end of a run: nodes of the body that passed through the
-surface (behind it deeper than the pair's search depth, where the pair no longer sees them:
-a body whose slaves are on its face away from the mould sinks through the mould, held at most
-by that face)."""
+"""Checks of a contact pair over a run: nodes of the body that passed through the surface
+(behind it deeper than the pair's search depth, where the pair no longer sees them: a body
+whose slaves are on its face away from the mould sinks through the mould, held at most by
+that face), and boundary nodes that are not its slaves behind it (a face the pair does not
+hold crossing the surface: the side of a part that barrels and folds onto a plate)."""
 
 from __future__ import annotations
 
@@ -36,3 +37,20 @@ def passed_through(pair, x: np.ndarray, t: float) -> PassedThrough | None:
         return None
     k = int(np.argmin(np.where(behind, proj.g, np.inf)))
     return PassedThrough(int(behind.sum()), float(-proj.g[k]), (float(x[k, 0]), float(x[k, 1])))
+
+
+def unheld(pair) -> np.ndarray:
+    """The boundary nodes of the body that are not slaves of the pair (k,)."""
+    return np.setdiff1d(np.unique(pair.mesh.boundary_edges), pair.nodes)
+
+
+def unheld_behind(pair, nodes: np.ndarray, x: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray]:
+    """Those of `nodes` (k,) (the pair's `unheld`) that lie behind its surface at positions
+    x (n_nodes, 2) at time t, within the pair's search depth (deeper: `passed_through`), on a
+    piece they project onto and in front of none: their indices and depths (none: empty)."""
+    if nodes.size == 0:
+        return nodes, np.zeros(0)
+    rel = x[nodes] - pair.surface.offset(t)
+    proj = pair.surface.local(rel, rel, depth=pair.depth, method=pair.search)
+    behind = proj.active & (proj.kind == 1) & (proj.g < 0.0)
+    return nodes[behind], -proj.g[behind]

@@ -63,6 +63,8 @@ class PairRecord:
     max_force_z: float = 0.0
     max_penetration_ratio: float = 0.0  # the largest penetration / local wall of a step
     at: dict = field(default_factory=dict)  # where and when: penetration, wall, r, z, step
+    unheld_ratio: float = 0.0  # the largest depth / local wall of a boundary node behind it, not its slave
+    unheld: dict = field(default_factory=dict)  # where and when: depth, r, z, step
 
     def summary(self) -> dict:
         return {
@@ -86,6 +88,11 @@ class RunRecord:
         """earlier: the `contact` entries of the summary.json a resumed run continues."""
         self.model = model
         self.pairs = [PairRecord(p.name or f"contact[{k}]") for k, p in enumerate(model.contacts)]
+        self.unheld: list[np.ndarray] = []  # each pair's boundary nodes that are not its slaves
+        if model.contacts:  # (a run without contact imports no contact module)
+            from ..contact.checks import unheld
+
+            self.unheld = [unheld(p) for p in model.contacts]
         for rec, old in zip(self.pairs, earlier or [], strict=False):
             rec.touched = bool(old.get("touched", False))
             for key in ("max_force_r", "max_force_z", "max_penetration_ratio"):
@@ -96,7 +103,8 @@ class RunRecord:
         nodes x (n, 2) and the thickness table of the step (None without a wall)."""
         mesh = self.model.mesh
         wall = nodal_thickness(mesh, table) if table is not None else element_heights(mesh, x)
-        for rec, rep in zip(self.pairs, reports, strict=False):
+        for k, (rec, rep) in enumerate(zip(self.pairs, reports, strict=False)):
+            self._unheld(k, rec, step, x, wall)
             rec.touched |= bool(np.any(rep["status"] > 0))
             rec.max_force_r = max(rec.max_force_r, abs(rep["force_r"]))
             rec.max_force_z = max(rec.max_force_z, abs(rep["force_z"]))
@@ -113,6 +121,21 @@ class RunRecord:
                     "z": float(x[node, 1]),
                     "step": int(step.number),
                 }
+
+    def _unheld(self, k: int, rec: PairRecord, step, x: np.ndarray, wall: np.ndarray) -> None:
+        """Record the deepest boundary node behind contact pair k that is not its slave
+        (contact.checks.unheld_behind), against the local wall (n_nodes,)."""
+        from ..contact.checks import unheld_behind
+
+        nodes, depth = unheld_behind(self.model.contacts[k], self.unheld[k], x, step.lam)
+        if nodes.size == 0:
+            return
+        ratio = depth / wall[nodes]
+        j = int(np.argmax(ratio))
+        if ratio[j] > rec.unheld_ratio:
+            rec.unheld_ratio = float(ratio[j])
+            node = nodes[j]
+            rec.unheld = {"depth": float(depth[j]), "r": float(x[node, 0]), "z": float(x[node, 1]), "step": step.number}
 
     def stabilization(self, step) -> dict | None:
         """{work, strain_energy, ratio} of the last step where a pair is stabilized, else None
@@ -134,7 +157,8 @@ class RunRecord:
     def warnings(self, step, stabilization: dict | None) -> list[str]:
         """The end-of-run warnings, one line each (a pair named once: contact[k], and its name
         where it has one): a pair that never touched, a penetration above PENETRATION_LIMIT
-        of the wall, slave nodes that passed through the mould (contact.checks), stabilization
+        of the wall, a boundary node that is not a slave behind the mould deeper than that,
+        slave nodes that passed through the mould (contact.checks), stabilization
         work above STABILIZATION_LIMIT of the strain energy."""
         from ..contact.state import ContactState
 
@@ -151,6 +175,14 @@ class RunRecord:
                     f"local wall thickness ({a['penetration']:.4g} of {a['wall']:.4g} at r = {a['r']:.4g}, "
                     f"z = {a['z']:.4g}, step {a['step']}; above {100 * PENETRATION_LIMIT:g} %): "
                     "raise its penalty or refine the steps"
+                )
+            if rec.unheld_ratio > PENETRATION_LIMIT:
+                a = rec.unheld
+                lines.append(
+                    f"{name}: a face of the body that is not its slave crosses it: a boundary node "
+                    f"{a['depth']:.4g} behind it at r = {a['r']:.4g}, z = {a['z']:.4g}, step {a['step']} "
+                    f"(above {100 * PENETRATION_LIMIT:g} % of the wall): select that face as slaves too "
+                    "(a side that barrels onto a plate)"
                 )
             through = self._through(k, step) if isinstance(held, ContactState) else None
             if through is not None:
