@@ -82,9 +82,8 @@ class NewtonOptions:
     way: no step crosses a nominal point, so every run passes the same nominal points however
     it cut.  Under arc length the step grows back by `growth` up to the nominal arc; with
     growth = 1 a cut arc is sub-stepped (its sub-steps add up to it) and the nominal arc then
-    resumes.  A step
-    of a fraction f of the nominal size moves the contact multipliers f of the way
-    (ContactState.advanced).  The run stops when a step would be smaller than min_step times
+    resumes.  A step of a fraction f of the nominal size moves the contact multipliers f of
+    the way (ContactState.advanced).  The run stops when a step would be smaller than min_step times
     the nominal step, or times the interval between two knots of the loads' curves where that
     is shorter (PathFollowing.span)."""
 
