@@ -295,17 +295,22 @@ def _loaded(case: Case) -> bool:
     return any(item.value for item in loads) or moving or gas or heated or weight
 
 
-def _loads_and_moulds(case: Case, model: Model, mesh, base: Path) -> tuple[dict, list]:
-    """Give the model the loads, cavities, moulds, heat conduction and weight of the case;
-    the cavities by name and the contact pairs.  The modules of the tables the case lacks are
-    not imported."""
+def _loads(case: Case, model: Model, mesh) -> dict:
+    """Give the model the supports, loads and cavities of the case; the cavities by name.
+    The cavity module is imported where the case has one."""
     prescribe_fixes(model, mesh, case.fix)
     apply_loads(model, mesh, case.pressure, case.point_load)
-    cavities: dict = {}
-    if case.cavity:
-        from .cavity import build_cavities
+    if not case.cavity:
+        return {}
+    from .cavity import build_cavities
 
-        cavities = build_cavities(model, mesh, case.cavity)
+    return build_cavities(model, mesh, case.cavity)
+
+
+def _moulds(case: Case, model: Model, mesh, base: Path) -> list:
+    """Give the model the moulds, heat conduction and weight of the case (after its initial
+    temperature: the conduction starts from it); the contact pairs.  The modules of the tables
+    the case lacks are not imported."""
     pairs = []
     if case.contact:
         from .contact import contact_pair
@@ -321,7 +326,7 @@ def _loads_and_moulds(case: Case, model: Model, mesh, base: Path) -> tuple[dict,
         from .gravity import build_gravity
 
         build_gravity(model, mesh, case.gravity, case.material.density)
-    return cavities, pairs
+    return pairs
 
 
 def build(case: Case, base: str | Path = ".") -> Built:
@@ -346,10 +351,6 @@ def build(case: Case, base: str | Path = ".") -> Built:
         model = Model(mesh, material, formulation=case.mesh.formulation, sfr_edges=case.mesh.sfr_edges)
     except MeshError as exc:
         raise CaseError(f"mesh: {exc}") from None
-    if heat is not None:
-        from .temperature import give_temperature
-
-        give_temperature(model, mesh, case)
     crossing = boundary_crossing(mesh.points, mesh.boundary_edges)
     if crossing is not None:
         p = mesh.points[mesh.boundary_edges[crossing[0], 0]]
@@ -358,7 +359,15 @@ def build(case: Case, base: str | Path = ".") -> Built:
             f"(a profile that crosses itself, or overlapping elements)"
         )
     try:
-        cavities, pairs = _loads_and_moulds(case, model, mesh, base)
+        cavities = _loads(case, model, mesh)
+        if case.mesh.kind == "rectangle":  # the wall is normal to the faces that carry the pressure
+            loaded = model.pressures + getattr(model, "cavities", [])
+            mesh.set_wall(case.mesh.wall or default_wall(mesh.points, [p.nodes for p in loaded]))
+        if heat is not None:  # after the wall: a table along s follows it
+            from .temperature import give_temperature
+
+            give_temperature(model, mesh, case)
+        pairs = _moulds(case, model, mesh, base)
         control = build_control(model, mesh, case.solver)
         if not _loaded(case):
             raise CaseError(
@@ -375,13 +384,6 @@ def build(case: Case, base: str | Path = ".") -> Built:
             f"fix: a mechanism: {len(free)} bod{'y' if len(free) == 1 else 'ies'} of the mesh can "
             "move rigidly along z (no [[fix]] holds uz on it and no [[contact]] touches it)"
         )
-    if case.mesh.kind == "rectangle":  # the wall is normal to the faces that carry the pressure
-        loaded = model.pressures + getattr(model, "cavities", [])
-        mesh.set_wall(case.mesh.wall or default_wall(mesh.points, [p.nodes for p in loaded]))
-        if heat is not None and getattr(heat.initial, "along", None) == "s":  # s runs along the wall just set
-            from .temperature import give_temperature
-
-            give_temperature(model, mesh, case)
     try:
         system = model.finalize()
     except ValueError as exc:  # a tied fibre rotation prescribed twice
