@@ -29,14 +29,21 @@ def passed_through(pair, x: np.ndarray, t: float) -> PassedThrough | None:
     """The nodes of the body at positions x (n_nodes, 2) at time t that lie behind the pair's
     surface by more than its search depth, on a piece they project onto and in front of
     none (surfaces' `local`: the piece with the largest gap); None where there is none."""
-    rel = x - pair.surface.offset(t)
     span = float(np.ptp(pair.mesh.points, axis=0).max())
-    proj = pair.surface.local(rel, rel, depth=REACH * span + pair.depth, method=pair.search)
-    behind = proj.active & (proj.kind == 1) & (proj.g < -pair.depth)
+    behind, g = _behind(pair, x, t, REACH * span + pair.depth, pair.depth)
     if not behind.any():
         return None
-    k = int(np.argmin(np.where(behind, proj.g, np.inf)))
-    return PassedThrough(int(behind.sum()), float(-proj.g[k]), (float(x[k, 0]), float(x[k, 1])))
+    k = int(np.argmin(np.where(behind, g, np.inf)))
+    return PassedThrough(int(behind.sum()), float(-g[k]), (float(x[k, 0]), float(x[k, 1])))
+
+
+def _behind(pair, x: np.ndarray, t: float, reach: float, beyond: float) -> tuple[np.ndarray, np.ndarray]:
+    """Which points x (k, 2) at time t lie behind the pair's surface by more than `beyond`
+    (0: at all), projected up to `reach` behind it, on a piece they project onto and in front
+    of none (surfaces' `local`: the piece with the largest gap) (k, bool); their gaps (k,)."""
+    rel = x - pair.surface.offset(t)
+    proj = pair.surface.local(rel, rel, depth=reach, method=pair.search)
+    return proj.active & (proj.kind == 1) & (proj.g < -beyond), proj.g
 
 
 def unheld(pair) -> np.ndarray:
@@ -50,7 +57,5 @@ def unheld_behind(pair, nodes: np.ndarray, x: np.ndarray, t: float) -> tuple[np.
     piece they project onto and in front of none: their indices and depths (none: empty)."""
     if nodes.size == 0:
         return nodes, np.zeros(0)
-    rel = x[nodes] - pair.surface.offset(t)
-    proj = pair.surface.local(rel, rel, depth=pair.depth, method=pair.search)
-    behind = proj.active & (proj.kind == 1) & (proj.g < 0.0)
-    return nodes[behind], -proj.g[behind]
+    behind, g = _behind(pair, x[nodes], t, pair.depth, 0.0)
+    return nodes[behind], -g[behind]
