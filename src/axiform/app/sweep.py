@@ -371,7 +371,7 @@ def run_sweep(
     with Stops() as stops:
         try:
             if todo:
-                _run_cases(sweep, root, todo, rows, progress, (scheduler, workers), stops)
+                _run_cases(sweep, root, folders, todo, rows, progress, (scheduler, workers), stops)
         except Exception:
             # SIGINT or SIGTERM (Interrupted, or whatever the cluster's code made of it)
             if stops.signum is None:
@@ -380,12 +380,14 @@ def run_sweep(
         return _wind_up(sweep, root, rows, progress, stops.signum)
 
 
-def _run_cases(sweep: Sweep, root: Path, todo: list[int], rows: list, progress, where, stops) -> None:
+def _run_cases(
+    sweep: Sweep, root: Path, folders: list[Path], todo: list[int], rows: list, progress, where, stops
+) -> None:
     """The cases `todo` on the cluster (where: the scheduler's address or None, the workers),
-    each row in `rows` and root/sweep.csv as it comes; the cluster closed however it ends."""
+    each in its folder of `folders`, its row in `rows` and root/sweep.csv as it comes; the
+    cluster closed however it ends."""
     from distributed import as_completed
 
-    folders = [root / "cases" / f"{k + 1:04d}" for k in range(len(rows))]
     client, cluster = _client(*where)
     try:
         futures = {
